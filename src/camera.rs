@@ -1,0 +1,269 @@
+//! The positionable camera with defocus blur.
+//!
+//! The camera sits at `lookfrom` and looks at `lookat`. Its orientation is the
+//! orthonormal basis (u, v, w): w = unit(lookfrom − lookat) points backwards,
+//! u = unit(vup × w) to the right, v = w × u up. The viewport lies on the focus
+//! plane, `focus_dist` in front of the camera, and is 2·tan(vfov/2)·focus_dist
+//! high. Rays start from a random point of the defocus disk (the lens) and pass
+//! through a random point of their pixel, so only the focus plane is sharp.
+
+use crate::math::{Point3, Vec3};
+use crate::ray::Ray;
+use crate::rng::Rng;
+use crate::sampling;
+use thiserror::Error;
+
+/// Everything that places and shapes the camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSettings {
+    /// Vertical field of view in degrees, in (0, 180).
+    pub vfov: f32,
+    /// Eye position.
+    pub lookfrom: Point3,
+    /// Point looked at.
+    pub lookat: Point3,
+    /// "Up" direction; need not be orthogonal to the view direction.
+    pub vup: Vec3,
+    /// Angle in degrees of the cone from a pixel on the focus plane to the lens.
+    /// Zero gives a pinhole camera (everything sharp).
+    pub defocus_angle: f32,
+    /// Distance from `lookfrom` to the plane in perfect focus.
+    pub focus_dist: f32,
+}
+
+impl Default for CameraSettings {
+    fn default() -> Self {
+        Self {
+            vfov: 90.0,
+            lookfrom: Vec3::ZERO,
+            lookat: Vec3::new(0.0, 0.0, -1.0),
+            vup: Vec3::Y,
+            defocus_angle: 0.0,
+            focus_dist: 1.0,
+        }
+    }
+}
+
+/// A camera that cannot be built.
+#[derive(Debug, Error, PartialEq)]
+pub enum CameraError {
+    /// The field of view is not in (0, 180) degrees.
+    #[error("vfov must be greater than 0 and less than 180 degrees, got {0}")]
+    FieldOfView(f32),
+    /// The eye and the target coincide, so there is no view direction.
+    #[error("lookfrom and lookat are the same point {0}: the camera has no view direction")]
+    NoViewDirection(Point3),
+    /// The up vector is parallel to the view direction (or zero).
+    #[error("vup {0} is parallel to the view direction: the camera cannot tell up from sideways")]
+    UpParallelToView(Vec3),
+    /// The focus distance is not positive.
+    #[error("focus_dist must be positive, got {0}")]
+    FocusDistance(f32),
+    /// The defocus angle is outside [0, 180).
+    #[error("defocus_angle must be at least 0 and less than 180 degrees, got {0}")]
+    DefocusAngle(f32),
+    /// The image has no pixels.
+    #[error("image size {0}x{1} has no pixels")]
+    EmptyImage(u32, u32),
+    /// A value is NaN or infinite.
+    #[error("camera {0} is not a finite number")]
+    NotFinite(&'static str),
+}
+
+/// A camera ready to generate rays for an image of a given size.
+#[derive(Clone, Debug)]
+pub struct Camera {
+    center: Point3,
+    pixel00: Point3,
+    pixel_du: Vec3,
+    pixel_dv: Vec3,
+    defocus_u: Vec3,
+    defocus_v: Vec3,
+    /// The orthonormal basis (u, v, w).
+    pub basis: [Vec3; 3],
+}
+
+impl Camera {
+    /// Builds the camera for a `width`×`height` image, refusing impossible set-ups.
+    pub fn new(settings: &CameraSettings, width: u32, height: u32) -> Result<Self, CameraError> {
+        let s = settings;
+        for (name, ok) in [
+            ("vfov", s.vfov.is_finite()),
+            ("lookfrom", s.lookfrom.is_finite()),
+            ("lookat", s.lookat.is_finite()),
+            ("vup", s.vup.is_finite()),
+            ("defocus_angle", s.defocus_angle.is_finite()),
+            ("focus_dist", s.focus_dist.is_finite()),
+        ] {
+            if !ok {
+                return Err(CameraError::NotFinite(name));
+            }
+        }
+        if !(s.vfov > 0.0 && s.vfov < 180.0) {
+            return Err(CameraError::FieldOfView(s.vfov));
+        }
+        if !(s.focus_dist > 0.0) {
+            return Err(CameraError::FocusDistance(s.focus_dist));
+        }
+        if !(s.defocus_angle >= 0.0 && s.defocus_angle < 180.0) {
+            return Err(CameraError::DefocusAngle(s.defocus_angle));
+        }
+        if width == 0 || height == 0 {
+            return Err(CameraError::EmptyImage(width, height));
+        }
+        let view = s.lookfrom - s.lookat;
+        if view.length_squared() == 0.0 {
+            return Err(CameraError::NoViewDirection(s.lookfrom));
+        }
+        let w = view.normalize();
+        let side = s.vup.cross(w);
+        // Parallel (or zero) vup: the cross product vanishes relative to |vup|.
+        if side.length_squared() <= 1e-12 * s.vup.length_squared().max(f32::MIN_POSITIVE) {
+            return Err(CameraError::UpParallelToView(s.vup));
+        }
+        let u = side.normalize();
+        let v = w.cross(u);
+
+        let h = (s.vfov.to_radians() / 2.0).tan();
+        let viewport_height = 2.0 * h * s.focus_dist;
+        let viewport_width = viewport_height * (width as f32 / height as f32);
+        let viewport_u = viewport_width * u;
+        let viewport_v = -viewport_height * v; // image rows go down
+        let pixel_du = viewport_u / width as f32;
+        let pixel_dv = viewport_v / height as f32;
+        let upper_left = s.lookfrom - s.focus_dist * w - viewport_u / 2.0 - viewport_v / 2.0;
+        let pixel00 = upper_left + 0.5 * (pixel_du + pixel_dv);
+        let defocus_radius = s.focus_dist * (s.defocus_angle.to_radians() / 2.0).tan();
+        Ok(Camera {
+            center: s.lookfrom,
+            pixel00,
+            pixel_du,
+            pixel_dv,
+            defocus_u: defocus_radius * u,
+            defocus_v: defocus_radius * v,
+            basis: [u, v, w],
+        })
+    }
+
+    /// The ray through pixel `(x, y)` at sub-pixel offset `(dx, dy)` ∈ [-0.5, 0.5)²
+    /// from the pixel centre, leaving the lens at a random point.
+    #[inline]
+    pub fn ray(&self, x: u32, y: u32, dx: f32, dy: f32, rng: &mut Rng) -> Ray {
+        let target =
+            self.pixel00 + (x as f32 + dx) * self.pixel_du + (y as f32 + dy) * self.pixel_dv;
+        let origin = if self.defocus_u == Vec3::ZERO {
+            self.center
+        } else {
+            let p = sampling::in_unit_disk(rng);
+            self.center + p.x * self.defocus_u + p.y * self.defocus_v
+        };
+        Ray::new(origin, (target - origin).normalize())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings() -> CameraSettings {
+        CameraSettings {
+            vfov: 90.0,
+            lookfrom: Vec3::new(0.0, 0.0, 0.0),
+            lookat: Vec3::new(0.0, 0.0, -1.0),
+            vup: Vec3::Y,
+            defocus_angle: 0.0,
+            focus_dist: 1.0,
+        }
+    }
+
+    #[test]
+    fn basis_is_orthonormal_and_right_handed() {
+        let s = CameraSettings {
+            lookfrom: Vec3::new(13.0, 2.0, 3.0),
+            lookat: Vec3::ZERO,
+            ..settings()
+        };
+        let cam = Camera::new(&s, 400, 225).unwrap();
+        let [u, v, w] = cam.basis;
+        for a in [u, v, w] {
+            assert!((a.length() - 1.0).abs() < 1e-6);
+        }
+        assert!(u.dot(v).abs() < 1e-6 && v.dot(w).abs() < 1e-6 && u.dot(w).abs() < 1e-6);
+        assert!((u.cross(v) - w).length() < 1e-6);
+        assert!((w - s.lookfrom.normalize()).length() < 1e-6);
+        assert!(v.y > 0.0, "v points up");
+    }
+
+    #[test]
+    fn centre_pixel_looks_at_the_target_and_corners_span_the_fov() {
+        let cam = Camera::new(&settings(), 2, 2).unwrap();
+        let mut rng = Rng::new(0);
+        // Between the four pixels of a 2x2 image lies the view direction.
+        let r = cam.ray(0, 0, 0.5, 0.5, &mut rng);
+        assert!((r.direction - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        // The top-left corner of a 90° square view is at 45° up and left.
+        let corner = cam.ray(0, 0, -0.5, -0.5, &mut rng);
+        let expected = Vec3::new(-1.0, 1.0, -1.0).normalize();
+        assert!((corner.direction - expected).length() < 1e-6);
+    }
+
+    #[test]
+    fn impossible_cameras_are_refused() {
+        let bad = |s: CameraSettings| Camera::new(&s, 10, 10).unwrap_err();
+        assert_eq!(
+            bad(CameraSettings {
+                vfov: 180.0,
+                ..settings()
+            }),
+            CameraError::FieldOfView(180.0)
+        );
+        assert_eq!(
+            bad(CameraSettings {
+                vfov: 0.0,
+                ..settings()
+            }),
+            CameraError::FieldOfView(0.0)
+        );
+        assert!(matches!(
+            bad(CameraSettings {
+                lookat: Vec3::ZERO,
+                ..settings()
+            }),
+            CameraError::NoViewDirection(_)
+        ));
+        assert!(matches!(
+            bad(CameraSettings {
+                vup: Vec3::Z,
+                ..settings()
+            }),
+            CameraError::UpParallelToView(_)
+        ));
+        assert!(matches!(
+            bad(CameraSettings {
+                focus_dist: 0.0,
+                ..settings()
+            }),
+            CameraError::FocusDistance(_)
+        ));
+    }
+
+    #[test]
+    fn defocus_rays_start_on_the_lens_and_meet_on_the_focus_plane() {
+        let s = CameraSettings {
+            defocus_angle: 10.0,
+            focus_dist: 3.0,
+            ..settings()
+        };
+        let cam = Camera::new(&s, 10, 10).unwrap();
+        let mut rng = Rng::new(1);
+        let radius = 3.0 * (5.0f32).to_radians().tan();
+        let reference = cam.ray(4, 6, 0.0, 0.0, &mut rng);
+        let focus_point = reference.at(3.0 / -reference.direction.z);
+        for _ in 0..100 {
+            let r = cam.ray(4, 6, 0.0, 0.0, &mut rng);
+            assert!(r.origin.length() <= radius * 1.0001);
+            let p = r.at(3.0 / -r.direction.z);
+            assert!((p - focus_point).length() < 1e-4);
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! The film: where samples accumulate, and how the accumulated light becomes
+//! displayable pixels.
+
+use crate::math::Color;
+
+/// Linear accumulation of samples for every pixel.
+///
+/// Sums are kept in `f64` so that adding hundreds of samples loses nothing,
+/// and always in sample order, so an image is the same however the samples
+/// were split into passes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    /// Sum of the finite samples of each pixel, row-major, top row first.
+    sums: Vec<[f64; 3]>,
+    /// Number of finite samples in each pixel.
+    counts: Vec<u32>,
+}
+
+impl Film {
+    /// A black film of `width`×`height` pixels with no samples.
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            width,
+            height,
+            sums: vec![[0.0; 3]; n],
+            counts: vec![0; n],
+        }
+    }
+
+    /// Image width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Image height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Mutable access to the rows, for parallel rendering: each item is one
+    /// row's sums and counts.
+    pub fn rows_mut(
+        &mut self,
+    ) -> impl rayon::iter::IndexedParallelIterator<Item = (&mut [[f64; 3]], &mut [u32])> {
+        use rayon::prelude::*;
+        let w = self.width as usize;
+        self.sums
+            .par_chunks_mut(w)
+            .zip(self.counts.par_chunks_mut(w))
+    }
+
+    /// The raw per-pixel sums and counts (for checkpoints).
+    pub fn raw(&self) -> (&[[f64; 3]], &[u32]) {
+        (&self.sums, &self.counts)
+    }
+
+    /// Rebuilds a film from raw sums and counts; `None` if the sizes disagree.
+    pub fn from_raw(
+        width: u32,
+        height: u32,
+        sums: Vec<[f64; 3]>,
+        counts: Vec<u32>,
+    ) -> Option<Self> {
+        let n = width as usize * height as usize;
+        (sums.len() == n && counts.len() == n).then_some(Self {
+            width,
+            height,
+            sums,
+            counts,
+        })
+    }
+
+    /// The mean linear colour of pixel `(x, y)`; black if it has no samples.
+    pub fn pixel(&self, x: u32, y: u32) -> Color {
+        let i = y as usize * self.width as usize + x as usize;
+        let n = self.counts[i];
+        if n == 0 {
+            return Color::ZERO;
+        }
+        let s = self.sums[i];
+        let n = f64::from(n);
+        Color::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32)
+    }
+
+    /// All pixels' mean linear colours, row-major, top row first.
+    pub fn linear(&self) -> Vec<Color> {
+        (0..self.height)
+            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+            .map(|(x, y)| self.pixel(x, y))
+            .collect()
+    }
+
+    /// Display values: gamma `gamma` applied to each channel, then clamped to [0, 1].
+    pub fn display(&self, gamma: f32) -> Vec<[f32; 3]> {
+        self.linear()
+            .into_iter()
+            .map(|c| {
+                let f = |v: f32| to_display(v, gamma);
+                [f(c.x), f(c.y), f(c.z)]
+            })
+            .collect()
+    }
+
+    /// 8-bit sRGB-like bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.
+    pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
+        self.display(gamma)
+            .into_iter()
+            .flat_map(|p| p.map(|v| (256.0 * v.clamp(0.0, 0.999)) as u8))
+            .collect()
+    }
+}
+
+/// Applies the display gamma (v^(1/γ)) and tone-maps by clamping to [0, 1].
+#[inline]
+pub fn to_display(linear: f32, gamma: f32) -> f32 {
+    let v = linear.max(0.0);
+    let v = if gamma == 1.0 { v } else { v.powf(1.0 / gamma) };
+    v.clamp(0.0, 1.0)
+}

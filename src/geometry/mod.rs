@@ -1,0 +1,10 @@
+//! Shapes that rays can hit, the record of a hit, and the acceleration
+//! structure that finds the nearest one.
+
+pub mod bvh;
+pub mod hit;
+pub mod sphere;
+
+pub use bvh::Bvh;
+pub use hit::HitRecord;
+pub use sphere::Sphere;

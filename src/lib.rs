@@ -1,0 +1,51 @@
+//! # lumen
+//!
+//! A physically based CPU path tracer that reproduces, step by step, Peter
+//! Shirley's *Ray Tracing in One Weekend*, and renders scenes of your own.
+//!
+//! The modules follow the path of a ray:
+//!
+//! - [`ray`]: p(t) = A + tB; [`math`]: vectors, colours, intervals.
+//! - [`camera`]: from a pixel to a ray, with field of view and defocus blur.
+//! - [`geometry`]: spheres, hit records, and the [`geometry::Bvh`] that finds
+//!   the nearest hit.
+//! - [`material`]: diffuse (four bounce models, two attenuation forms),
+//!   metal, dielectric.
+//! - [`integrator`]: the path of one ray, top to bottom, in one function.
+//! - [`sampling`] and [`rng`]: random directions and seeded random numbers.
+//! - [`render`]: every sample of every pixel, in parallel, deterministically.
+//! - [`film`] and [`output`]: accumulation, gamma, tone mapping, image files.
+//! - [`scene`]: scene descriptions, the built-in scenes, and the compiled scene.
+//! - [`gallery`] and [`bench`]: all the notes' figures at once; throughput.
+//!
+//! ```
+//! use lumen::scene::{builtin, Scene};
+//!
+//! let mut desc = builtin::find("metal-mirror").unwrap().desc();
+//! desc.render.width = 32;
+//! desc.render.samples_per_pixel = 4;
+//! let scene = Scene::from_desc(&desc).unwrap();
+//! let (film, stats) = lumen::render::render(&scene, &|_| {});
+//! assert_eq!(stats.samples, 32 * 18 * 4);
+//! let png_bytes = film.to_rgb8(scene.settings.gamma);
+//! assert_eq!(png_bytes.len(), 32 * 18 * 3);
+//! ```
+#![deny(unsafe_code)]
+#![warn(missing_docs)]
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod bench;
+pub mod camera;
+pub mod film;
+pub mod gallery;
+pub mod geometry;
+pub mod integrator;
+pub mod material;
+pub mod math;
+pub mod output;
+pub mod ray;
+pub mod render;
+pub mod rng;
+pub mod sampling;
+pub mod scene;

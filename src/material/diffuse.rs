@@ -1,0 +1,95 @@
+//! Diffuse materials: the four ways of bouncing and the two ways of attenuating
+//! that the notes compare.
+
+use super::Scatter;
+use crate::geometry::HitRecord;
+use crate::math::{Color, Vec3};
+use crate::rng::Rng;
+use crate::sampling;
+
+/// How a diffuse bounce chooses its direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BounceModel {
+    /// Towards a random point on the surface of the cube [-1, 1]³ centred at p + N.
+    /// Cube corners bias the directions, and some point into the surface.
+    Cube,
+    /// Towards a random point inside the unit sphere tangent at p (centre p + N).
+    /// Biased towards the normal: pdf ∝ cos³θ.
+    SphereVolume,
+    /// Towards a random point on the surface of that sphere: true Lambertian
+    /// scattering, pdf = cosθ/π.
+    Lambertian,
+    /// A uniform direction in the hemisphere around N: pdf = 1/(2π).
+    Hemisphere,
+}
+
+/// How a diffuse surface removes light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Attenuation {
+    /// Every ray scatters and its colour is multiplied by the albedo.
+    Scale,
+    /// A ray survives with probability p = the albedo's largest component and
+    /// is otherwise absorbed; survivors are multiplied by albedo / p, which is
+    /// 1 (unattenuated) for a grey albedo. Same expected value as `Scale`.
+    Absorb,
+}
+
+/// A diffuse (matte) surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Diffuse {
+    /// Fraction of light reflected per channel.
+    pub albedo: Color,
+    /// How bounce directions are chosen.
+    pub bounce: BounceModel,
+    /// How the albedo is applied.
+    pub attenuation: Attenuation,
+}
+
+impl Diffuse {
+    /// A Lambertian surface that scales by its albedo.
+    pub fn lambertian(albedo: Color) -> Self {
+        Self {
+            albedo,
+            bounce: BounceModel::Lambertian,
+            attenuation: Attenuation::Scale,
+        }
+    }
+
+    /// Scatters at `hit`; `None` when the ray is absorbed.
+    #[inline]
+    pub fn scatter(&self, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+        let attenuation = match self.attenuation {
+            Attenuation::Scale => self.albedo,
+            Attenuation::Absorb => {
+                let p = self.albedo.max_element();
+                if !(p > 0.0) || rng.next_f32() >= p {
+                    return None;
+                }
+                self.albedo / p
+            }
+        };
+        Some(Scatter {
+            attenuation,
+            direction: bounce_direction(self.bounce, hit.normal, rng),
+        })
+    }
+}
+
+/// A unit bounce direction around unit `normal` following `model`.
+#[inline]
+pub fn bounce_direction(model: BounceModel, normal: Vec3, rng: &mut Rng) -> Vec3 {
+    let d = match model {
+        BounceModel::Cube => normal + sampling::on_cube_surface(rng),
+        BounceModel::SphereVolume => normal + sampling::in_unit_sphere(rng),
+        BounceModel::Lambertian => normal + sampling::unit_vector(rng),
+        BounceModel::Hemisphere => sampling::on_hemisphere(rng, normal),
+    };
+    // A sample opposite the normal cancels it; fall back to the normal rather
+    // than normalising a (near) zero vector into NaN.
+    let len2 = d.length_squared();
+    if len2 < 1e-12 {
+        normal
+    } else {
+        d / len2.sqrt()
+    }
+}

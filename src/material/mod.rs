@@ -1,0 +1,49 @@
+//! Materials: how a surface turns an incoming ray into a scattered one.
+//!
+//! A closed set of materials dispatched with `match`, so the path loop makes no
+//! virtual calls.
+
+pub mod dielectric;
+pub mod diffuse;
+pub mod metal;
+
+pub use dielectric::{reflectance, refract, Dielectric};
+pub use diffuse::{Attenuation, BounceModel, Diffuse};
+pub use metal::{reflect, Metal};
+
+use crate::geometry::HitRecord;
+use crate::math::{Color, Vec3};
+use crate::rng::Rng;
+
+/// A surface material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Diffuse (matte) surface.
+    Diffuse(Diffuse),
+    /// Mirror-like metal, optionally fuzzy.
+    Metal(Metal),
+    /// Clear refracting material such as glass or water.
+    Dielectric(Dielectric),
+}
+
+/// The outcome of a ray meeting a surface that does not absorb it.
+#[derive(Clone, Copy, Debug)]
+pub struct Scatter {
+    /// Factor by which the scattered ray's colour is multiplied.
+    pub attenuation: Color,
+    /// Unit direction of the scattered ray.
+    pub direction: Vec3,
+}
+
+impl Material {
+    /// Scatters a ray arriving along unit `direction` at `hit`; `None` means
+    /// the ray is absorbed.
+    #[inline]
+    pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+        match self {
+            Material::Diffuse(m) => m.scatter(hit, rng),
+            Material::Metal(m) => m.scatter(direction, hit, rng),
+            Material::Dielectric(m) => m.scatter(direction, hit, rng),
+        }
+    }
+}

@@ -1,0 +1,190 @@
+//! Writing images: plain-text PPM (the notes' format), 8-bit PNG, and linear
+//! floating-point PFM and OpenEXR. Every file is written to a temporary name
+//! beside its destination and renamed into place, so a reader never sees a
+//! half-written file.
+
+use crate::film::Film;
+use std::fs;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Image file formats, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `.ppm`: plain-text P3, 8-bit, gamma applied.
+    Ppm,
+    /// `.png`: 8-bit RGB, gamma applied.
+    Png,
+    /// `.pfm`: portable float map, linear (no gamma, no clamping).
+    Pfm,
+    /// `.exr`: OpenEXR, 32-bit float, linear.
+    Exr,
+}
+
+/// An image that could not be written.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    /// The extension names no supported format.
+    #[error("{path}: unknown image format; use a file name ending in .ppm, .png, .pfm or .exr")]
+    UnknownFormat {
+        /// The output path.
+        path: PathBuf,
+    },
+    /// The destination cannot be written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The output path.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl ImageFormat {
+    /// The format named by `path`'s extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self, OutputError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("ppm") => Ok(Self::Ppm),
+            Some("png") => Ok(Self::Png),
+            Some("pfm") => Ok(Self::Pfm),
+            Some("exr") => Ok(Self::Exr),
+            _ => Err(OutputError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+fn io_error(path: &Path, e: impl std::fmt::Display) -> OutputError {
+    OutputError::Io {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Checks, before any work is done, that `path` can later be written: its
+/// format is known, its directory exists and accepts new files.
+pub fn check_writable(path: &Path) -> Result<(), OutputError> {
+    if path.is_dir() {
+        return Err(io_error(path, "is a directory, not a file"));
+    }
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        return Err(io_error(
+            path,
+            format!("directory {} does not exist", dir.display()),
+        ));
+    }
+    let probe = temp_path(path);
+    fs::File::create(&probe)
+        .and_then(|_| fs::remove_file(&probe))
+        .map_err(|e| io_error(path, format!("cannot write in {}: {e}", dir.display())))
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+/// Writes a file atomically: `write` fills a temporary file in the same
+/// directory, which is flushed to disk and then renamed over `path`.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), OutputError> {
+    let tmp = temp_path(path);
+    let result = write(&tmp)
+        .and_then(|()| {
+            fs::File::open(&tmp)
+                .and_then(|f| f.sync_all())
+                .map_err(|e| e.to_string())
+        })
+        .and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if let Err(message) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(OutputError::Io {
+            path: path.to_path_buf(),
+            message,
+        });
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_atomic(path, |tmp| fs::write(tmp, bytes).map_err(|e| e.to_string()))
+}
+
+/// Writes the film to `path` in the format its extension names.
+pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputError> {
+    let format = ImageFormat::from_path(path)?;
+    let (w, h) = (film.width(), film.height());
+    match format {
+        ImageFormat::Ppm => write_bytes_atomic(path, &encode_ppm(film, gamma)),
+        ImageFormat::Pfm => write_bytes_atomic(path, &encode_pfm(film)),
+        ImageFormat::Png => {
+            let img = image::RgbImage::from_raw(w, h, film.to_rgb8(gamma))
+                .ok_or_else(|| io_error(path, "image buffer has the wrong size"))?;
+            write_atomic(path, |tmp| {
+                img.save_with_format(tmp, image::ImageFormat::Png)
+                    .map_err(|e| e.to_string())
+            })
+        }
+        ImageFormat::Exr => {
+            let pixels = film.linear();
+            write_atomic(path, |tmp| {
+                exr::prelude::write_rgb_file(tmp, w as usize, h as usize, |x, y| {
+                    let c = pixels[y * w as usize + x];
+                    (c.x, c.y, c.z)
+                })
+                .map_err(|e| e.to_string())
+            })
+        }
+    }
+}
+
+/// Plain-text P3 PPM: a header, then one "r g b" line a pixel, top row first.
+pub fn encode_ppm(film: &Film, gamma: f32) -> Vec<u8> {
+    let bytes = film.to_rgb8(gamma);
+    let mut out = BufWriter::new(Vec::with_capacity(bytes.len() * 4 + 32));
+    let write = |out: &mut BufWriter<Vec<u8>>| -> io::Result<()> {
+        writeln!(out, "P3\n{} {}\n255", film.width(), film.height())?;
+        for p in bytes.chunks_exact(3) {
+            writeln!(out, "{} {} {}", p[0], p[1], p[2])?;
+        }
+        Ok(())
+    };
+    write(&mut out).expect("writing to memory cannot fail");
+    out.into_inner().expect("flushing to memory cannot fail")
+}
+
+/// Portable float map: linear RGB, little-endian, bottom row first.
+pub fn encode_pfm(film: &Film) -> Vec<u8> {
+    let (w, h) = (film.width(), film.height());
+    let mut out = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+    out.reserve(w as usize * h as usize * 12);
+    for y in (0..h).rev() {
+        for x in 0..w {
+            let c = film.pixel(x, y);
+            for v in [c.x, c.y, c.z] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    out
+}

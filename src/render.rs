@@ -1,0 +1,116 @@
+//! The render loop: camera samples for every pixel, in parallel, into a film.
+
+use crate::film::Film;
+use crate::integrator::radiance;
+use crate::rng::Rng;
+use crate::scene::{Sampling, Scene};
+use rayon::prelude::*;
+use std::ops::Range;
+use std::time::Duration;
+
+/// Counts gathered while rendering.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Camera samples taken (including dropped ones).
+    pub samples: u64,
+    /// Ray segments traced (camera rays and bounces).
+    pub rays: u64,
+    /// Samples whose colour was NaN or infinite and were left out of the image.
+    pub dropped: u64,
+}
+
+impl RenderStats {
+    /// Adds another set of counts to this one.
+    pub fn add(&mut self, other: RenderStats) {
+        self.samples += other.samples;
+        self.rays += other.rays;
+        self.dropped += other.dropped;
+    }
+
+    /// Rays per second over `elapsed`.
+    pub fn rays_per_second(&self, elapsed: Duration) -> f64 {
+        self.rays as f64 / elapsed.as_secs_f64().max(1e-9)
+    }
+
+    /// Camera samples per second over `elapsed`.
+    pub fn samples_per_second(&self, elapsed: Duration) -> f64 {
+        self.samples as f64 / elapsed.as_secs_f64().max(1e-9)
+    }
+}
+
+/// The sub-pixel offset in [-0.5, 0.5)² of sample `index` of `spp`.
+///
+/// Stratified sampling puts the first k² samples (k = ⌊√spp⌋) one in each cell
+/// of a k×k grid over the pixel; any remaining samples, and all samples of
+/// random sampling, are uniform over the pixel.
+#[inline]
+pub fn pixel_offset(sampling: Sampling, index: u32, spp: u32, rng: &mut Rng) -> (f32, f32) {
+    let (jx, jy) = (rng.next_f32(), rng.next_f32());
+    if sampling == Sampling::Stratified {
+        let k = (spp as f64).sqrt() as u32;
+        if index < k * k {
+            let inv = 1.0 / k as f32;
+            let (cx, cy) = ((index % k) as f32, (index / k) as f32);
+            return ((cx + jx) * inv - 0.5, (cy + jy) * inv - 0.5);
+        }
+    }
+    (jx - 0.5, jy - 0.5)
+}
+
+/// Adds samples `samples` (a range of sample indices, each in
+/// `0..samples_per_pixel`) of every pixel to `film`, in parallel over rows.
+///
+/// Each sample draws its random numbers from its own generator, seeded by the
+/// scene seed, the pixel and the sample index, and each pixel adds its samples
+/// in index order: the film is bit-identical whatever the thread count, and
+/// rendering `0..a` then `a..b` gives the same film as `0..b`.
+///
+/// `progress` is called with the number of samples finished, once per row.
+pub fn render_samples(
+    scene: &Scene,
+    film: &mut Film,
+    samples: Range<u32>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RenderStats {
+    let s = &scene.settings;
+    let width = film.width();
+    let row_samples = u64::from(width) * u64::from(samples.len() as u32);
+    film.rows_mut()
+        .enumerate()
+        .map(|(y, (sums, counts))| {
+            let mut stats = RenderStats::default();
+            for x in 0..width {
+                let pixel = y as u64 * u64::from(width) + u64::from(x);
+                let (sum, count) = (&mut sums[x as usize], &mut counts[x as usize]);
+                for index in samples.clone() {
+                    let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
+                    let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, &mut rng);
+                    let ray = scene.camera.ray(x, y as u32, dx, dy, &mut rng);
+                    let c = radiance(scene, ray, &mut rng, &mut stats.rays);
+                    stats.samples += 1;
+                    if c.is_finite() {
+                        sum[0] += f64::from(c.x);
+                        sum[1] += f64::from(c.y);
+                        sum[2] += f64::from(c.z);
+                        *count += 1;
+                    } else {
+                        stats.dropped += 1;
+                    }
+                }
+            }
+            progress(row_samples);
+            stats
+        })
+        .reduce(RenderStats::default, |mut a, b| {
+            a.add(b);
+            a
+        })
+}
+
+/// Renders the whole image at the scene's samples per pixel.
+pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderStats) {
+    let s = &scene.settings;
+    let mut film = Film::new(s.width, s.height);
+    let stats = render_samples(scene, &mut film, 0..s.samples_per_pixel, progress);
+    (film, stats)
+}

@@ -1,0 +1,447 @@
+//! The built-in scenes: every figure of the notes, in their order, and the
+//! book's cover image.
+//!
+//! Each scene is a [`SceneDesc`], the same data a scene file holds, so any of
+//! them can be exported and edited.
+
+use super::desc::{
+    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc,
+    SamplingDesc, SceneDesc, ShadingDesc, Triple,
+};
+use crate::rng::Rng;
+use std::collections::BTreeMap;
+
+/// A named built-in scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Builtin {
+    /// Name used on the command line.
+    pub name: &'static str,
+    /// One-line caption.
+    pub caption: &'static str,
+    make: fn() -> SceneDesc,
+}
+
+impl Builtin {
+    /// The scene's description, with its caption filled in.
+    pub fn desc(&self) -> SceneDesc {
+        let mut d = (self.make)();
+        d.caption = self.caption.to_string();
+        d
+    }
+}
+
+macro_rules! scenes {
+    ($( $name:literal, $caption:literal => $make:expr; )*) => {
+        /// Every built-in scene in the order of the notes.
+        pub const BUILTINS: &[Builtin] = &[
+            $( Builtin { name: $name, caption: $caption, make: $make }, )*
+        ];
+    };
+}
+
+scenes! {
+    "gradient", "Background only: a vertical lerp from white to sky blue by the ray's y direction" => gradient;
+    "hit-sphere", "Hit or miss: red wherever a ray hits the sphere" => hit_sphere;
+    "normals-unit", "The unit normal used directly as a colour" => || normals(ShadingDesc::NormalsUnit, false, 1);
+    "normals-raw", "The un-normalised normal P - C as a colour: it looks dark" => || normals(ShadingDesc::NormalsRaw, false, 1);
+    "normals-brightened", "Normals brightened with grey: 0.5 * (N + 1)" => || normals(ShadingDesc::NormalsBrightened, false, 1);
+    "aa-1spp", "Antialiasing: one sample per pixel shows jaggies" => || normals(ShadingDesc::NormalsBrightened, true, 1);
+    "aa-100spp", "Antialiasing: 100 random samples per pixel, averaged" => || normals(ShadingDesc::NormalsBrightened, true, 100);
+    "diffuse-first", "First diffuse attempt: one bounce, objects with an intrinsic colour" => diffuse_first;
+    "diffuse-absorb-half", "Diffuse with reflectivity 0.5: every bounce halves the colour" => || diffuse_grey(1.0, false, 50);
+    "diffuse-gamma2", "Gamma corrected, gamma = 2" => || diffuse_grey(2.0, false, 50);
+    "diffuse-blue-background", "Plain blue background" => || diffuse_grey(2.0, true, 50);
+    "diffuse-zero-bounces", "Zero bounces (max depth 1): only the background lights anything" => || diffuse_grey(2.0, true, 1);
+    "shadow-acne", "Shadow acne: with epsilon 0 bounce rays hit their own surface" => || acne(0.0);
+    "shadow-acne-fixed", "Shadow acne fixed by ignoring hits closer than 0.001" => || acne(0.001);
+    "bounce-cube", "Bounce towards a random point on a cube around p + N" => || bounce(BounceDesc::Cube);
+    "bounce-sphere-volume", "Bounce towards a random point inside the tangent unit sphere" => || bounce(BounceDesc::SphereVolume);
+    "bounce-lambertian", "Bounce towards a random point on the tangent unit sphere: true Lambertian" => || bounce(BounceDesc::Lambertian);
+    "bounce-hemisphere", "Bounce in a uniformly random direction of the hemisphere around N" => || bounce(BounceDesc::Hemisphere);
+    "albedo-grey", "Albedo 0.5 (small sphere) and 0.2 (big sphere), colour scaled" => || albedo_grey(AttenuationDesc::Scale);
+    "albedo-grey-absorb", "The same albedos as absorption probabilities: converges to the same image" => || albedo_grey(AttenuationDesc::Absorb);
+    "albedo-coloured", "Different base colours" => || albedo_colours([0.8, 0.3, 0.3], [0.8, 0.8, 0.0]);
+    "albedo-same-colour", "The same base colour on both spheres" => || albedo_colours([0.8, 0.3, 0.3], [0.8, 0.3, 0.3]);
+    "metal-mirror", "Metal: perfect mirror reflection, tinted by the albedo" => || metal_fuzz(0.0);
+    "metal-fuzz-1", "Fuzzy metal, fuzz sphere of radius 1.0" => || metal_fuzz(1.0);
+    "metal-fuzz-0.2", "Fuzzy metal, fuzz sphere of radius 0.2" => || metal_fuzz(0.2);
+    "metal-fuzz-0.5", "Fuzzy metal, fuzz sphere of radius 0.5" => || metal_fuzz(0.5);
+    "metal-albedo-1", "Mirror albedo 1: the ball reflects the exact colours" => || metal_albedo([1.0; 3], [0.8, 0.6, 0.2], false);
+    "metal-albedo-0.9", "Mirror albedo 0.9: a little attenuation gives the ball definition" => || metal_albedo([0.9; 3], [0.8, 0.6, 0.2], false);
+    "metal-albedo-0.2", "Mirror albedo 0.2" => || metal_albedo([0.2; 3], [0.8, 0.6, 0.2], false);
+    "metal-albedo-black", "Mirror albedo black, fuzzy ball white" => || metal_albedo([0.0; 3], [1.0; 3], false);
+    "metal-all-black", "All three albedos black" => || metal_albedo([0.0; 3], [0.0; 3], true);
+    "glass-refract-only", "Glass that only refracts (no Fresnel reflection)" => || glass(true, false);
+    "glass-refract-reflect", "Glass that refracts and reflects (Schlick), with total internal reflection" => || glass(false, false);
+    "glass-hollow", "A hollow glass ball: an inner sphere with the inverse index" => || glass(false, true);
+    "fov-90", "Vertical field of view 90 degrees" => || fov(90.0);
+    "fov-135", "Vertical field of view 135 degrees" => || fov(135.0);
+    "fov-170", "Vertical field of view 170 degrees" => || fov(170.0);
+    "camera-lookfrom", "A positioned camera: lookfrom (-2, 2, 1), lookat (0, 0, -1), vfov 20" => || positioned(0.0);
+    "depth-of-field", "Depth of field: defocus angle 10, focus distance 3.4" => || positioned(10.0);
+    "cover", "The cover: a random field of spheres, glass, diffuse and metal" => cover;
+}
+
+/// Looks up a built-in scene by name.
+pub fn find(name: &str) -> Option<&'static Builtin> {
+    BUILTINS.iter().find(|b| b.name == name)
+}
+
+struct Builder {
+    desc: SceneDesc,
+}
+
+impl Builder {
+    fn new(render: RenderDesc) -> Self {
+        Builder {
+            desc: SceneDesc {
+                caption: String::new(),
+                render,
+                camera: CameraDesc::default(),
+                background: BackgroundDesc::default(),
+                materials: BTreeMap::new(),
+                objects: Vec::new(),
+            },
+        }
+    }
+
+    fn material(mut self, name: &str, m: MaterialDesc) -> Self {
+        self.desc.materials.insert(name.to_string(), m);
+        self
+    }
+
+    fn sphere(mut self, center: Triple, radius: f64, material: &str) -> Self {
+        self.desc.objects.push(ObjectDesc::Sphere {
+            center,
+            radius,
+            material: material.to_string(),
+        });
+        self
+    }
+
+    fn background(mut self, b: BackgroundDesc) -> Self {
+        self.desc.background = b;
+        self
+    }
+
+    fn camera(mut self, c: CameraDesc) -> Self {
+        self.desc.camera = c;
+        self
+    }
+
+    fn build(self) -> SceneDesc {
+        self.desc
+    }
+}
+
+fn render(spp: u32, gamma: f64) -> RenderDesc {
+    RenderDesc {
+        samples_per_pixel: spp,
+        gamma,
+        ..RenderDesc::default()
+    }
+}
+
+fn diffuse(albedo: Triple, bounce: BounceDesc) -> MaterialDesc {
+    MaterialDesc::Diffuse {
+        albedo,
+        bounce,
+        attenuation: AttenuationDesc::Scale,
+    }
+}
+
+fn lambertian(albedo: Triple) -> MaterialDesc {
+    diffuse(albedo, BounceDesc::Lambertian)
+}
+
+fn metal(albedo: Triple, fuzz: f64) -> MaterialDesc {
+    MaterialDesc::Metal { albedo, fuzz }
+}
+
+fn glass_material(ior: f64, refract_only: bool) -> MaterialDesc {
+    MaterialDesc::Dielectric { ior, refract_only }
+}
+
+const BLUE: BackgroundDesc = BackgroundDesc::Solid {
+    color: [0.5, 0.7, 1.0],
+};
+
+/// The sphere at (0, 0, -1) resting on a radius-100 "ground" sphere.
+fn sphere_on_ground(render: RenderDesc, sphere: MaterialDesc, ground: MaterialDesc) -> Builder {
+    Builder::new(render)
+        .material("sphere", sphere)
+        .material("ground", ground)
+        .sphere([0.0, 0.0, -1.0], 0.5, "sphere")
+        .sphere([0.0, -100.5, -1.0], 100.0, "ground")
+}
+
+fn gradient() -> SceneDesc {
+    Builder::new(render(1, 1.0)).build()
+}
+
+fn hit_sphere() -> SceneDesc {
+    let mut r = render(1, 1.0);
+    r.shading = ShadingDesc::Hit;
+    Builder::new(r)
+        .material("sphere", lambertian([1.0, 0.0, 0.0]))
+        .sphere([0.0, 0.0, -1.0], 0.5, "sphere")
+        .build()
+}
+
+fn normals(shading: ShadingDesc, ground: bool, spp: u32) -> SceneDesc {
+    let mut r = render(spp, 1.0);
+    r.shading = shading;
+    let b = Builder::new(r)
+        .material("surface", lambertian([0.5; 3]))
+        .sphere([0.0, 0.0, -1.0], 0.5, "surface");
+    if ground {
+        b.sphere([0.0, -100.5, -1.0], 100.0, "surface").build()
+    } else {
+        b.build()
+    }
+}
+
+fn diffuse_first() -> SceneDesc {
+    let mut r = render(100, 1.0);
+    r.max_depth = 2;
+    sphere_on_ground(
+        r,
+        diffuse([0.8, 0.3, 0.3], BounceDesc::SphereVolume),
+        diffuse([0.8, 0.8, 0.0], BounceDesc::SphereVolume),
+    )
+    .build()
+}
+
+fn diffuse_grey(gamma: f64, blue: bool, depth: u32) -> SceneDesc {
+    let mut r = render(100, gamma);
+    r.max_depth = depth;
+    let b = sphere_on_ground(
+        r,
+        diffuse([0.5; 3], BounceDesc::SphereVolume),
+        diffuse([0.5; 3], BounceDesc::SphereVolume),
+    );
+    if blue {
+        b.background(BLUE).build()
+    } else {
+        b.build()
+    }
+}
+
+fn acne(epsilon: f64) -> SceneDesc {
+    let mut r = render(100, 2.0);
+    r.epsilon = epsilon;
+    sphere_on_ground(
+        r,
+        diffuse([0.5; 3], BounceDesc::SphereVolume),
+        diffuse([0.5; 3], BounceDesc::SphereVolume),
+    )
+    .build()
+}
+
+fn bounce(model: BounceDesc) -> SceneDesc {
+    sphere_on_ground(
+        render(100, 2.0),
+        diffuse([0.5; 3], model),
+        diffuse([0.5; 3], model),
+    )
+    .build()
+}
+
+fn albedo_grey(attenuation: AttenuationDesc) -> SceneDesc {
+    let m = |a: f64| MaterialDesc::Diffuse {
+        albedo: [a; 3],
+        bounce: BounceDesc::Lambertian,
+        attenuation,
+    };
+    sphere_on_ground(render(100, 2.0), m(0.5), m(0.2)).build()
+}
+
+fn albedo_colours(sphere: Triple, ground: Triple) -> SceneDesc {
+    sphere_on_ground(render(100, 2.0), lambertian(sphere), lambertian(ground)).build()
+}
+
+/// The book's three balls on a yellow ground: diffuse in the centre, a mirror
+/// on the left and a (possibly fuzzy) metal on the right.
+fn three_balls(
+    center: MaterialDesc,
+    left: MaterialDesc,
+    right: MaterialDesc,
+    ground: Triple,
+) -> Builder {
+    Builder::new(render(100, 2.0))
+        .material("ground", lambertian(ground))
+        .material("center", center)
+        .material("left", left)
+        .material("right", right)
+        .sphere([0.0, -100.5, -1.0], 100.0, "ground")
+        .sphere([0.0, 0.0, -1.2], 0.5, "center")
+        .sphere([-1.0, 0.0, -1.0], 0.5, "left")
+        .sphere([1.0, 0.0, -1.0], 0.5, "right")
+}
+
+fn metal_fuzz(fuzz: f64) -> SceneDesc {
+    three_balls(
+        lambertian([0.1, 0.2, 0.5]),
+        metal([0.8, 0.8, 0.8], 0.0),
+        metal([0.8, 0.6, 0.2], fuzz),
+        [0.8, 0.8, 0.0],
+    )
+    .build()
+}
+
+fn metal_albedo(mirror: Triple, fuzzy: Triple, all_black: bool) -> SceneDesc {
+    let center = if all_black { [0.0; 3] } else { [0.1, 0.2, 0.5] };
+    three_balls(
+        lambertian(center),
+        metal(mirror, 0.0),
+        metal(fuzzy, 0.3),
+        [0.8, 0.8, 0.0],
+    )
+    .build()
+}
+
+fn glass(refract_only: bool, hollow: bool) -> SceneDesc {
+    let b = three_balls(
+        lambertian([0.1, 0.2, 0.5]),
+        glass_material(1.5, refract_only),
+        metal([0.8, 0.6, 0.2], 1.0),
+        [0.8, 0.8, 0.0],
+    );
+    if hollow {
+        b.material("bubble", glass_material(1.0 / 1.5, false))
+            .sphere([-1.0, 0.0, -1.0], 0.4, "bubble")
+            .build()
+    } else {
+        b.build()
+    }
+}
+
+fn fov(vfov: f64) -> SceneDesc {
+    let r = std::f64::consts::FRAC_PI_4.cos();
+    Builder::new(render(100, 2.0))
+        .material("left", lambertian([0.0, 0.0, 1.0]))
+        .material("right", lambertian([1.0, 0.0, 0.0]))
+        .sphere([-r, 0.0, -1.0], r, "left")
+        .sphere([r, 0.0, -1.0], r, "right")
+        .camera(CameraDesc {
+            vfov,
+            ..CameraDesc::default()
+        })
+        .build()
+}
+
+fn positioned(defocus_angle: f64) -> SceneDesc {
+    let b = three_balls(
+        lambertian([0.1, 0.2, 0.5]),
+        glass_material(1.5, false),
+        metal([0.8, 0.6, 0.2], 1.0),
+        [0.8, 0.8, 0.0],
+    )
+    .material("bubble", glass_material(1.0 / 1.5, false))
+    .sphere([-1.0, 0.0, -1.0], 0.4, "bubble");
+    b.camera(CameraDesc {
+        vfov: 20.0,
+        lookfrom: [-2.0, 2.0, 1.0],
+        lookat: [0.0, 0.0, -1.0],
+        vup: [0.0, 1.0, 0.0],
+        defocus_angle,
+        focus_dist: Some(3.4),
+    })
+    .build()
+}
+
+/// Seed of the cover scene's layout: fixed, so the cover is the same every run.
+const COVER_LAYOUT_SEED: u64 = 0x00C0_FFEE;
+
+/// The book's final scene: a 22×22 grid of small random spheres around three
+/// big ones, at the book's full quality (1200 wide, 500 samples per pixel).
+pub fn cover() -> SceneDesc {
+    cover_with_grid(11)
+}
+
+/// A cover-style field on a (2·half)² grid of small spheres; `half = 11` is the
+/// cover itself. Used to measure how cost grows with the number of spheres.
+pub fn cover_with_grid(half: i32) -> SceneDesc {
+    let mut rng = Rng::new(COVER_LAYOUT_SEED);
+    let mut b = Builder::new(RenderDesc {
+        width: 1200,
+        samples_per_pixel: 500,
+        max_depth: 50,
+        sampling: SamplingDesc::Random,
+        ..RenderDesc::default()
+    })
+    .material("ground", lambertian([0.5, 0.5, 0.5]))
+    .material("glass", glass_material(1.5, false))
+    .sphere([0.0, -1000.0, 0.0], 1000.0, "ground");
+    let mut count = 0usize;
+    for a in -half..half {
+        for c in -half..half {
+            let choose = rng.next_f64();
+            let center = [
+                f64::from(a) + 0.9 * rng.next_f64(),
+                0.2,
+                f64::from(c) + 0.9 * rng.next_f64(),
+            ];
+            let d = [center[0] - 4.0, center[1] - 0.2, center[2]];
+            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() <= 0.9 {
+                continue;
+            }
+            let name = if choose < 0.8 {
+                let albedo = [0; 3].map(|_| rng.next_f64() * rng.next_f64());
+                let name = format!("diffuse{count}");
+                b = b.material(&name, lambertian(albedo));
+                name
+            } else if choose < 0.95 {
+                let albedo = [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64());
+                let fuzz = 0.5 * rng.next_f64();
+                let name = format!("metal{count}");
+                b = b.material(&name, metal(albedo, fuzz));
+                name
+            } else {
+                "glass".to_string()
+            };
+            b = b.sphere(center, 0.2, &name);
+            count += 1;
+        }
+    }
+    b.material("big-diffuse", lambertian([0.4, 0.2, 0.1]))
+        .material("big-metal", metal([0.7, 0.6, 0.5], 0.0))
+        .sphere([0.0, 1.0, 0.0], 1.0, "glass")
+        .sphere([-4.0, 1.0, 0.0], 1.0, "big-diffuse")
+        .sphere([4.0, 1.0, 0.0], 1.0, "big-metal")
+        .camera(CameraDesc {
+            vfov: 20.0,
+            lookfrom: [13.0, 2.0, 3.0],
+            lookat: [0.0, 0.0, 0.0],
+            vup: [0.0, 1.0, 0.0],
+            defocus_angle: 0.6,
+            focus_dist: Some(10.0),
+        })
+        .build()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    #[test]
+    fn names_are_unique_and_every_scene_compiles() {
+        let mut names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), BUILTINS.len());
+        for b in BUILTINS {
+            Scene::from_desc(&b.desc()).unwrap_or_else(|e| panic!("{}: {e}", b.name));
+        }
+    }
+
+    #[test]
+    fn cover_has_the_books_layout() {
+        let d = cover();
+        // 22×22 candidates minus those too close to the big metal ball, plus
+        // the ground and the three big spheres.
+        assert!(d.objects.len() > 400 && d.objects.len() <= 22 * 22 + 4);
+        assert_eq!(d, cover(), "the layout is the same every time");
+    }
+}

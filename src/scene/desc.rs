@@ -1,0 +1,242 @@
+//! The scene description: a plain-data form of a scene that maps one-to-one
+//! onto the scene file format (TOML or JSON) and from which every built-in
+//! scene is made.
+//!
+//! Numbers are `f64` here so that files round-trip exactly and print the way
+//! people write them; the renderer converts them to `f32` when it compiles the
+//! scene.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// An RGB triple or a 3-D point/vector.
+pub type Triple = [f64; 3];
+
+/// A whole scene: settings, camera, background, named materials and objects.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// A one-line description, shown by `lumen scenes`.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub caption: String,
+    /// Image size, sampling and output settings.
+    #[serde(default)]
+    pub render: RenderDesc,
+    /// Camera placement and lens.
+    #[serde(default)]
+    pub camera: CameraDesc,
+    /// What rays that hit nothing see.
+    #[serde(default)]
+    pub background: BackgroundDesc,
+    /// Materials by name; objects refer to them by name.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// The objects of the scene.
+    #[serde(default)]
+    pub objects: Vec<ObjectDesc>,
+}
+
+/// Image size, sampling and output settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderDesc {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels; when absent, `width / aspect_ratio` rounded down.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub height: Option<u32>,
+    /// Width over height, used when `height` is absent.
+    pub aspect_ratio: f64,
+    /// Camera samples per pixel.
+    pub samples_per_pixel: u32,
+    /// Maximum number of ray segments per path; 1 shows no bounce light.
+    pub max_depth: u32,
+    /// Seed of every random choice of the render.
+    pub seed: u64,
+    /// Where in the pixel samples are placed.
+    pub sampling: SamplingDesc,
+    /// Display gamma: output = linear^(1/gamma). 1 disables the correction.
+    pub gamma: f64,
+    /// Smallest ray parameter accepted as a hit; 0 shows shadow acne.
+    pub epsilon: f64,
+    /// What a camera ray's colour shows.
+    pub shading: ShadingDesc,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        Self {
+            width: 400,
+            height: None,
+            aspect_ratio: 16.0 / 9.0,
+            samples_per_pixel: 100,
+            max_depth: 50,
+            seed: 0,
+            sampling: SamplingDesc::Random,
+            gamma: 2.0,
+            epsilon: 0.001,
+            shading: ShadingDesc::Path,
+        }
+    }
+}
+
+/// Placement of samples within a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SamplingDesc {
+    /// A uniformly random point of the pixel for every sample.
+    Random,
+    /// One random point in each cell of a √N×√N grid (the remaining samples,
+    /// when N is not square, are random).
+    Stratified,
+}
+
+/// What the colour of a camera ray shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadingDesc {
+    /// Full path tracing with materials.
+    Path,
+    /// Red where the ray hits anything, background elsewhere.
+    Hit,
+    /// The unit normal used directly as a colour (negative parts show black).
+    NormalsUnit,
+    /// The un-normalised normal P − C (its length is the radius).
+    NormalsRaw,
+    /// The unit normal mapped to colour by 0.5·(N + 1).
+    NormalsBrightened,
+}
+
+/// Camera placement and lens.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraDesc {
+    /// Vertical field of view in degrees.
+    pub vfov: f64,
+    /// Eye position.
+    pub lookfrom: Triple,
+    /// Point looked at.
+    pub lookat: Triple,
+    /// Up direction.
+    pub vup: Triple,
+    /// Aperture as the angle in degrees of the cone from the focus plane to the lens.
+    pub defocus_angle: f64,
+    /// Distance to the plane in focus; when absent, the distance to `lookat`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub focus_dist: Option<f64>,
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        Self {
+            vfov: 90.0,
+            lookfrom: [0.0, 0.0, 0.0],
+            lookat: [0.0, 0.0, -1.0],
+            vup: [0.0, 1.0, 0.0],
+            defocus_angle: 0.0,
+            focus_dist: None,
+        }
+    }
+}
+
+/// What rays that hit nothing see.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum BackgroundDesc {
+    /// A vertical blend from `bottom` (ray pointing down) to `top` (up) by the
+    /// ray direction's y component.
+    Gradient {
+        /// Colour straight down.
+        bottom: Triple,
+        /// Colour straight up.
+        top: Triple,
+    },
+    /// One colour in every direction.
+    Solid {
+        /// The colour.
+        color: Triple,
+    },
+}
+
+impl Default for BackgroundDesc {
+    fn default() -> Self {
+        BackgroundDesc::Gradient {
+            bottom: [1.0, 1.0, 1.0],
+            top: [0.5, 0.7, 1.0],
+        }
+    }
+}
+
+/// A material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// A matte surface.
+    Diffuse {
+        /// Reflected fraction per channel, each in [0, 1].
+        albedo: Triple,
+        /// Bounce direction model.
+        #[serde(default)]
+        bounce: BounceDesc,
+        /// How the albedo is applied.
+        #[serde(default)]
+        attenuation: AttenuationDesc,
+    },
+    /// A reflective metal.
+    Metal {
+        /// Reflection colour, each channel in [0, 1].
+        albedo: Triple,
+        /// Blur of the reflection, in [0, 1].
+        #[serde(default)]
+        fuzz: f64,
+    },
+    /// A clear refracting material.
+    Dielectric {
+        /// Index of refraction, > 0.
+        ior: f64,
+        /// Never reflect partially (no Schlick term).
+        #[serde(default)]
+        refract_only: bool,
+    },
+}
+
+/// Diffuse bounce model (see [`crate::material::BounceModel`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BounceDesc {
+    /// Random point on the surface of a cube around p + N.
+    Cube,
+    /// Random point inside the unit sphere at p + N.
+    SphereVolume,
+    /// Random point on the surface of the unit sphere at p + N.
+    #[default]
+    Lambertian,
+    /// Uniform direction in the hemisphere around N.
+    Hemisphere,
+}
+
+/// Diffuse attenuation form (see [`crate::material::Attenuation`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AttenuationDesc {
+    /// Multiply the colour by the albedo.
+    #[default]
+    Scale,
+    /// Absorb rays with probability 1 − albedo.
+    Absorb,
+}
+
+/// An object of the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ObjectDesc {
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Triple,
+        /// Radius, > 0.
+        radius: f64,
+        /// Name of a material in `materials`.
+        material: String,
+    },
+}

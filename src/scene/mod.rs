@@ -1,0 +1,429 @@
+//! Scenes: the description people write, the built-in scenes of the notes, and
+//! the compiled form the renderer traces.
+
+pub mod builtin;
+pub mod desc;
+
+pub use desc::SceneDesc;
+
+use crate::camera::{Camera, CameraError, CameraSettings};
+use crate::geometry::{Bvh, HitRecord, Sphere};
+use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
+use crate::math::{lerp, Color, Interval, Vec3};
+use crate::ray::Ray;
+use desc::{
+    AttenuationDesc, BackgroundDesc, BounceDesc, MaterialDesc, ObjectDesc, SamplingDesc,
+    ShadingDesc,
+};
+use std::collections::HashMap;
+use thiserror::Error;
+
+/// Largest accepted image, in pixels: the film needs 28 bytes a pixel.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// A scene description that cannot be rendered.
+#[derive(Debug, Error)]
+pub enum SceneError {
+    /// The camera cannot be built.
+    #[error("camera: {0}")]
+    Camera(#[from] CameraError),
+    /// A field has a value outside its allowed range.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// Path of the field, e.g. `objects[3].radius`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// What a camera ray's colour shows (see [`desc::ShadingDesc`]).
+pub type Shading = ShadingDesc;
+/// Placement of samples within a pixel (see [`desc::SamplingDesc`]).
+pub type Sampling = SamplingDesc;
+
+/// What rays that escape the scene see.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Background {
+    /// Blend from `bottom` to `top` by the unit direction's y.
+    Gradient {
+        /// Colour straight down.
+        bottom: Color,
+        /// Colour straight up.
+        top: Color,
+    },
+    /// One colour everywhere.
+    Solid(Color),
+}
+
+impl Background {
+    /// The colour seen along unit direction `direction`.
+    #[inline]
+    pub fn color(&self, direction: Vec3) -> Color {
+        match *self {
+            Background::Gradient { bottom, top } => lerp(bottom, top, 0.5 * (direction.y + 1.0)),
+            Background::Solid(c) => c,
+        }
+    }
+}
+
+/// Render settings after validation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub samples_per_pixel: u32,
+    /// Maximum ray segments per path.
+    pub max_depth: u32,
+    /// Seed of the render.
+    pub seed: u64,
+    /// Sample placement.
+    pub sampling: Sampling,
+    /// Display gamma.
+    pub gamma: f32,
+    /// Shadow-acne epsilon: smallest accepted hit distance.
+    pub epsilon: f32,
+    /// What camera rays show.
+    pub shading: Shading,
+}
+
+/// A scene compiled for rendering: validated, with a BVH over its objects.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Render settings.
+    pub settings: Settings,
+    /// The camera, sized for the image.
+    pub camera: Camera,
+    /// The background.
+    pub background: Background,
+    /// Material table indexed by [`HitRecord::material`].
+    pub materials: Vec<Material>,
+    /// The spheres, in description order.
+    pub spheres: Vec<Sphere>,
+    /// Material index of each sphere.
+    pub sphere_materials: Vec<u32>,
+    bvh: Bvh,
+}
+
+fn vec3(t: [f64; 3]) -> Vec3 {
+    Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32)
+}
+
+fn finite(field: &str, values: &[f64]) -> Result<(), SceneError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(field, "must be a finite number"))
+    }
+}
+
+fn color(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+    finite(field, &c)?;
+    if c.iter().any(|&v| v < 0.0) {
+        return Err(invalid(
+            field,
+            format!("colour components must not be negative, got {c:?}"),
+        ));
+    }
+    Ok(vec3(c))
+}
+
+fn albedo(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+    let v = color(field, c)?;
+    if c.iter().any(|&x| x > 1.0) {
+        return Err(invalid(
+            field,
+            format!("albedo components must be in [0, 1], got {c:?}"),
+        ));
+    }
+    Ok(v)
+}
+
+impl Scene {
+    /// Validates and compiles a scene description.
+    pub fn from_desc(desc: &SceneDesc) -> Result<Scene, SceneError> {
+        let settings = compile_settings(desc)?;
+        let cam = &desc.camera;
+        finite("camera.vfov", &[cam.vfov])?;
+        finite("camera.lookfrom", &cam.lookfrom)?;
+        finite("camera.lookat", &cam.lookat)?;
+        finite("camera.vup", &cam.vup)?;
+        finite("camera.defocus_angle", &[cam.defocus_angle])?;
+        let lookfrom = vec3(cam.lookfrom);
+        let lookat = vec3(cam.lookat);
+        let focus_dist = match cam.focus_dist {
+            Some(d) => {
+                finite("camera.focus_dist", &[d])?;
+                d as f32
+            }
+            None => (lookfrom - lookat).length(),
+        };
+        let camera = Camera::new(
+            &CameraSettings {
+                vfov: cam.vfov as f32,
+                lookfrom,
+                lookat,
+                vup: vec3(cam.vup),
+                defocus_angle: cam.defocus_angle as f32,
+                focus_dist,
+            },
+            settings.width,
+            settings.height,
+        )?;
+        let background = match &desc.background {
+            BackgroundDesc::Gradient { bottom, top } => Background::Gradient {
+                bottom: color("background.bottom", *bottom)?,
+                top: color("background.top", *top)?,
+            },
+            BackgroundDesc::Solid { color: c } => Background::Solid(color("background.color", *c)?),
+        };
+
+        let mut materials = Vec::with_capacity(desc.materials.len());
+        let mut material_index = HashMap::with_capacity(desc.materials.len());
+        for (name, m) in &desc.materials {
+            material_index.insert(name.as_str(), materials.len() as u32);
+            materials.push(compile_material(&format!("materials.{name}"), m)?);
+        }
+
+        let mut spheres = Vec::with_capacity(desc.objects.len());
+        let mut sphere_materials = Vec::with_capacity(desc.objects.len());
+        for (i, object) in desc.objects.iter().enumerate() {
+            match object {
+                ObjectDesc::Sphere {
+                    center,
+                    radius,
+                    material,
+                } => {
+                    finite(&format!("objects[{i}].center"), center)?;
+                    finite(&format!("objects[{i}].radius"), &[*radius])?;
+                    if !(*radius > 0.0) || *radius as f32 <= 0.0 {
+                        return Err(invalid(
+                            format!("objects[{i}].radius"),
+                            format!("must be greater than 0, got {radius}"),
+                        ));
+                    }
+                    let Some(&m) = material_index.get(material.as_str()) else {
+                        return Err(invalid(
+                            format!("objects[{i}].material"),
+                            unknown_material_message(material, desc),
+                        ));
+                    };
+                    spheres.push(Sphere::new(vec3(*center), *radius as f32));
+                    sphere_materials.push(m);
+                }
+            }
+        }
+        let bvh = Bvh::new(&spheres);
+        Ok(Scene {
+            settings,
+            camera,
+            background,
+            materials,
+            spheres,
+            sphere_materials,
+            bvh,
+        })
+    }
+
+    /// The nearest hit of `ray` within `interval`.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
+        let hit = self.bvh.hit(ray, interval)?;
+        let sphere = &self.spheres[hit.index as usize];
+        let point = ray.at(hit.t);
+        let outward = sphere.outward_normal(point);
+        let (normal, front_face) = crate::geometry::hit::face_normal(ray, outward);
+        Some(HitRecord {
+            point,
+            normal,
+            t: hit.t,
+            front_face,
+            material: self.sphere_materials[hit.index as usize],
+            object: hit.index,
+        })
+    }
+
+    /// Number of nodes in the acceleration structure.
+    pub fn bvh_nodes(&self) -> usize {
+        self.bvh.node_count()
+    }
+}
+
+fn unknown_material_message(name: &str, desc: &SceneDesc) -> String {
+    let known: Vec<&str> = desc.materials.keys().map(String::as_str).collect();
+    if known.is_empty() {
+        format!("no material named \"{name}\": the scene defines no materials")
+    } else {
+        format!(
+            "no material named \"{name}\"; defined materials: {}",
+            known.join(", ")
+        )
+    }
+}
+
+fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
+    let r = &desc.render;
+    if r.width == 0 {
+        return Err(invalid("render.width", "must be at least 1 pixel"));
+    }
+    let height = match r.height {
+        Some(0) => return Err(invalid("render.height", "must be at least 1 pixel")),
+        Some(h) => h,
+        None => {
+            finite("render.aspect_ratio", &[r.aspect_ratio])?;
+            if !(r.aspect_ratio > 0.0) {
+                return Err(invalid(
+                    "render.aspect_ratio",
+                    format!("must be greater than 0, got {}", r.aspect_ratio),
+                ));
+            }
+            let h = (f64::from(r.width) / r.aspect_ratio).floor();
+            if h > f64::from(u32::MAX) {
+                return Err(invalid(
+                    "render.aspect_ratio",
+                    "gives an image taller than 4294967295 pixels",
+                ));
+            }
+            (h as u32).max(1)
+        }
+    };
+    let pixels = u64::from(r.width) * u64::from(height);
+    if pixels > MAX_PIXELS {
+        return Err(invalid(
+            "render",
+            format!(
+                "image {}x{} has {pixels} pixels, more than the {MAX_PIXELS} lumen can hold in memory",
+                r.width, height
+            ),
+        ));
+    }
+    if r.samples_per_pixel == 0 {
+        return Err(invalid("render.samples_per_pixel", "must be at least 1"));
+    }
+    if r.max_depth == 0 {
+        return Err(invalid(
+            "render.max_depth",
+            "must be at least 1 (the camera ray)",
+        ));
+    }
+    finite("render.gamma", &[r.gamma])?;
+    if !(r.gamma > 0.0) {
+        return Err(invalid(
+            "render.gamma",
+            format!("must be greater than 0, got {}", r.gamma),
+        ));
+    }
+    finite("render.epsilon", &[r.epsilon])?;
+    if !(r.epsilon >= 0.0) {
+        return Err(invalid(
+            "render.epsilon",
+            format!("must not be negative, got {}", r.epsilon),
+        ));
+    }
+    Ok(Settings {
+        width: r.width,
+        height,
+        samples_per_pixel: r.samples_per_pixel,
+        max_depth: r.max_depth,
+        seed: r.seed,
+        sampling: r.sampling,
+        gamma: r.gamma as f32,
+        epsilon: r.epsilon as f32,
+        shading: r.shading,
+    })
+}
+
+fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
+    Ok(match m {
+        MaterialDesc::Diffuse {
+            albedo: a,
+            bounce,
+            attenuation,
+        } => Material::Diffuse(Diffuse {
+            albedo: albedo(&format!("{field}.albedo"), *a)?,
+            bounce: match bounce {
+                BounceDesc::Cube => BounceModel::Cube,
+                BounceDesc::SphereVolume => BounceModel::SphereVolume,
+                BounceDesc::Lambertian => BounceModel::Lambertian,
+                BounceDesc::Hemisphere => BounceModel::Hemisphere,
+            },
+            attenuation: match attenuation {
+                AttenuationDesc::Scale => Attenuation::Scale,
+                AttenuationDesc::Absorb => Attenuation::Absorb,
+            },
+        }),
+        MaterialDesc::Metal { albedo: a, fuzz } => {
+            finite(&format!("{field}.fuzz"), &[*fuzz])?;
+            if !(0.0..=1.0).contains(fuzz) {
+                return Err(invalid(
+                    format!("{field}.fuzz"),
+                    format!("must be in [0, 1], got {fuzz}"),
+                ));
+            }
+            Material::Metal(Metal {
+                albedo: albedo(&format!("{field}.albedo"), *a)?,
+                fuzz: *fuzz as f32,
+            })
+        }
+        MaterialDesc::Dielectric { ior, refract_only } => {
+            finite(&format!("{field}.ior"), &[*ior])?;
+            if !(*ior > 0.0) {
+                return Err(invalid(
+                    format!("{field}.ior"),
+                    format!("index of refraction must be greater than 0, got {ior}"),
+                ));
+            }
+            Material::Dielectric(Dielectric {
+                ior: *ior as f32,
+                refract_only: *refract_only,
+            })
+        }
+    })
+}
+
+/// Settings given on the command line that replace a scene's own.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// Image width; the height follows the scene's aspect ratio.
+    pub width: Option<u32>,
+    /// Samples per pixel.
+    pub samples_per_pixel: Option<u32>,
+    /// Maximum path depth.
+    pub max_depth: Option<u32>,
+    /// Random seed.
+    pub seed: Option<u64>,
+}
+
+impl Overrides {
+    /// Replaces the description's settings by those given here.
+    pub fn apply(&self, desc: &mut SceneDesc) {
+        let r = &mut desc.render;
+        if let Some(w) = self.width {
+            // Keep an explicit height in proportion to the new width.
+            if let Some(h) = r.height {
+                let scaled = (u64::from(h) * u64::from(w)) / u64::from(r.width.max(1));
+                r.height = Some(scaled.clamp(1, u64::from(u32::MAX)) as u32);
+            }
+            r.width = w;
+        }
+        if let Some(n) = self.samples_per_pixel {
+            r.samples_per_pixel = n;
+        }
+        if let Some(d) = self.max_depth {
+            r.max_depth = d;
+        }
+        if let Some(s) = self.seed {
+            r.seed = s;
+        }
+    }
+}
