@@ -1,0 +1,185 @@
+//! Helpers shared by the integration tests: small scenes and per-pixel sample
+//! statistics taken through the library's own render loop.
+#![allow(dead_code)]
+
+use lumen::film::Film;
+use lumen::render::{render_samples, RenderStats};
+use lumen::scene::builtin;
+use lumen::scene::desc::{BackgroundDesc, MaterialDesc, ObjectDesc, RenderDesc};
+use lumen::scene::{Overrides, Scene, SceneDesc};
+
+/// Standard errors allowed between an estimate and its expected value.
+pub const K: f64 = 5.0;
+
+/// A built-in scene's description at a small size.
+pub fn builtin_desc(name: &str, width: u32, spp: u32, seed: u64) -> SceneDesc {
+    let mut desc = builtin::find(name)
+        .unwrap_or_else(|| panic!("no built-in scene {name}"))
+        .desc();
+    Overrides {
+        width: Some(width),
+        samples_per_pixel: Some(spp),
+        max_depth: None,
+        seed: Some(seed),
+    }
+    .apply(&mut desc);
+    desc
+}
+
+/// A built-in scene compiled at a small size.
+pub fn builtin_scene(name: &str, width: u32, spp: u32, seed: u64) -> Scene {
+    Scene::from_desc(&builtin_desc(name, width, spp, seed)).unwrap()
+}
+
+/// One sphere of `material`, radius 1 at distance 2 in front of the default
+/// camera, inside a uniform white background ("white furnace"); gamma 1.
+pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth: u32) -> Scene {
+    let desc = SceneDesc {
+        caption: String::new(),
+        render: RenderDesc {
+            width,
+            height: Some(height),
+            samples_per_pixel: spp,
+            max_depth: depth,
+            gamma: 1.0,
+            seed: 11,
+            ..RenderDesc::default()
+        },
+        camera: Default::default(),
+        background: BackgroundDesc::Solid {
+            color: [1.0, 1.0, 1.0],
+        },
+        materials: [("m".to_string(), material)].into_iter().collect(),
+        objects: vec![ObjectDesc::Sphere {
+            center: FURNACE_CENTER,
+            radius: FURNACE_RADIUS,
+            material: "m".into(),
+        }],
+    };
+    Scene::from_desc(&desc).unwrap()
+}
+
+/// Centre of the furnace sphere.
+pub const FURNACE_CENTER: [f64; 3] = [0.0, 0.0, -2.0];
+/// Radius of the furnace sphere.
+pub const FURNACE_RADIUS: f64 = 1.0;
+
+/// Per-pixel statistics of every sample of a render.
+pub struct PixelStats {
+    pub width: u32,
+    pub height: u32,
+    /// Finite samples per pixel.
+    pub counts: Vec<u32>,
+    /// Mean of each pixel's finite samples, per channel.
+    pub mean: Vec<[f64; 3]>,
+    /// Unbiased sample variance of each pixel's samples, per channel.
+    pub var: Vec<[f64; 3]>,
+    /// Smallest and largest sample value seen, per channel.
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// The film the samples add up to.
+    pub film: Film,
+    pub stats: RenderStats,
+}
+
+/// Renders `scene` one sample index at a time with
+/// [`lumen::render::render_samples`], so that every sample's value is seen,
+/// and gathers each pixel's mean and variance.
+pub fn pixel_stats(scene: &Scene) -> PixelStats {
+    let s = &scene.settings;
+    let n = (s.width * s.height) as usize;
+    let mut sum = vec![[0.0f64; 3]; n];
+    let mut sum2 = vec![[0.0f64; 3]; n];
+    let mut counts = vec![0u32; n];
+    let mut min = [f64::INFINITY; 3];
+    let mut max = [f64::NEG_INFINITY; 3];
+    let mut film = Film::new(s.width, s.height);
+    let mut stats = RenderStats::default();
+    for index in 0..s.samples_per_pixel {
+        let mut one = Film::new(s.width, s.height);
+        stats.add(render_samples(scene, &mut one, index..index + 1, &|_| {}));
+        let (sums, cs) = one.raw();
+        for i in 0..n {
+            if cs[i] == 0 {
+                continue;
+            }
+            counts[i] += 1;
+            for c in 0..3 {
+                let v = sums[i][c];
+                sum[i][c] += v;
+                sum2[i][c] += v * v;
+                min[c] = min[c].min(v);
+                max[c] = max[c].max(v);
+            }
+        }
+        render_samples(scene, &mut film, index..index + 1, &|_| {});
+    }
+    // The film adds the same samples in the same order: identical sums.
+    assert_eq!(film.raw().0, &sum[..], "film sums differ from the samples");
+    assert_eq!(film.raw().1, &counts[..]);
+    let mut mean = vec![[0.0; 3]; n];
+    let mut var = vec![[0.0; 3]; n];
+    for i in 0..n {
+        let k = f64::from(counts[i]);
+        for c in 0..3 {
+            mean[i][c] = sum[i][c] / k;
+            var[i][c] = if counts[i] > 1 {
+                ((sum2[i][c] - k * mean[i][c] * mean[i][c]) / (k - 1.0)).max(0.0)
+            } else {
+                0.0
+            };
+        }
+    }
+    PixelStats {
+        width: s.width,
+        height: s.height,
+        counts,
+        mean,
+        var,
+        min,
+        max,
+        film,
+        stats,
+    }
+}
+
+impl PixelStats {
+    /// Mean over the pixels `x0..x1` × `y0..y1` of channel `c`, and its
+    /// standard error: the pixels are independent, each mean of `count`
+    /// samples has variance var/count.
+    pub fn region(&self, xs: std::ops::Range<u32>, ys: std::ops::Range<u32>, c: usize) -> (f64, f64) {
+        let (mut m, mut v, mut n) = (0.0, 0.0, 0.0);
+        for y in ys {
+            for x in xs.clone() {
+                let i = (y * self.width + x) as usize;
+                m += self.mean[i][c];
+                v += self.var[i][c] / f64::from(self.counts[i]);
+                n += 1.0;
+            }
+        }
+        (m / n, v.sqrt() / n)
+    }
+
+    /// Mean of the whole image in channel `c`, with its standard error.
+    pub fn image(&self, c: usize) -> (f64, f64) {
+        self.region(0..self.width, 0..self.height, c)
+    }
+
+    /// The mean of pixel (x, y).
+    pub fn pixel(&self, x: u32, y: u32) -> [f64; 3] {
+        self.mean[(y * self.width + x) as usize]
+    }
+}
+
+/// Asserts that two independent estimates agree within K combined standard errors.
+pub fn assert_agree(what: &str, a: (f64, f64), b: (f64, f64)) {
+    let se = (a.1 * a.1 + b.1 * b.1).sqrt();
+    assert!(
+        (a.0 - b.0).abs() <= K * se,
+        "{what}: {:.5} ± {:.5} vs {:.5} ± {:.5} differ by more than {K} standard errors",
+        a.0,
+        a.1,
+        b.0,
+        b.1
+    );
+}
