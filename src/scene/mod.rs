@@ -119,11 +119,15 @@ fn vec3(t: [f64; 3]) -> Vec3 {
     Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32)
 }
 
+/// Accepts numbers that stay finite once converted to the renderer's `f32`.
 fn finite(field: &str, values: &[f64]) -> Result<(), SceneError> {
-    if values.iter().all(|v| v.is_finite()) {
+    if values.iter().all(|v| v.abs() <= f64::from(f32::MAX)) {
         Ok(())
     } else {
-        Err(invalid(field, "must be a finite number"))
+        Err(invalid(
+            field,
+            format!("must be a finite number of magnitude at most {:e}", f32::MAX),
+        ))
     }
 }
 
