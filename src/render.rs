@@ -2,6 +2,7 @@
 
 use crate::film::Film;
 use crate::integrator::radiance;
+use crate::math::Color;
 use crate::rng::Rng;
 use crate::scene::{Sampling, Scene};
 use rayon::prelude::*;
@@ -88,12 +89,7 @@ pub fn render_samples(
                     let ray = scene.camera.ray(x, y as u32, dx, dy, &mut rng);
                     let c = radiance(scene, ray, &mut rng, &mut stats.rays);
                     stats.samples += 1;
-                    if c.is_finite() {
-                        sum[0] += f64::from(c.x);
-                        sum[1] += f64::from(c.y);
-                        sum[2] += f64::from(c.z);
-                        *count += 1;
-                    } else {
+                    if !accumulate(sum, count, c) {
                         stats.dropped += 1;
                     }
                 }
@@ -107,10 +103,45 @@ pub fn render_samples(
         })
 }
 
+/// Adds one sample's colour to a pixel's sum and count, unless it is NaN or
+/// infinite: such a sample is left out and `false` is returned so the caller
+/// can count it.
+#[inline]
+fn accumulate(sum: &mut [f64; 3], count: &mut u32, c: Color) -> bool {
+    if !c.is_finite() {
+        return false;
+    }
+    sum[0] += f64::from(c.x);
+    sum[1] += f64::from(c.y);
+    sum[2] += f64::from(c.z);
+    *count += 1;
+    true
+}
+
 /// Renders the whole image at the scene's samples per pixel.
 pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderStats) {
     let s = &scene.settings;
     let mut film = Film::new(s.width, s.height);
     let stats = render_samples(scene, &mut film, 0..s.samples_per_pixel, progress);
     (film, stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn non_finite_samples_are_dropped_and_finite_ones_added() {
+        let (mut sum, mut count) = ([0.0f64; 3], 0u32);
+        assert!(accumulate(&mut sum, &mut count, Color::new(0.25, 0.5, 2.0)));
+        for bad in [
+            Color::new(f32::NAN, 0.0, 0.0),
+            Color::new(0.0, f32::INFINITY, 0.0),
+            Color::new(0.0, 0.0, f32::NEG_INFINITY),
+        ] {
+            assert!(!accumulate(&mut sum, &mut count, bad));
+        }
+        assert!(accumulate(&mut sum, &mut count, Color::new(0.25, 0.5, 2.0)));
+        assert_eq!((sum, count), ([0.5, 1.0, 4.0], 2));
+    }
 }
