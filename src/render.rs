@@ -52,7 +52,11 @@ pub fn pixel_offset(sampling: Sampling, index: u32, spp: u32, rng: &mut Rng) -> 
         if index < k * k {
             let inv = 1.0 / k as f32;
             let (cx, cy) = ((index % k) as f32, (index / k) as f32);
-            return ((cx + jx) * inv - 0.5, (cy + jy) * inv - 0.5);
+            // In f32, (c + j)·(1/k) rounds to 1 when j is the largest value
+            // below 1 in the last cell: keep it below 1 so the offset stays < 0.5.
+            let below_one = 1.0 - f32::EPSILON / 2.0;
+            let cell = |c: f32, j: f32| ((c + j) * inv).min(below_one) - 0.5;
+            return (cell(cx, jx), cell(cy, jy));
         }
     }
     (jx - 0.5, jy - 0.5)
