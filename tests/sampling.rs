@@ -1,0 +1,133 @@
+//! Sample placement within a pixel, and the depth and epsilon settings.
+
+mod common;
+
+use common::{assert_agree, builtin_scene, pixel_stats};
+use lumen::render::{pixel_offset, render};
+use lumen::rng::Rng;
+use lumen::scene::Sampling;
+
+/// Tolerance on stratum boundaries: the offset is computed in f32, so a
+/// sample drawn at the very end of its cell may round onto the boundary.
+const BOUNDARY: f64 = 1e-6;
+
+#[test]
+fn stratified_samples_fill_every_stratum_exactly_once() {
+    for spp in [1u32, 4, 9, 16, 20, 100] {
+        let k = (spp as f64).sqrt() as u32;
+        for pixel in 0..2000u64 {
+            let mut seen = vec![0u32; (k * k) as usize];
+            for index in 0..spp {
+                let mut rng = Rng::for_sample(1, pixel, u64::from(index));
+                let (dx, dy) = pixel_offset(Sampling::Stratified, index, spp, &mut rng);
+                assert!((-0.5..0.5).contains(&dx) && (-0.5..0.5).contains(&dy));
+                if index >= k * k {
+                    continue; // the samples beyond k² are uniform
+                }
+                let (u, v) = (f64::from(dx) + 0.5, f64::from(dy) + 0.5);
+                let (cx, cy) = ((u * f64::from(k)) as u32, (v * f64::from(k)) as u32);
+                let (cx, cy) = (cx.min(k - 1), cy.min(k - 1));
+                // The cell the sample is in must be the one its index owns,
+                // up to rounding at a cell boundary.
+                let (ix, iy) = (index % k, index / k);
+                let inside = |t: f64, c: u32| {
+                    let lo = f64::from(c) / f64::from(k) - BOUNDARY;
+                    let hi = f64::from(c + 1) / f64::from(k) + BOUNDARY;
+                    (lo..hi).contains(&t)
+                };
+                assert!(inside(u, ix) && inside(v, iy), "spp {spp}, index {index}: ({dx}, {dy})");
+                seen[(cy * k + cx) as usize] += 1;
+            }
+            // Exactly one per stratum (a sample on a boundary may be counted
+            // in the neighbouring cell only with probability ~1e-7).
+            assert!(seen.iter().all(|&n| n == 1), "spp {spp}, pixel {pixel}: {seen:?}");
+        }
+    }
+}
+
+#[test]
+fn offsets_stay_below_half_even_at_the_end_of_the_last_stratum() {
+    // The largest uniform value, 1 − 2⁻²⁴, in the last cell of a 2×2 grid is
+    // (1 + 0.99999994)·0.5, which rounds to 1 in f32: the offset must still be
+    // below 0.5. Enough samples are drawn that this value occurs several
+    // times (it has probability 2⁻²⁴ per draw).
+    for sampling in [Sampling::Stratified, Sampling::Random] {
+        let mut max = f32::MIN;
+        for pixel in 0..(1u64 << 24) {
+            let index = 3;
+            let mut rng = Rng::for_sample(0, pixel, index);
+            let (dx, dy) = pixel_offset(sampling, index as u32, 4, &mut rng);
+            max = max.max(dx).max(dy);
+        }
+        assert!(max < 0.5, "{sampling:?}: offset {max}");
+        assert!(max > 0.4999, "{sampling:?}: the largest offsets were not reached");
+    }
+}
+
+#[test]
+fn random_offsets_are_uniform_over_the_pixel() {
+    // Mean 0 and variance 1/12 per axis; 5 standard errors.
+    let n = 200_000u64;
+    let (mut s, mut s2) = (0.0f64, 0.0f64);
+    for i in 0..n {
+        let mut rng = Rng::for_sample(2, i, 0);
+        let (dx, _) = pixel_offset(Sampling::Random, 0, 16, &mut rng);
+        s += f64::from(dx);
+        s2 += f64::from(dx) * f64::from(dx);
+    }
+    let mean = s / n as f64;
+    assert!(mean.abs() <= 5.0 * (1.0 / 12.0 / n as f64).sqrt());
+    // Var(x²) for x uniform on [-1/2, 1/2] is 1/80 − 1/144.
+    let se2 = ((1.0 / 80.0 - 1.0 / 144.0) / n as f64).sqrt();
+    assert!((s2 / n as f64 - 1.0 / 12.0).abs() <= 5.0 * se2);
+}
+
+#[test]
+fn max_depth_one_shows_every_surface_black() {
+    // Depth 1: the camera ray is the only segment, so a ray that hits
+    // anything never reaches the light. Each sample is either exactly black
+    // or exactly the (plain blue) background.
+    let scene = builtin_scene("diffuse-zero-bounces", 32, 16, 0);
+    let background = lumen::math::Color::new(0.5, 0.7, 1.0);
+    let (film, stats) = render(&scene, &|_| {});
+    assert_eq!(stats.rays, stats.samples, "one segment per sample");
+    let (w, h) = (film.width(), film.height());
+    // The sphere at the centre and the ground at the bottom are black.
+    assert_eq!(film.pixel(w / 2, h / 2), lumen::math::Color::ZERO);
+    for x in 0..w {
+        assert_eq!(film.pixel(x, h - 1), lumen::math::Color::ZERO, "ground at x = {x}");
+    }
+    // Every pixel is a fraction of the background: the fraction of its
+    // samples that missed everything.
+    let mut black = 0;
+    for c in film.linear() {
+        let f = c.z / background.z;
+        assert!((c - f * background).abs().max_element() < 1e-6, "{c}");
+        black += usize::from(c == lumen::math::Color::ZERO);
+    }
+    assert!(black > (w * h) as usize / 4, "only {black} black pixels");
+    // With one more segment the surfaces are lit.
+    let mut desc = common::builtin_desc("diffuse-zero-bounces", 32, 16, 0);
+    desc.render.max_depth = 2;
+    let lit = render(&lumen::scene::Scene::from_desc(&desc).unwrap(), &|_| {}).0;
+    assert!(lit.pixel(w / 2, h / 2).x > 0.0);
+}
+
+#[test]
+fn epsilon_zero_shows_shadow_acne() {
+    // With epsilon 0 bounce rays re-hit their own surface and lose half their
+    // light each time: the image is darker. Independent seeds.
+    let acne = pixel_stats(&builtin_scene("shadow-acne", 32, 16, 1));
+    let fixed = pixel_stats(&builtin_scene("shadow-acne-fixed", 32, 16, 2));
+    for c in 0..3 {
+        let (a, sa) = acne.image(c);
+        let (f, sf) = fixed.image(c);
+        let se = (sa * sa + sf * sf).sqrt();
+        assert!(f - a > 5.0 * se, "channel {c}: acne {a} ± {sa}, fixed {f} ± {sf}");
+    }
+    // The sky is the same in both: the top rows see only the background.
+    let w = acne.width;
+    for c in 0..3 {
+        assert_agree("sky", acne.region(0..w, 0..2, c), fixed.region(0..w, 0..2, c));
+    }
+}
