@@ -36,3 +36,44 @@ pub fn face_normal(ray: &Ray, outward_normal: Vec3) -> (Vec3, bool) {
     };
     (normal, front_face)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Sphere;
+    use crate::math::Interval;
+
+    #[test]
+    fn ray_from_outside_hits_the_front_face_with_the_outward_normal() {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
+        let (n, front) = face_normal(&ray, Vec3::Z);
+        assert!(front);
+        assert_eq!(n, Vec3::Z);
+    }
+
+    #[test]
+    fn ray_from_inside_hits_the_back_face_with_the_normal_flipped() {
+        let sphere = Sphere::new(Vec3::ZERO, 2.0);
+        let ray = Ray::new(Vec3::new(0.5, 0.0, 0.0), Vec3::X);
+        let t = sphere.hit(&ray, Interval::new(0.0, f32::INFINITY)).unwrap();
+        assert_eq!(t, 1.5);
+        let outward = sphere.outward_normal(ray.at(t));
+        assert_eq!(outward, Vec3::X);
+        let (n, front) = face_normal(&ray, outward);
+        assert!(!front);
+        assert_eq!(n, -Vec3::X, "the normal faces against the ray");
+        assert!(n.dot(ray.direction) < 0.0);
+    }
+
+    #[test]
+    fn the_normal_always_opposes_the_ray() {
+        for d in [Vec3::new(1.0, 2.0, -3.0), Vec3::new(-1.0, 0.5, 0.2)] {
+            for outward in [Vec3::Y, -Vec3::Y, Vec3::new(0.6, 0.8, 0.0)] {
+                let (n, front) = face_normal(&Ray::new(Vec3::ZERO, d), outward);
+                assert!(n.dot(d) <= 0.0);
+                assert_eq!(front, d.dot(outward) < 0.0);
+                assert_eq!(n, if front { outward } else { -outward });
+            }
+        }
+    }
+}

@@ -43,3 +43,32 @@ impl Metal {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reflect_mirrors_about_the_normal() {
+        // 45° in, 45° out.
+        let r = reflect(Vec3::new(1.0, -1.0, 0.0), Vec3::Y);
+        assert_eq!(r, Vec3::new(1.0, 1.0, 0.0));
+        // Head-on reverses; grazing is unchanged.
+        assert_eq!(reflect(-Vec3::Y, Vec3::Y), Vec3::Y);
+        assert_eq!(reflect(Vec3::X, Vec3::Y), Vec3::X);
+    }
+
+    #[test]
+    fn reflect_keeps_length_and_the_tangential_part_and_flips_the_normal_part() {
+        let n = Vec3::new(1.0, 2.0, 2.0) / 3.0;
+        for v in [Vec3::new(0.3, -0.4, 2.0), Vec3::new(-1.0, -1.0, 0.5)] {
+            let r = reflect(v, n);
+            assert!((r.length() - v.length()).abs() < 1e-6);
+            assert!((r.dot(n) + v.dot(n)).abs() < 1e-6);
+            let tangential = |u: Vec3| u - u.dot(n) * n;
+            assert!((tangential(r) - tangential(v)).length() < 1e-6);
+            // Reflecting twice gives the original back.
+            assert!((reflect(r, n) - v).length() < 1e-6);
+        }
+    }
+}
