@@ -56,7 +56,12 @@ fn unknown_scene_is_one_clear_line() {
     let out_path = dir.join("x.png");
     let out = lumen(&["render", "no-such-scene", "-o", out_path.to_str().unwrap()]);
     assert_fails(&out, &["no-such-scene"]);
-    assert_eq!(stderr(&out).trim_end().lines().count(), 1, "{}", stderr(&out));
+    assert_eq!(
+        stderr(&out).trim_end().lines().count(),
+        1,
+        "{}",
+        stderr(&out)
+    );
     assert!(listing(&dir).is_empty());
 }
 
@@ -81,7 +86,11 @@ fn bad_option_values_are_refused_by_name() {
     // clap names a missing argument on the line after its error line.
     let missing = lumen(&["render", "cover"]);
     assert_fails(&missing, &[]);
-    assert!(stderr(&missing).contains("--output"), "{}", stderr(&missing));
+    assert!(
+        stderr(&missing).contains("--output"),
+        "{}",
+        stderr(&missing)
+    );
     assert_fails(&lumen(&["paint", "cover"]), &["paint"]);
     assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
 }
@@ -92,14 +101,29 @@ fn unwritable_outputs_fail_before_rendering_and_leave_no_file() {
     std::fs::create_dir(dir.join("taken.png")).unwrap();
     let before = listing(&dir);
     for (path, words) in [
-        (dir.join("missing").join("x.png"), vec!["missing", "does not exist"]),
+        (
+            dir.join("missing").join("x.png"),
+            vec!["missing", "does not exist"],
+        ),
         (dir.join("taken.png"), vec!["taken.png", "directory"]),
         (dir.join("x.jpg"), vec!["x.jpg", "format"]),
         (dir.join("x"), vec!["format"]),
     ] {
-        let out = lumen(&["render", "gradient", "-o", path.to_str().unwrap(), "--width", "8"]);
+        let out = lumen(&[
+            "render",
+            "gradient",
+            "-o",
+            path.to_str().unwrap(),
+            "--width",
+            "8",
+        ]);
         assert_fails(&out, &words);
-        assert_eq!(stderr(&out).trim_end().lines().count(), 1, "{}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end().lines().count(),
+            1,
+            "{}",
+            stderr(&out)
+        );
         assert_eq!(listing(&dir), before, "a file was left behind");
     }
 }
@@ -143,13 +167,19 @@ fn renders_every_format_with_the_librarys_pixels() {
     let ppm = std::fs::read_to_string(render_to(&dir, "a.ppm", &[])).unwrap();
     let mut tokens = ppm.split_whitespace();
     assert_eq!(tokens.next(), Some("P3"));
-    let header: Vec<u32> = tokens.by_ref().take(3).map(|t| t.parse().unwrap()).collect();
+    let header: Vec<u32> = tokens
+        .by_ref()
+        .take(3)
+        .map(|t| t.parse().unwrap())
+        .collect();
     assert_eq!(header, [w, h, 255]);
     let values: Vec<u8> = tokens.map(|t| t.parse().unwrap()).collect();
     assert_eq!(values.len(), (w * h * 3) as usize, "one triple per pixel");
     assert_eq!(values, film.to_rgb8(gamma));
 
-    let png = image::open(render_to(&dir, "a.png", &[])).unwrap().into_rgb8();
+    let png = image::open(render_to(&dir, "a.png", &[]))
+        .unwrap()
+        .into_rgb8();
     assert_eq!(png.dimensions(), (w, h));
     assert_eq!(png.into_raw(), film.to_rgb8(gamma));
 
@@ -202,7 +232,14 @@ fn scenes_lists_every_builtin_in_order_with_its_caption() {
 #[test]
 fn gallery_writes_every_image_and_an_index_in_order() {
     let dir = scratch_dir("gallery").join("new-folder");
-    let out = lumen(&["gallery", dir.to_str().unwrap(), "--width", "32", "--spp", "1"]);
+    let out = lumen(&[
+        "gallery",
+        dir.to_str().unwrap(),
+        "--width",
+        "32",
+        "--spp",
+        "1",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let mut last = 0;
@@ -217,7 +254,12 @@ fn gallery_writes_every_image_and_an_index_in_order() {
         last = at;
         assert!(index.contains(b.caption), "caption of {}", b.name);
     }
-    assert_eq!(listing(&dir).len(), BUILTINS.len() + 1, "{:?}", listing(&dir));
+    assert_eq!(
+        listing(&dir).len(),
+        BUILTINS.len() + 1,
+        "{:?}",
+        listing(&dir)
+    );
 }
 
 #[test]

@@ -18,13 +18,23 @@ fn render_with_threads(scene: &Scene, threads: usize) -> Film {
 
 #[test]
 fn films_are_bit_identical_across_thread_counts() {
-    for (name, width, spp) in [("cover", 64, 4), ("glass-hollow", 48, 8), ("depth-of-field", 48, 4)] {
+    for (name, width, spp) in [
+        ("cover", 64, 4),
+        ("glass-hollow", 48, 8),
+        ("depth-of-field", 48, 4),
+    ] {
         let scene = builtin_scene(name, width, spp, 3);
         let one = render_with_threads(&scene, 1);
-        assert!(one.linear().iter().any(|c| *c != one.pixel(0, 0)), "{name}: flat image");
+        assert!(
+            one.linear().iter().any(|c| *c != one.pixel(0, 0)),
+            "{name}: flat image"
+        );
         for threads in [2, 4] {
             let other = render_with_threads(&scene, threads);
-            assert!(one == other, "{name}: {threads} threads differ from 1 thread");
+            assert!(
+                one == other,
+                "{name}: {threads} threads differ from 1 thread"
+            );
         }
     }
 }
@@ -37,7 +47,10 @@ fn rendering_in_passes_equals_rendering_at_once() {
         let mut film = Film::new(scene.settings.width, scene.settings.height);
         let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
         passes.add(render_samples(&scene, &mut film, split..9, &|_| {}));
-        assert!(film == whole, "0..{split} then {split}..9 differs from 0..9");
+        assert!(
+            film == whole,
+            "0..{split} then {split}..9 differs from 0..9"
+        );
         assert_eq!(passes, stats);
     }
 }
@@ -56,7 +69,10 @@ fn a_different_seed_gives_a_different_image() {
         .zip(b.linear())
         .filter(|(p, q)| **p != *q)
         .count();
-    assert!(changed > a.linear().len() / 2, "only {changed} pixels changed");
+    assert!(
+        changed > a.linear().len() / 2,
+        "only {changed} pixels changed"
+    );
 }
 
 #[test]
@@ -69,5 +85,8 @@ fn the_progress_callback_counts_every_sample() {
     });
     assert_eq!(done.into_inner(), stats.samples);
     let s = &scene.settings;
-    assert_eq!(stats.samples, u64::from(s.width * s.height * s.samples_per_pixel));
+    assert_eq!(
+        stats.samples,
+        u64::from(s.width * s.height * s.samples_per_pixel)
+    );
 }

@@ -42,7 +42,11 @@ fn cosines(model: BounceModel, normal: Vec3, seed: u64) -> Vec<f64> {
     (0..N)
         .map(|_| {
             let d = bounce_direction(model, normal, &mut rng);
-            assert!((d.length() - 1.0).abs() < 1e-5, "{model:?}: |d| = {}", d.length());
+            assert!(
+                (d.length() - 1.0).abs() < 1e-5,
+                "{model:?}: |d| = {}",
+                d.length()
+            );
             f64::from(d.dot(normal))
         })
         .collect()
@@ -86,7 +90,13 @@ fn check_model(model: BounceModel, mean_cos: f64, cdf: impl Fn(f64) -> f64 + Cop
         let below: Vec<f64> = cos.iter().copied().filter(|&c| c < -1e-4).collect();
         assert!(below.is_empty(), "{model:?}: below the surface: {below:?}");
         let (m, se) = mean_and_se(cos.iter().copied());
-        assert_close(&format!("{model:?} mean cos, N={normal}"), m, se, mean_cos, 0.0);
+        assert_close(
+            &format!("{model:?} mean cos, N={normal}"),
+            m,
+            se,
+            mean_cos,
+            0.0,
+        );
         let d = ks_distance(cos, cdf);
         let threshold = ks_threshold(N);
         assert!(
@@ -111,7 +121,9 @@ fn check_model(model: BounceModel, mean_cos: f64, cdf: impl Fn(f64) -> f64 + Cop
 #[test]
 fn lambertian_cosine_is_distributed_as_sqrt_of_uniform() {
     // pdf(ω) = cosθ/π ⇒ pdf(μ = cosθ) = 2μ on [0, 1]: mean 2/3, CDF μ².
-    check_model(BounceModel::Lambertian, 2.0 / 3.0, |x| x.clamp(0.0, 1.0).powi(2));
+    check_model(BounceModel::Lambertian, 2.0 / 3.0, |x| {
+        x.clamp(0.0, 1.0).powi(2)
+    });
 }
 
 #[test]
@@ -127,7 +139,9 @@ fn sphere_volume_cosine_follows_cos_cubed() {
     // ball's volume in that thin cone, ∫₀^{2cosθ} r² dr ∝ cos³θ. Normalised over
     // the hemisphere (∫cos³θ dω = π/2): pdf(ω) = 2cos³θ/π, hence
     // pdf(μ) = 2π·2μ³/π = 4μ³ on [0, 1]: mean 4/5, CDF μ⁴.
-    check_model(BounceModel::SphereVolume, 0.8, |x| x.clamp(0.0, 1.0).powi(4));
+    check_model(BounceModel::SphereVolume, 0.8, |x| {
+        x.clamp(0.0, 1.0).powi(4)
+    });
 }
 
 /// E[f(unit(N + c))] for c uniform on the surface of [-1, 1]³, by the midpoint
@@ -184,8 +198,20 @@ fn cube_moments_match_numeric_integration() {
         let samples = cosines(BounceModel::Cube, normal, 200 + i as u64);
         let (m1, se1) = mean_and_se(samples.iter().copied());
         let (m2, se2) = mean_and_se(samples.iter().map(|c| c * c));
-        assert_close(&format!("cube mean cos, N={normal}"), m1, se1, mean_cos, err1);
-        assert_close(&format!("cube mean cos², N={normal}"), m2, se2, mean_cos2, err2);
+        assert_close(
+            &format!("cube mean cos, N={normal}"),
+            m1,
+            se1,
+            mean_cos,
+            err1,
+        );
+        assert_close(
+            &format!("cube mean cos², N={normal}"),
+            m2,
+            se2,
+            mean_cos2,
+            err2,
+        );
         if i == 0 {
             // With N = +z the cube [-1,1]²×[0,2] lies above the surface; its
             // bottom face (1/6 of the area) gives exactly tangent directions.

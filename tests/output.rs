@@ -65,10 +65,16 @@ fn eight_bit_values_are_floor_of_256_times_the_clamped_value() {
         let expected = (256.0 * v.clamp(0.0, top)).floor() as u8;
         assert_eq!(bytes[3 * i], expected, "v = {v}");
     }
-    assert_eq!(bytes[3 * values.iter().position(|&v| v == 0.5).unwrap()], 128);
+    assert_eq!(
+        bytes[3 * values.iter().position(|&v| v == 0.5).unwrap()],
+        128
+    );
     assert_eq!(*bytes.last().unwrap(), 255);
     // With gamma 2 the transform comes first: 0.25 → 0.5 → 128.
-    assert_eq!(film_of(1, 1, &[Some([0.25, 1.0, 0.0])]).to_rgb8(2.0), [128, 255, 0]);
+    assert_eq!(
+        film_of(1, 1, &[Some([0.25, 1.0, 0.0])]).to_rgb8(2.0),
+        [128, 255, 0]
+    );
 }
 
 #[test]
@@ -95,13 +101,30 @@ fn ppm_is_plain_p3_with_one_triple_per_pixel_top_row_first() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines,
-        ["P3", "2 2", "255", "255 0 0", "0 255 0", "0 0 255", "128 128 128"]
+        [
+            "P3",
+            "2 2",
+            "255",
+            "255 0 0",
+            "0 255 0",
+            "0 0 255",
+            "128 128 128"
+        ]
     );
 }
 
 #[test]
 fn pfm_is_linear_little_endian_bottom_row_first() {
-    let film = film_of(2, 2, &[Some([0.1, 0.2, 0.3]), None, Some([7.5, 0.0, 2.0]), Some([0.25; 3])]);
+    let film = film_of(
+        2,
+        2,
+        &[
+            Some([0.1, 0.2, 0.3]),
+            None,
+            Some([7.5, 0.0, 2.0]),
+            Some([0.25; 3]),
+        ],
+    );
     let bytes = encode_pfm(&film);
     let header = b"PF\n2 2\n-1.0\n";
     assert_eq!(&bytes[..header.len()], header);
@@ -110,7 +133,9 @@ fn pfm_is_linear_little_endian_bottom_row_first() {
         .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
         .collect();
     // Bottom row (y = 1) first; no gamma, no clamping.
-    let expected = [7.5, 0.0, 2.0, 0.25, 0.25, 0.25, 0.1, 0.2, 0.3, 0.0, 0.0, 0.0];
+    let expected = [
+        7.5, 0.0, 2.0, 0.25, 0.25, 0.25, 0.1, 0.2, 0.3, 0.0, 0.0, 0.0,
+    ];
     let expected: Vec<f32> = expected.iter().map(|&v: &f64| v as f32).collect();
     assert_eq!(floats, expected);
 }
@@ -143,7 +168,10 @@ fn every_format_round_trips_through_its_file() {
     let size = img.layer_data.size;
     assert_eq!((size.width(), size.height()), (w as usize, h as usize));
     let linear: Vec<[f32; 3]> = film.linear().iter().map(|c| [c.x, c.y, c.z]).collect();
-    assert_eq!(img.layer_data.channel_data.pixels, linear, "EXR is linear, unclamped");
+    assert_eq!(
+        img.layer_data.channel_data.pixels, linear,
+        "EXR is linear, unclamped"
+    );
 
     for (ext, bytes) in [("ppm", encode_ppm(&film, 2.0)), ("pfm", encode_pfm(&film))] {
         let path = dir.join(format!("a.{ext}"));
@@ -163,10 +191,17 @@ fn unknown_extensions_and_bad_destinations_are_refused_without_a_file() {
         let err = write_image(&dir.join(name), &film, 2.0).unwrap_err();
         assert!(err.to_string().contains(name), "{err}");
     }
-    assert_eq!(ImageFormat::from_path(Path::new("A.PNG")).unwrap(), ImageFormat::Png);
+    assert_eq!(
+        ImageFormat::from_path(Path::new("A.PNG")).unwrap(),
+        ImageFormat::Png
+    );
     let missing = dir.join("no-such-dir").join("a.png");
     assert!(write_image(&missing, &film, 2.0).is_err());
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "a file was left behind");
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "a file was left behind"
+    );
 }
 
 #[test]

@@ -35,12 +35,18 @@ fn stratified_samples_fill_every_stratum_exactly_once() {
                     let hi = f64::from(c + 1) / f64::from(k) + BOUNDARY;
                     (lo..hi).contains(&t)
                 };
-                assert!(inside(u, ix) && inside(v, iy), "spp {spp}, index {index}: ({dx}, {dy})");
+                assert!(
+                    inside(u, ix) && inside(v, iy),
+                    "spp {spp}, index {index}: ({dx}, {dy})"
+                );
                 seen[(cy * k + cx) as usize] += 1;
             }
             // Exactly one per stratum (a sample on a boundary may be counted
             // in the neighbouring cell only with probability ~1e-7).
-            assert!(seen.iter().all(|&n| n == 1), "spp {spp}, pixel {pixel}: {seen:?}");
+            assert!(
+                seen.iter().all(|&n| n == 1),
+                "spp {spp}, pixel {pixel}: {seen:?}"
+            );
         }
     }
 }
@@ -60,7 +66,10 @@ fn offsets_stay_below_half_even_at_the_end_of_the_last_stratum() {
             max = max.max(dx).max(dy);
         }
         assert!(max < 0.5, "{sampling:?}: offset {max}");
-        assert!(max > 0.4999, "{sampling:?}: the largest offsets were not reached");
+        assert!(
+            max > 0.4999,
+            "{sampling:?}: the largest offsets were not reached"
+        );
     }
 }
 
@@ -95,7 +104,11 @@ fn max_depth_one_shows_every_surface_black() {
     // The sphere at the centre and the ground at the bottom are black.
     assert_eq!(film.pixel(w / 2, h / 2), lumen::math::Color::ZERO);
     for x in 0..w {
-        assert_eq!(film.pixel(x, h - 1), lumen::math::Color::ZERO, "ground at x = {x}");
+        assert_eq!(
+            film.pixel(x, h - 1),
+            lumen::math::Color::ZERO,
+            "ground at x = {x}"
+        );
     }
     // Every pixel is a fraction of the background: the fraction of its
     // samples that missed everything.
@@ -123,11 +136,18 @@ fn epsilon_zero_shows_shadow_acne() {
         let (a, sa) = acne.image(c);
         let (f, sf) = fixed.image(c);
         let se = (sa * sa + sf * sf).sqrt();
-        assert!(f - a > 5.0 * se, "channel {c}: acne {a} ± {sa}, fixed {f} ± {sf}");
+        assert!(
+            f - a > 5.0 * se,
+            "channel {c}: acne {a} ± {sa}, fixed {f} ± {sf}"
+        );
     }
     // The sky is the same in both: the top rows see only the background.
     let w = acne.width;
     for c in 0..3 {
-        assert_agree("sky", acne.region(0..w, 0..2, c), fixed.region(0..w, 0..2, c));
+        assert_agree(
+            "sky",
+            acne.region(0..w, 0..2, c),
+            fixed.region(0..w, 0..2, c),
+        );
     }
 }

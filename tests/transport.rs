@@ -7,7 +7,9 @@
 
 mod common;
 
-use common::{assert_agree, builtin_scene, furnace, pixel_stats, FURNACE_CENTER, FURNACE_RADIUS, K};
+use common::{
+    assert_agree, builtin_scene, furnace, pixel_stats, FURNACE_CENTER, FURNACE_RADIUS, K,
+};
 use lumen::geometry::HitRecord;
 use lumen::material::{Attenuation, BounceModel, Diffuse, Metal};
 use lumen::math::{Color, Vec3};
@@ -93,7 +95,10 @@ fn absorb_attenuation_has_expected_throughput_equal_to_the_albedo() {
     let m = Diffuse::lambertian(Color::new(0.8, 0.3, 0.1));
     let mut rng = Rng::new(6);
     for _ in 0..1000 {
-        assert_eq!(m.scatter(&hit_facing_up(), &mut rng).unwrap().attenuation, m.albedo);
+        assert_eq!(
+            m.scatter(&hit_facing_up(), &mut rng).unwrap().attenuation,
+            m.albedo
+        );
     }
 }
 
@@ -105,7 +110,11 @@ fn scale_and_absorb_renders_converge_to_the_same_image() {
     let (w, h) = (scale.width, scale.height);
     assert_eq!((w, h), (absorb.width, absorb.height));
     for c in 0..3 {
-        assert_agree(&format!("image mean, channel {c}"), scale.image(c), absorb.image(c));
+        assert_agree(
+            &format!("image mean, channel {c}"),
+            scale.image(c),
+            absorb.image(c),
+        );
         for ry in 0..3 {
             for rx in 0..4 {
                 let xs = rx * w / 4..(rx + 1) * w / 4;
@@ -135,7 +144,10 @@ fn assert_white(what: &str, material: MaterialDesc, depth: u32) {
             (mean - 1.0).abs() <= K * se,
             "{what}, channel {c}: furnace mean {mean} ± {se}, expected 1"
         );
-        assert!(stats.max[c] <= 1.0, "{what}: a sample brighter than the light");
+        assert!(
+            stats.max[c] <= 1.0,
+            "{what}: a sample brighter than the light"
+        );
     }
     let hits = stats.stats.rays as f64 / stats.stats.samples as f64 - 1.0;
     assert!(

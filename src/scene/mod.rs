@@ -126,7 +126,10 @@ fn finite(field: &str, values: &[f64]) -> Result<(), SceneError> {
     } else {
         Err(invalid(
             field,
-            format!("must be a finite number of magnitude at most {:e}", f32::MAX),
+            format!(
+                "must be a finite number of magnitude at most {:e}",
+                f32::MAX
+            ),
         ))
     }
 }

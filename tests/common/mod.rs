@@ -147,7 +147,12 @@ impl PixelStats {
     /// Mean over the pixels `x0..x1` × `y0..y1` of channel `c`, and its
     /// standard error: the pixels are independent, each mean of `count`
     /// samples has variance var/count.
-    pub fn region(&self, xs: std::ops::Range<u32>, ys: std::ops::Range<u32>, c: usize) -> (f64, f64) {
+    pub fn region(
+        &self,
+        xs: std::ops::Range<u32>,
+        ys: std::ops::Range<u32>,
+        c: usize,
+    ) -> (f64, f64) {
         let (mut m, mut v, mut n) = (0.0, 0.0, 0.0);
         for y in ys {
             for x in xs.clone() {
