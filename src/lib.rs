@@ -15,6 +15,8 @@
 //! - [`sampling`] and [`rng`]: random directions and seeded random numbers.
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.
 //! - [`film`] and [`output`]: accumulation, gamma, tone mapping, image files.
+//! - [`progressive`] and [`checkpoint`]: rendering in passes that can be
+//!   stopped, saved and resumed, within a time budget.
 //! - [`scene`]: scene descriptions, the built-in scenes, and the compiled scene.
 //! - [`gallery`] and [`bench`]: all the notes' figures at once; throughput.
 //!
@@ -37,6 +39,7 @@
 
 pub mod bench;
 pub mod camera;
+pub mod checkpoint;
 pub mod film;
 pub mod gallery;
 pub mod geometry;
@@ -44,6 +47,7 @@ pub mod integrator;
 pub mod material;
 pub mod math;
 pub mod output;
+pub mod progressive;
 pub mod ray;
 pub mod render;
 pub mod rng;

@@ -4,12 +4,16 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use lumen::bench;
+use lumen::checkpoint::{self, Checkpoint};
 use lumen::output;
-use lumen::render::{render, RenderStats};
+use lumen::progressive::{parse_duration, Session, SessionError, StopReason};
+use lumen::render::RenderStats;
 use lumen::scene::builtin::{self, BUILTINS};
-use lumen::scene::{Overrides, Scene, SceneDesc};
+use lumen::scene::{Overrides, SceneDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// lumen: a physically based path tracer following Ray Tracing in One Weekend.
@@ -31,6 +35,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         settings: SettingArgs,
+        #[command(flatten)]
+        progressive: ProgressiveArgs,
     },
     /// List the built-in scenes with their captions.
     Scenes,
@@ -74,6 +80,27 @@ struct SettingArgs {
     threads: Option<u32>,
 }
 
+/// How a render is saved, stopped and resumed.
+#[derive(Args, Clone, Default)]
+struct ProgressiveArgs {
+    /// Checkpoint file, saved during the render so that it can be resumed
+    /// [default: the output path + .lumen-ckpt].
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Save the image and the checkpoint at most this often (e.g. 30s, 5m)
+    /// instead of after every pass.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    checkpoint_interval: Option<Duration>,
+    /// Continue the render saved in the checkpoint; the scene and settings
+    /// must be the same as when it was made.
+    #[arg(long)]
+    resume: bool,
+    /// Stop after the last pass that ends within this time (e.g. 90s, 10m,
+    /// 2h) and write the image; --spp stays the upper bound.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    time_limit: Option<Duration>,
+}
+
 impl SettingArgs {
     fn overrides(&self) -> Overrides {
         Overrides {
@@ -85,10 +112,13 @@ impl SettingArgs {
     }
 }
 
+/// Exit status of a render stopped by Ctrl-C or SIGTERM (128 + SIGINT).
+const EXIT_INTERRUPTED: u8 = 130;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("lumen: error: {e:#}");
             ExitCode::FAILURE
@@ -96,26 +126,31 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> Result<()> {
+fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Render {
             scene,
             output,
             settings,
+            progressive,
         } => with_threads(settings.threads, || {
-            render_command(&scene, &output, &settings)
+            render_command(&scene, &output, &settings, &progressive)
         }),
         Command::Scenes => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {
                 println!("{:width$}  {}", b.name, b.caption);
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Gallery { dir, settings } => {
-            with_threads(settings.threads, || gallery_command(&dir, &settings))
+            with_threads(settings.threads, || gallery_command(&dir, &settings))?;
+            Ok(ExitCode::SUCCESS)
         }
-        Command::Bench { spp, runs, threads } => with_threads(threads, || bench_command(spp, runs)),
+        Command::Bench { spp, runs, threads } => {
+            with_threads(threads, || bench_command(spp, runs))?;
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
@@ -163,40 +198,187 @@ fn strsim_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-fn render_command(name: &str, out: &Path, args: &SettingArgs) -> Result<()> {
+fn render_command(
+    name: &str,
+    out: &Path,
+    args: &SettingArgs,
+    prog: &ProgressiveArgs,
+) -> Result<ExitCode> {
     let mut desc = load_scene(name)?;
     args.overrides().apply(&mut desc);
-    let scene = Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
     output::ImageFormat::from_path(out)?;
+    let ckpt_path = prog
+        .checkpoint
+        .clone()
+        .unwrap_or_else(|| checkpoint::default_path(out));
+    if ckpt_path == out {
+        bail!(
+            "{}: the checkpoint cannot be the output image",
+            out.display()
+        );
+    }
+    // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
-    let s = &scene.settings;
-    let total = u64::from(s.width) * u64::from(s.height) * u64::from(s.samples_per_pixel);
-    let bar = progress_bar(total);
-    let start = Instant::now();
-    let (film, stats) = render(&scene, &|n| bar.inc(n));
-    let elapsed = start.elapsed();
-    bar.finish_and_clear();
-    output::write_image(out, &film, s.gamma)?;
+    output::check_writable(&ckpt_path).context("checkpoint")?;
+    let compile_error = |e: SessionError| match e {
+        SessionError::Scene(e) => anyhow!("scene '{name}': {e}"),
+        e => anyhow!(e),
+    };
+    let mut session = if prog.resume {
+        if !ckpt_path.exists() {
+            bail!(
+                "--resume: there is no checkpoint at {}",
+                ckpt_path.display()
+            );
+        }
+        let ckpt = Checkpoint::read(&ckpt_path)?;
+        Session::resume(&desc, ckpt, &ckpt_path).map_err(compile_error)?
+    } else {
+        let session = Session::new(&desc).map_err(compile_error)?;
+        if ckpt_path.exists() {
+            eprintln!(
+                "lumen: note: starting afresh; the checkpoint {} will be replaced (--resume continues it)",
+                ckpt_path.display()
+            );
+        }
+        session
+    };
+
+    let stop = Arc::new(AtomicBool::new(false));
+    install_stop_handler(
+        &stop,
+        [output::temp_path(out), output::temp_path(&ckpt_path)],
+    )?;
+
+    let s = session.scene().settings.clone();
+    let resumed_from = session.spp_done();
     eprintln!(
-        "{name}: {}x{} at {} spp, depth {}, written to {}",
+        "{name}: {}x{} at {} spp, depth {}{}",
         s.width,
         s.height,
         s.samples_per_pixel,
         s.max_depth,
-        out.display()
+        if prog.resume {
+            format!(
+                ", resuming at {resumed_from} spp from {}",
+                ckpt_path.display()
+            )
+        } else {
+            String::new()
+        }
     );
-    eprintln!("{}", summary(&stats, elapsed));
-    Ok(())
+    let save = |session: &Session| -> Result<()> {
+        output::write_image(out, session.film(), s.gamma)?;
+        session
+            .checkpoint()
+            .write(&ckpt_path)
+            .context("cannot save the checkpoint")?;
+        Ok(())
+    };
+    let pixels = u64::from(s.width) * u64::from(s.height);
+    let bar = progress_bar(pixels * u64::from(s.samples_per_pixel - resumed_from));
+    let start = Instant::now();
+    let mut last_save = start;
+    let run = session.run(&stop, prog.time_limit, &|n| bar.inc(n), &mut |session,
+                                                                          pass|
+     -> Result<
+        (),
+    > {
+        bar.suspend(|| {
+            eprintln!(
+                "pass {}: samples {}..{} in {:.3} s, {} of {} spp",
+                pass.number,
+                pass.samples.start,
+                pass.samples.end,
+                pass.duration.as_secs_f64(),
+                session.spp_done(),
+                session.spp_total()
+            )
+        });
+        // The finished image is written once, below.
+        let due = prog
+            .checkpoint_interval
+            .is_none_or(|every| last_save.elapsed() >= every);
+        if !session.is_complete() && due {
+            save(session)?;
+            last_save = Instant::now();
+        }
+        Ok(())
+    })?;
+    let elapsed = start.elapsed();
+    bar.finish_and_clear();
+    let (held, total) = (session.spp_done(), session.spp_total());
+    let code = match run.reason {
+        StopReason::Complete => {
+            output::write_image(out, session.film(), s.gamma)?;
+            match std::fs::remove_file(&ckpt_path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    eprintln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
+                }
+                _ => {}
+            }
+            eprintln!("{name}: {total} spp written to {}", out.display());
+            ExitCode::SUCCESS
+        }
+        reason if held == 0 => {
+            debug_assert_eq!(reason, StopReason::Interrupted);
+            eprintln!("lumen: interrupted before the first pass finished; nothing written");
+            ExitCode::from(EXIT_INTERRUPTED)
+        }
+        reason => {
+            save(&session)?;
+            let why = if reason == StopReason::Interrupted {
+                "interrupted"
+            } else {
+                "time limit reached"
+            };
+            eprintln!(
+                "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
+                out.display(),
+                ckpt_path.display()
+            );
+            if reason == StopReason::Interrupted {
+                ExitCode::from(EXIT_INTERRUPTED)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+    };
+    eprintln!("{}", summary(&run.stats, &session.stats(), elapsed));
+    Ok(code)
 }
 
-fn summary(stats: &RenderStats, elapsed: Duration) -> String {
+/// On the first Ctrl-C or SIGTERM, sets `stop`: the render abandons the pass
+/// in flight and saves what it has. On the second, exits at once, removing
+/// any half-written `temps`: the files in place are those of the last save,
+/// complete, since every file is renamed into place only once written.
+fn install_stop_handler(stop: &Arc<AtomicBool>, temps: [PathBuf; 2]) -> Result<()> {
+    let stop = Arc::clone(stop);
+    ctrlc::set_handler(move || {
+        if stop.swap(true, Ordering::SeqCst) {
+            for t in &temps {
+                let _ = std::fs::remove_file(t);
+            }
+            eprintln!("lumen: stopped at once; the files on disk are those of the last save");
+            std::process::exit(i32::from(EXIT_INTERRUPTED));
+        }
+        eprintln!(
+            "lumen: stopping: saving the image and a checkpoint (interrupt again to quit at once)"
+        );
+    })
+    .context("cannot install the interrupt handler")
+}
+
+/// One line of counts: rates of this run (`run`) over `elapsed`, totals of
+/// the whole image (`all`, which includes earlier runs when resumed).
+fn summary(run: &RenderStats, all: &RenderStats, elapsed: Duration) -> String {
     format!(
         "time {:.2} s, {:.2} M samples/s, {:.2} M rays/s, {} rays, {} dropped samples",
         elapsed.as_secs_f64(),
-        stats.samples_per_second(elapsed) / 1e6,
-        stats.rays_per_second(elapsed) / 1e6,
-        stats.rays,
-        stats.dropped
+        run.samples_per_second(elapsed) / 1e6,
+        run.rays_per_second(elapsed) / 1e6,
+        all.rays,
+        all.dropped
     )
 }
 
@@ -227,7 +409,7 @@ fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
         BUILTINS.len(),
         dir.join("index.html").display()
     );
-    eprintln!("{}", summary(&total, start.elapsed()));
+    eprintln!("{}", summary(&total, &total, start.elapsed()));
     Ok(())
 }
 

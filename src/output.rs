@@ -93,7 +93,9 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
+/// The temporary name [`write_atomic`] writes `path`'s content to before
+/// renaming it into place: hidden, in the same directory, unique per process.
+pub fn temp_path(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

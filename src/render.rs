@@ -77,12 +77,30 @@ pub fn render_samples(
     samples: Range<u32>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderStats {
+    render_samples_cancellable(scene, film, samples, progress, &|| false)
+        .expect("a render that is never stopped completes")
+}
+
+/// [`render_samples`] that can be abandoned: `should_stop` is asked before
+/// each row (rows are the units of work), and once it answers `true` the
+/// remaining rows are skipped and `None` is returned. The film then holds the
+/// new samples in some rows only; the caller must put back its copy.
+pub fn render_samples_cancellable(
+    scene: &Scene,
+    film: &mut Film,
+    samples: Range<u32>,
+    progress: &(dyn Fn(u64) + Sync),
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Option<RenderStats> {
     let s = &scene.settings;
     let width = film.width();
     let row_samples = u64::from(width) * u64::from(samples.len() as u32);
     film.rows_mut()
         .enumerate()
         .map(|(y, (sums, counts))| {
+            if should_stop() {
+                return None;
+            }
             let mut stats = RenderStats::default();
             for x in 0..width {
                 let pixel = y as u64 * u64::from(width) + u64::from(x);
@@ -99,12 +117,16 @@ pub fn render_samples(
                 }
             }
             progress(row_samples);
-            stats
+            Some(stats)
         })
-        .reduce(RenderStats::default, |mut a, b| {
-            a.add(b);
-            a
-        })
+        .reduce(
+            || Some(RenderStats::default()),
+            |a, b| {
+                let (mut a, b) = (a?, b?);
+                a.add(b);
+                Some(a)
+            },
+        )
 }
 
 /// Adds one sample's colour to a pixel's sum and count, unless it is NaN or

@@ -1,0 +1,425 @@
+//! Checkpoints: the state of an unfinished render (the film's raw sums and
+//! counts, how many samples per pixel they hold, the counts gathered so far),
+//! saved so that a later run can continue where this one stopped.
+//!
+//! A checkpoint also records the scene description it was made for, after
+//! the command line's overrides, as canonical JSON: a render continues a
+//! checkpoint only if its own description is the same, so that the image is
+//! bit-identical to one rendered without a stop.
+//!
+//! # File format (version 1)
+//!
+//! All integers little-endian.
+//!
+//! | bytes | content |
+//! | --- | --- |
+//! | 8 | magic `LUMENCKP` |
+//! | 4 | format version (1) |
+//! | 8 | payload length *n* |
+//! | 4 | CRC-32 of the payload |
+//! | *n* | payload |
+//!
+//! The payload: the lumen version and the description (each as a u32 length
+//! and UTF-8 bytes), samples per pixel done (u32), width and height (u32),
+//! samples, rays and dropped samples (u64 each), then every pixel's three
+//! `f64` sums and finally every pixel's `u32` count, row-major, top row first.
+
+use crate::film::Film;
+use crate::output::{self, OutputError};
+use crate::render::RenderStats;
+use crate::scene::SceneDesc;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// First bytes of every checkpoint file.
+pub const MAGIC: &[u8; 8] = b"LUMENCKP";
+/// The format version this lumen writes and reads.
+pub const VERSION: u32 = 1;
+/// Extension added to an output path to name its default checkpoint.
+pub const EXTENSION: &str = "lumen-ckpt";
+
+const HEADER_LEN: usize = 8 + 4 + 8 + 4;
+
+/// The state of an unfinished render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    /// Version of lumen that wrote it; another version may compute other
+    /// samples, so it is part of what must match.
+    pub lumen_version: String,
+    /// Canonical JSON of the scene description, overrides applied
+    /// (see [`description_text`]).
+    pub description: String,
+    /// Samples per pixel held by the film: samples `0..spp_done` of every pixel.
+    pub spp_done: u32,
+    /// Counts gathered while rendering those samples.
+    pub stats: RenderStats,
+    /// The accumulated samples.
+    pub film: Film,
+}
+
+/// A checkpoint that cannot be read or does not belong to this render.
+#[derive(Debug, Error)]
+pub enum CheckpointError {
+    /// The file cannot be read.
+    #[error("checkpoint {path}: cannot read: {message}")]
+    Io {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The file does not start with the checkpoint magic bytes.
+    #[error("checkpoint {path}: not a lumen checkpoint (wrong magic bytes)")]
+    NotACheckpoint {
+        /// The checkpoint path.
+        path: PathBuf,
+    },
+    /// The file has a format version this lumen does not read.
+    #[error("checkpoint {path}: format version {found}, but this lumen reads version {VERSION}")]
+    Version {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// The version found.
+        found: u32,
+    },
+    /// The file is shorter or longer than its header says.
+    #[error("checkpoint {path}: truncated or damaged: {found} bytes, the header says {expected}; refusing to use it")]
+    Truncated {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// Length the header announces.
+        expected: u64,
+        /// Actual length.
+        found: u64,
+    },
+    /// The payload does not match its checksum.
+    #[error("checkpoint {path}: corrupted (checksum mismatch); refusing to use it")]
+    Corrupted {
+        /// The checkpoint path.
+        path: PathBuf,
+    },
+    /// The checksum matches but the content makes no sense.
+    #[error("checkpoint {path}: malformed: {message}")]
+    Malformed {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The checkpoint was made for another scene or other settings.
+    #[error("checkpoint {path} was made for a different render: {differences}; render with the same scene and settings to resume, or without --resume to start afresh")]
+    Mismatch {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// What differs, e.g. `width 160 in the checkpoint, 200 here`.
+        differences: String,
+    },
+}
+
+/// The canonical text of a scene description that identifies a render:
+/// compact JSON, materials sorted by name (they are a `BTreeMap`).
+pub fn description_text(desc: &SceneDesc) -> String {
+    serde_json::to_string(desc).expect("a scene description always serialises")
+}
+
+/// The default checkpoint path of an output image: `out.png` →
+/// `out.png.lumen-ckpt`, in the same directory.
+pub fn default_path(output: &Path) -> PathBuf {
+    let mut name = output.as_os_str().to_owned();
+    name.push(".");
+    name.push(EXTENSION);
+    PathBuf::from(name)
+}
+
+impl Checkpoint {
+    /// The checkpoint's bytes, header included.
+    pub fn encode(&self) -> Vec<u8> {
+        let (sums, counts) = self.film.raw();
+        let mut p = Vec::with_capacity(64 + self.description.len() + sums.len() * 28);
+        for text in [&self.lumen_version, &self.description] {
+            p.extend_from_slice(&(text.len() as u32).to_le_bytes());
+            p.extend_from_slice(text.as_bytes());
+        }
+        for v in [self.spp_done, self.film.width(), self.film.height()] {
+            p.extend_from_slice(&v.to_le_bytes());
+        }
+        for v in [self.stats.samples, self.stats.rays, self.stats.dropped] {
+            p.extend_from_slice(&v.to_le_bytes());
+        }
+        for s in sums.iter().flatten() {
+            p.extend_from_slice(&s.to_le_bytes());
+        }
+        for c in counts {
+            p.extend_from_slice(&c.to_le_bytes());
+        }
+        let mut out = Vec::with_capacity(HEADER_LEN + p.len());
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&(p.len() as u64).to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(&p).to_le_bytes());
+        out.extend_from_slice(&p);
+        out
+    }
+
+    /// Reads a checkpoint from `bytes`; `path` only names it in errors.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, CheckpointError> {
+        let path_buf = || path.to_path_buf();
+        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(CheckpointError::NotACheckpoint { path: path_buf() });
+        }
+        if bytes.len() < HEADER_LEN {
+            return Err(CheckpointError::Truncated {
+                path: path_buf(),
+                expected: HEADER_LEN as u64,
+                found: bytes.len() as u64,
+            });
+        }
+        let mut header = Reader(&bytes[MAGIC.len()..HEADER_LEN]);
+        let version = header.u32().expect("header length checked");
+        if version != VERSION {
+            return Err(CheckpointError::Version {
+                path: path_buf(),
+                found: version,
+            });
+        }
+        let len = header.u64().expect("header length checked");
+        let crc = header.u32().expect("header length checked");
+        let payload = &bytes[HEADER_LEN..];
+        if payload.len() as u64 != len {
+            return Err(CheckpointError::Truncated {
+                path: path_buf(),
+                expected: HEADER_LEN as u64 + len,
+                found: bytes.len() as u64,
+            });
+        }
+        if crc32fast::hash(payload) != crc {
+            return Err(CheckpointError::Corrupted { path: path_buf() });
+        }
+        Self::decode_payload(payload).map_err(|message| CheckpointError::Malformed {
+            path: path_buf(),
+            message: message.to_string(),
+        })
+    }
+
+    fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
+        let mut r = Reader(payload);
+        let lumen_version = r.text().ok_or("bad version text")?;
+        let description = r.text().ok_or("bad description text")?;
+        let spp_done = r.u32().ok_or("missing sample count")?;
+        let width = r.u32().ok_or("missing width")?;
+        let height = r.u32().ok_or("missing height")?;
+        let mut stat = || r.u64().ok_or("missing statistics");
+        let stats = RenderStats {
+            samples: stat()?,
+            rays: stat()?,
+            dropped: stat()?,
+        };
+        let n = width as usize * height as usize;
+        if r.0.len() as u64 != n as u64 * 28 {
+            return Err("pixel data does not match the image size");
+        }
+        let (sum_bytes, count_bytes) = r.0.split_at(n * 24);
+        let sums = sum_bytes
+            .chunks_exact(24)
+            .map(|p| {
+                let f = |i: usize| f64::from_le_bytes(p[i..i + 8].try_into().expect("8 bytes"));
+                [f(0), f(8), f(16)]
+            })
+            .collect();
+        let counts = count_bytes
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect();
+        let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
+        Ok(Self {
+            lumen_version,
+            description,
+            spp_done,
+            stats,
+            film,
+        })
+    }
+
+    /// Writes the checkpoint to `path` atomically (temporary file + rename),
+    /// so a kill at any moment leaves the previous checkpoint or this one.
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
+        output::write_bytes_atomic(path, &self.encode())
+    }
+
+    /// Reads and verifies the checkpoint at `path`.
+    pub fn read(path: &Path) -> Result<Self, CheckpointError> {
+        let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Self::decode(&bytes, path)
+    }
+
+    /// Checks that this checkpoint was made for a render of `desc` (overrides
+    /// applied) by this version of lumen; the error names what differs.
+    pub fn check_matches(&self, desc: &SceneDesc, path: &Path) -> Result<(), CheckpointError> {
+        let mismatch = |differences: String| CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+            differences,
+        };
+        let ours = env!("CARGO_PKG_VERSION");
+        if self.lumen_version != ours {
+            return Err(mismatch(format!(
+                "written by lumen {}, this is lumen {ours}",
+                self.lumen_version
+            )));
+        }
+        if self.description == description_text(desc) {
+            return Ok(());
+        }
+        let Ok(theirs) = serde_json::from_str::<SceneDesc>(&self.description) else {
+            return Err(mismatch("a different scene description".into()));
+        };
+        Err(mismatch(describe_differences(&theirs, desc)))
+    }
+}
+
+/// What differs between the checkpoint's description and this render's, in
+/// words: render settings one by one, the rest by section.
+fn describe_differences(theirs: &SceneDesc, ours: &SceneDesc) -> String {
+    let mut out = Vec::new();
+    let (a, b) = (&theirs.render, &ours.render);
+    macro_rules! field {
+        ($name:literal, $f:ident) => {
+            if a.$f != b.$f {
+                out.push(format!(
+                    "{} {:?} in the checkpoint, {:?} here",
+                    $name, a.$f, b.$f
+                ));
+            }
+        };
+    }
+    field!("width", width);
+    field!("height", height);
+    field!("aspect ratio", aspect_ratio);
+    field!("spp", samples_per_pixel);
+    field!("depth", max_depth);
+    field!("seed", seed);
+    field!("sampling", sampling);
+    field!("gamma", gamma);
+    field!("epsilon", epsilon);
+    field!("shading", shading);
+    let scene_differs = theirs.caption != ours.caption
+        || theirs.camera != ours.camera
+        || theirs.background != ours.background
+        || theirs.materials != ours.materials
+        || theirs.objects != ours.objects;
+    if scene_differs {
+        out.push("a different scene (camera, background, materials or objects differ)".into());
+    }
+    if out.is_empty() {
+        out.push("a different scene description".into());
+    }
+    out.join(", ")
+}
+
+/// A cursor over little-endian bytes.
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Option<&[u8]> {
+        if self.0.len() < n {
+            return None;
+        }
+        let (head, rest) = self.0.split_at(n);
+        self.0 = rest;
+        Some(head)
+    }
+
+    fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+
+    fn text(&mut self) -> Option<String> {
+        let n = self.u32()? as usize;
+        String::from_utf8(self.take(n)?.to_vec()).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    fn sample() -> (SceneDesc, Checkpoint) {
+        let mut desc = builtin::find("metal-mirror").unwrap().desc();
+        desc.render.width = 8;
+        let h = 4;
+        desc.render.height = Some(h);
+        let n = 8 * h as usize;
+        let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, f64::MAX]).collect();
+        let counts = (0..n as u32).collect();
+        let ckpt = Checkpoint {
+            lumen_version: env!("CARGO_PKG_VERSION").into(),
+            description: description_text(&desc),
+            spp_done: 3,
+            stats: RenderStats {
+                samples: 96,
+                rays: 1234,
+                dropped: 2,
+            },
+            film: Film::from_raw(8, h, sums, counts).unwrap(),
+        };
+        (desc, ckpt)
+    }
+
+    #[test]
+    fn round_trips_exactly() {
+        let (desc, ckpt) = sample();
+        let p = Path::new("x");
+        let back = Checkpoint::decode(&ckpt.encode(), p).unwrap();
+        assert_eq!(back, ckpt);
+        back.check_matches(&desc, p).unwrap();
+    }
+
+    #[test]
+    fn every_flipped_byte_and_every_truncation_is_refused() {
+        let (_, ckpt) = sample();
+        let bytes = ckpt.encode();
+        let p = Path::new("x");
+        for i in 0..bytes.len() {
+            let mut bad = bytes.clone();
+            bad[i] ^= 0x10;
+            assert!(Checkpoint::decode(&bad, p).is_err(), "flip at {i} accepted");
+            assert!(
+                Checkpoint::decode(&bytes[..i], p).is_err(),
+                "truncation to {i} accepted"
+            );
+        }
+    }
+
+    #[test]
+    fn mismatches_are_named() {
+        let (mut desc, ckpt) = sample();
+        let p = Path::new("x");
+        let spp = desc.render.samples_per_pixel;
+        desc.render.seed = 7;
+        desc.render.samples_per_pixel = 5;
+        let e = ckpt.check_matches(&desc, p).unwrap_err().to_string();
+        assert!(e.contains("seed 0 in the checkpoint, 7 here"), "{e}");
+        assert!(
+            e.contains(&format!("spp {spp} in the checkpoint, 5 here")),
+            "{e}"
+        );
+        let other = builtin::find("cover").unwrap().desc();
+        let e = ckpt.check_matches(&other, p).unwrap_err().to_string();
+        assert!(e.contains("a different scene"), "{e}");
+    }
+
+    #[test]
+    fn default_path_is_beside_the_output() {
+        assert_eq!(
+            default_path(Path::new("dir/out.png")),
+            PathBuf::from("dir/out.png.lumen-ckpt")
+        );
+    }
+}

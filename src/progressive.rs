@@ -1,0 +1,421 @@
+//! Progressive rendering: the image is rendered in passes, each adding some
+//! samples to every pixel, so that after any pass the film is a complete,
+//! viewable image of the samples so far and can be saved as a checkpoint.
+//!
+//! Because every sample has its own random numbers and every pixel adds its
+//! samples in index order (see [`crate::render::render_samples`]), the way
+//! the samples are split into passes, and where a render was stopped and
+//! resumed, never changes the image: it is bit-identical to one rendered in a
+//! single pass.
+//!
+//! A [`Session`] holds a render in progress; [`Session::run`] renders passes
+//! until the image is complete, a stop is asked for through an [`AtomicBool`]
+//! (lumen's command sets it on Ctrl-C), or a time budget would be exceeded.
+//!
+//! ```
+//! use lumen::progressive::{Session, StopReason};
+//! use lumen::scene::builtin;
+//! use std::sync::atomic::AtomicBool;
+//!
+//! let mut desc = builtin::find("metal-mirror").unwrap().desc();
+//! desc.render.width = 16;
+//! desc.render.samples_per_pixel = 24;
+//! let mut session = Session::new(&desc).unwrap();
+//! let stop = AtomicBool::new(false);
+//! let mut passes = 0;
+//! let run = session
+//!     .run(&stop, None, &|_| {}, &mut |_, _| -> Result<(), ()> {
+//!         passes += 1;
+//!         Ok(())
+//!     })
+//!     .unwrap();
+//! assert_eq!(run.reason, StopReason::Complete);
+//! // Samples 0..1, 1..2, 2..4, then passes of 3 (an eighth of 24), 22..24.
+//! assert_eq!(passes, 10);
+//! assert_eq!(session.spp_done(), 24);
+//! ```
+
+use crate::checkpoint::{description_text, Checkpoint, CheckpointError};
+use crate::film::Film;
+use crate::render::{render_samples_cancellable, RenderStats};
+use crate::scene::{Scene, SceneDesc, SceneError};
+use std::ops::Range;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Largest pass, in samples per pixel.
+pub const MAX_PASS_SPP: u32 = 64;
+
+/// Size in samples per pixel of the pass that follows `done` samples of
+/// `spp`: passes double (1, 1, 2, 4, 8, …) so that a first image appears at
+/// once, up to an eighth of the render (at most [`MAX_PASS_SPP`]) so that a
+/// stop or a time limit loses little. It depends on `done` and `spp` only,
+/// so a resumed render takes the same passes as one never stopped.
+pub fn pass_size(done: u32, spp: u32) -> u32 {
+    let cap = (spp / 8).clamp(1, MAX_PASS_SPP);
+    done.max(1).min(cap).min(spp.saturating_sub(done))
+}
+
+/// All passes of a render of `spp` samples per pixel, as sample ranges.
+pub fn schedule(spp: u32) -> Vec<Range<u32>> {
+    let mut passes = Vec::new();
+    let mut done = 0;
+    while done < spp {
+        let n = pass_size(done, spp);
+        passes.push(done..done + n);
+        done += n;
+    }
+    passes
+}
+
+/// Parses a duration such as `90s`, `1.5m`, `2h` or `45` (seconds).
+pub fn parse_duration(text: &str) -> Result<Duration, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, 's')) => (&t[..i], 1.0),
+        Some((i, 'm')) => (&t[..i], 60.0),
+        Some((i, 'h')) => (&t[..i], 3600.0),
+        _ => (t, 1.0),
+    };
+    let bad = || format!("'{text}' is not a duration; write e.g. 90s, 1.5m or 2h");
+    let value: f64 = number.trim().parse().map_err(|_| bad())?;
+    let seconds = value * unit;
+    if !(seconds > 0.0) || !seconds.is_finite() || seconds > 1e9 {
+        return Err(format!("'{text}': a duration must be positive"));
+    }
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+/// A render in progress: the scene and the samples rendered so far.
+pub struct Session {
+    scene: Scene,
+    description: String,
+    film: Film,
+    stats: RenderStats,
+    spp_done: u32,
+}
+
+/// A session that cannot be started.
+#[derive(Debug, Error)]
+pub enum SessionError {
+    /// The scene does not compile.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The checkpoint cannot be used.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+}
+
+/// One finished pass.
+#[derive(Clone, Debug)]
+pub struct PassReport {
+    /// Pass number within this run, from 1.
+    pub number: u32,
+    /// The sample indices it rendered in every pixel.
+    pub samples: Range<u32>,
+    /// How long it took.
+    pub duration: Duration,
+    /// Its counts.
+    pub stats: RenderStats,
+}
+
+/// Why [`Session::run`] returned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// Every sample is rendered.
+    Complete,
+    /// A stop was asked for.
+    Interrupted,
+    /// The next pass would not fit in the time budget.
+    TimeLimit,
+}
+
+/// What [`Session::run`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunSummary {
+    /// Why it returned.
+    pub reason: StopReason,
+    /// Passes finished in this run.
+    pub passes: u32,
+    /// Counts of this run's finished passes only.
+    pub stats: RenderStats,
+}
+
+impl Session {
+    /// A new render of `desc` with no samples yet.
+    pub fn new(desc: &SceneDesc) -> Result<Self, SessionError> {
+        let scene = Scene::from_desc(desc)?;
+        let film = Film::new(scene.settings.width, scene.settings.height);
+        Ok(Self {
+            scene,
+            description: description_text(desc),
+            film,
+            stats: RenderStats::default(),
+            spp_done: 0,
+        })
+    }
+
+    /// Continues the render of `desc` saved in `checkpoint` (read from
+    /// `path`, which names it in errors). Refused unless the checkpoint was
+    /// made for the same description, overrides included.
+    pub fn resume(
+        desc: &SceneDesc,
+        checkpoint: Checkpoint,
+        path: &Path,
+    ) -> Result<Self, SessionError> {
+        checkpoint.check_matches(desc, path)?;
+        let mut session = Self::new(desc)?;
+        let s = &session.scene.settings;
+        let malformed = |message: String| CheckpointError::Malformed {
+            path: path.to_path_buf(),
+            message,
+        };
+        if (checkpoint.film.width(), checkpoint.film.height()) != (s.width, s.height) {
+            return Err(malformed(format!(
+                "its image is {}x{}, the render's {}x{}",
+                checkpoint.film.width(),
+                checkpoint.film.height(),
+                s.width,
+                s.height
+            ))
+            .into());
+        }
+        if checkpoint.spp_done > s.samples_per_pixel {
+            return Err(malformed(format!(
+                "it holds {} spp of a {} spp render",
+                checkpoint.spp_done, s.samples_per_pixel
+            ))
+            .into());
+        }
+        session.film = checkpoint.film;
+        session.stats = checkpoint.stats;
+        session.spp_done = checkpoint.spp_done;
+        Ok(session)
+    }
+
+    /// The compiled scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The film: samples `0..spp_done()` of every pixel.
+    pub fn film(&self) -> &Film {
+        &self.film
+    }
+
+    /// Counts of all samples in the film, including those of earlier runs.
+    pub fn stats(&self) -> RenderStats {
+        self.stats
+    }
+
+    /// Samples per pixel in the film.
+    pub fn spp_done(&self) -> u32 {
+        self.spp_done
+    }
+
+    /// Samples per pixel of the finished image.
+    pub fn spp_total(&self) -> u32 {
+        self.scene.settings.samples_per_pixel
+    }
+
+    /// Whether every sample is rendered.
+    pub fn is_complete(&self) -> bool {
+        self.spp_done >= self.spp_total()
+    }
+
+    /// The state to save so that a later run can continue this one.
+    pub fn checkpoint(&self) -> Checkpoint {
+        Checkpoint {
+            lumen_version: env!("CARGO_PKG_VERSION").into(),
+            description: self.description.clone(),
+            spp_done: self.spp_done,
+            stats: self.stats,
+            film: self.film.clone(),
+        }
+    }
+
+    /// Renders the next pass. `should_stop` is asked before every row; if it
+    /// answers `true` the pass is abandoned, the film is left as it was
+    /// before the pass, and `None` is returned.
+    pub fn render_pass(
+        &mut self,
+        progress: &(dyn Fn(u64) + Sync),
+        should_stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<(Range<u32>, Duration, RenderStats)> {
+        let n = pass_size(self.spp_done, self.spp_total());
+        let samples = self.spp_done..self.spp_done + n;
+        // A pass abandoned half-way has added samples to some rows only:
+        // keep the film as it was to put it back.
+        let before = self.film.clone();
+        let start = Instant::now();
+        let result = render_samples_cancellable(
+            &self.scene,
+            &mut self.film,
+            samples.clone(),
+            progress,
+            should_stop,
+        );
+        let duration = start.elapsed();
+        match result {
+            Some(stats) => {
+                self.stats.add(stats);
+                self.spp_done = samples.end;
+                Some((samples, duration, stats))
+            }
+            None => {
+                self.film = before;
+                None
+            }
+        }
+    }
+
+    /// Renders passes until the image is complete, `stop` is set (the pass
+    /// in flight is abandoned), or the time budget `time_limit` would be
+    /// exceeded: the next pass is started only if, predicted from the
+    /// previous pass's time per sample, it ends within the budget, and a
+    /// pass still running when the budget is spent is abandoned. The first
+    /// pass of a render without samples is always finished, since an image
+    /// needs at least one sample.
+    ///
+    /// `on_pass` is called after every finished pass (to save the image and
+    /// a checkpoint); its error ends the run.
+    pub fn run<E>(
+        &mut self,
+        stop: &AtomicBool,
+        time_limit: Option<Duration>,
+        progress: &(dyn Fn(u64) + Sync),
+        on_pass: &mut dyn FnMut(&Session, &PassReport) -> Result<(), E>,
+    ) -> Result<RunSummary, E> {
+        let deadline = time_limit.map(|t| Instant::now() + t);
+        let mut summary = RunSummary {
+            reason: StopReason::Complete,
+            passes: 0,
+            stats: RenderStats::default(),
+        };
+        let mut last: Option<(u32, Duration)> = None;
+        while !self.is_complete() {
+            if stop.load(Ordering::SeqCst) {
+                summary.reason = StopReason::Interrupted;
+                return Ok(summary);
+            }
+            let next = pass_size(self.spp_done, self.spp_total());
+            if let (Some(deadline), Some((n, took))) = (deadline, last) {
+                let predicted = took.mul_f64(f64::from(next) / f64::from(n));
+                if Instant::now() + predicted > deadline {
+                    summary.reason = StopReason::TimeLimit;
+                    return Ok(summary);
+                }
+            }
+            let must_finish = self.spp_done == 0;
+            let should_stop = || {
+                stop.load(Ordering::Relaxed)
+                    || (!must_finish && deadline.is_some_and(|d| Instant::now() >= d))
+            };
+            let Some((samples, duration, stats)) = self.render_pass(progress, &should_stop) else {
+                summary.reason = if stop.load(Ordering::SeqCst) {
+                    StopReason::Interrupted
+                } else {
+                    StopReason::TimeLimit
+                };
+                return Ok(summary);
+            };
+            last = Some((samples.len() as u32, duration));
+            summary.passes += 1;
+            summary.stats.add(stats);
+            let report = PassReport {
+                number: summary.passes,
+                samples,
+                duration,
+                stats,
+            };
+            on_pass(self, &report)?;
+        }
+        Ok(summary)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::render;
+    use crate::scene::builtin;
+
+    #[test]
+    fn schedule_covers_every_sample_once_in_order() {
+        for spp in [1, 2, 3, 7, 8, 64, 100, 1000, 5000] {
+            let passes = schedule(spp);
+            assert_eq!(passes[0], 0..1);
+            assert_eq!(passes.last().unwrap().end, spp);
+            for w in passes.windows(2) {
+                assert_eq!(w[0].end, w[1].start);
+            }
+            let cap = (spp / 8).clamp(1, MAX_PASS_SPP) as usize;
+            assert!(passes.iter().all(|p| !p.is_empty() && p.len() <= cap));
+        }
+        assert_eq!(schedule(64).len(), 11);
+    }
+
+    #[test]
+    fn durations_parse_with_units() {
+        assert_eq!(parse_duration("90s"), Ok(Duration::from_secs(90)));
+        assert_eq!(parse_duration("1.5m"), Ok(Duration::from_secs(90)));
+        assert_eq!(parse_duration("2h"), Ok(Duration::from_secs(7200)));
+        assert_eq!(parse_duration("45"), Ok(Duration::from_secs(45)));
+        for bad in ["", "s", "0s", "-1m", "ten", "5d", "nan", "inf"] {
+            assert!(parse_duration(bad).is_err(), "{bad}");
+        }
+    }
+
+    fn small_desc() -> SceneDesc {
+        let mut desc = builtin::find("glass-hollow").unwrap().desc();
+        desc.render.width = 24;
+        desc.render.samples_per_pixel = 40;
+        desc
+    }
+
+    #[test]
+    fn passes_and_resume_equal_one_render_bit_for_bit() {
+        let desc = small_desc();
+        let (reference, ref_stats) = render(&Scene::from_desc(&desc).unwrap(), &|_| {});
+        let stop = AtomicBool::new(false);
+        // Stop after the third pass, save, resume from the saved bytes.
+        let mut first = Session::new(&desc).unwrap();
+        let run = first
+            .run(&stop, None, &|_| {}, &mut |_, r| {
+                if r.number == 3 {
+                    stop.store(true, Ordering::SeqCst);
+                }
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+        assert_eq!(run.reason, StopReason::Interrupted);
+        assert_eq!(first.spp_done(), 4);
+        let path = Path::new("mem");
+        let ckpt = Checkpoint::decode(&first.checkpoint().encode(), path).unwrap();
+        let mut second = Session::resume(&desc, ckpt, path).unwrap();
+        stop.store(false, Ordering::SeqCst);
+        let run = second
+            .run(&stop, None, &|_| {}, &mut |_, _| Ok::<(), ()>(()))
+            .unwrap();
+        assert_eq!(run.reason, StopReason::Complete);
+        assert_eq!(second.film(), &reference);
+        assert_eq!(second.stats(), ref_stats);
+    }
+
+    #[test]
+    fn an_abandoned_pass_leaves_the_film_as_it_was() {
+        let desc = small_desc();
+        let mut session = Session::new(&desc).unwrap();
+        session.render_pass(&|_| {}, &|| false).unwrap();
+        let before = session.film().clone();
+        let rows = std::sync::atomic::AtomicU32::new(0);
+        let stop_after_some_rows = || rows.fetch_add(1, Ordering::SeqCst) >= 3;
+        assert!(session
+            .render_pass(&|_| {}, &stop_after_some_rows)
+            .is_none());
+        assert_eq!(session.film(), &before);
+        assert_eq!(session.spp_done(), 1);
+    }
+}
