@@ -1,0 +1,145 @@
+//! Helpers for the tests that run the `lumen` binary and signal it.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc::{self, Receiver};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// The render every interrupt test uses: several passes, about a second.
+pub const RENDER: &[&str] = &["render", "cover", "--width", "160", "--spp", "64"];
+
+/// A fresh empty directory for one test.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lumen-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+pub fn lumen() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lumen"))
+}
+
+/// Runs lumen to the end; returns its status and stderr.
+pub fn run(args: &[&str], out: &Path, extra: &[&str]) -> (ExitStatus, String) {
+    let o = lumen()
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    (o.status, String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// The bytes of an uninterrupted render of `args` to a PFM file in `dir`.
+pub fn reference(dir: &Path, args: &[&str]) -> Vec<u8> {
+    let out = dir.join("reference.pfm");
+    let (status, err) = run(args, &out, &[]);
+    assert!(status.success(), "{err}");
+    std::fs::read(out).unwrap()
+}
+
+/// A running lumen whose stderr lines are collected as they come.
+pub struct Running {
+    pub child: Child,
+    lines: Receiver<String>,
+    pub stderr: Arc<Mutex<Vec<String>>>,
+}
+
+pub fn spawn(args: &[&str], out: &Path, extra: &[&str]) -> Running {
+    let mut child = lumen()
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let (tx, lines) = mpsc::channel();
+    let stderr = Arc::new(Mutex::new(Vec::new()));
+    let all = Arc::clone(&stderr);
+    let pipe = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+            all.lock().unwrap().push(line.clone());
+            let _ = tx.send(line);
+        }
+    });
+    Running {
+        child,
+        lines,
+        stderr,
+    }
+}
+
+impl Running {
+    /// Waits (up to a minute) for a stderr line starting with `prefix`.
+    pub fn wait_line(&self, prefix: &str) -> String {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if line.starts_with(prefix) => return line,
+                Ok(_) => {}
+                Err(e) => panic!(
+                    "no line starting with {prefix:?}: {e}; stderr so far: {:?}",
+                    self.stderr.lock().unwrap()
+                ),
+            }
+        }
+    }
+
+    pub fn signal(&self, signal: i32) {
+        // SAFETY: kill(2) on our own child's pid, which is not yet reaped.
+        let r = unsafe { libc::kill(self.child.id() as libc::pid_t, signal) };
+        assert_eq!(r, 0, "kill failed");
+    }
+
+    /// Waits for the exit; returns the status and the whole stderr.
+    pub fn finish(mut self) -> (ExitStatus, String) {
+        let status = self.child.wait().unwrap();
+        // Let the reader thread drain the pipe.
+        while self.lines.recv_timeout(Duration::from_secs(10)).is_ok() {}
+        let text = self.stderr.lock().unwrap().join("\n");
+        (status, text)
+    }
+}
+
+/// The `N` of "holds N of M spp" in lumen's report.
+pub fn held_spp(stderr: &str) -> u32 {
+    let at = stderr
+        .find(" holds ")
+        .unwrap_or_else(|| panic!("no 'holds' in: {stderr}"));
+    stderr[at + 7..]
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
+/// Checks that `bytes` is a complete PFM file of `w`×`h` pixels.
+pub fn assert_valid_pfm(bytes: &[u8], w: usize, h: usize) {
+    let header = format!("PF\n{w} {h}\n-1.0\n");
+    assert!(bytes.starts_with(header.as_bytes()), "bad PFM header");
+    assert_eq!(
+        bytes.len(),
+        header.len() + w * h * 12,
+        "PFM has the wrong length"
+    );
+}
+
+/// Names of files in `dir` left by an atomic write that never finished.
+pub fn temp_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
