@@ -173,3 +173,25 @@ fn sigkill_during_checkpoint_writes_leaves_a_usable_checkpoint() {
         resume_to_end(&out, &reference);
     }
 }
+
+#[test]
+fn an_interrupt_during_the_first_pass_writes_nothing() {
+    let dir = temp_dir("first-pass");
+    let out = dir.join("first.pfm");
+    // A first pass long enough (most of a second) to be interrupted in.
+    let r = spawn(
+        &["render", "cover", "--width", "1200", "--spp", "4"],
+        &out,
+        &[],
+    );
+    r.wait_line("cover:");
+    r.signal(libc::SIGINT);
+    let (status, err) = r.finish();
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("before the first pass finished; nothing written"),
+        "{err}"
+    );
+    assert!(!out.exists() && !default_path(&out).exists());
+    assert!(temp_files(&dir).is_empty());
+}
