@@ -2,12 +2,12 @@
 //! render, refuses unwritable outputs before rendering, and keeps to a time
 //! limit.
 
-mod common;
+mod lumen_process;
 
-use common::*;
 use lumen::checkpoint::{default_path, Checkpoint};
 use lumen::progressive::{Session, StopReason};
 use lumen::scene::{builtin, Overrides};
+use lumen_process::*;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 

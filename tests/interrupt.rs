@@ -3,9 +3,9 @@
 
 mod lumen_process;
 
-use lumen_process::*;
 use lumen::checkpoint::{default_path, Checkpoint};
 use lumen::output::encode_pfm;
+use lumen_process::*;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
