@@ -166,7 +166,7 @@ fn build(
 
 /// Cost of a leaf of `n` spheres, tested four at a time.
 fn leaf_cost(n: usize) -> f32 {
-    INTERSECT_COST * n as f32
+    INTERSECT_COST * n.div_ceil(MAX_LEAF) as f32
 }
 
 /// The SAH-best split `(axis, position)`, or `None` if a leaf is cheaper.
