@@ -186,6 +186,7 @@ impl Bvh {
                 let mut mask = t_near.cmple(t_far).bitmask() & node.used;
                 if mask != 0 {
                     // Push the hit children farthest first; go on with the nearest.
+                    let t_near = t_near.to_array();
                     let mut hits = [(0u32, 0.0f32); 4];
                     let mut n = 0;
                     while mask != 0 {
