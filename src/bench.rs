@@ -207,3 +207,78 @@ pub fn measure_field(n: usize, spp: u32, runs: usize) -> Result<ScalingPoint, Sc
         measurement,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    #[test]
+    fn sphere_fields_have_the_asked_count_at_constant_density() {
+        for n in [1, 100, 2_000] {
+            let desc = sphere_field(n);
+            let small: Vec<[f64; 3]> = desc
+                .objects
+                .iter()
+                .filter_map(|o| match o {
+                    ObjectDesc::Sphere { center, radius, .. } if *radius == 0.2 => Some(*center),
+                    _ => None,
+                })
+                .collect();
+            assert_eq!(small.len(), n);
+            // Spread over about n unit cells: the bounding square's area is
+            // n plus at most the border cells and those skipped under the big spheres.
+            let extent = |k: usize| {
+                let lo = small.iter().map(|c| c[k]).fold(f64::INFINITY, f64::min);
+                let hi = small.iter().map(|c| c[k]).fold(f64::NEG_INFINITY, f64::max);
+                hi - lo
+            };
+            let area = extent(0) * extent(2);
+            assert!(
+                area <= n as f64 + 6.0 * (n as f64).sqrt() + 40.0,
+                "n = {n}: area {area}"
+            );
+            Scene::from_desc(&desc).expect("field compiles");
+        }
+        let big = sphere_field(10_000);
+        let xs = big.objects.iter().filter_map(|o| match o {
+            ObjectDesc::Sphere { center, .. } => Some(center[0]),
+        });
+        let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
+        assert!(
+            (95.0..110.0).contains(&width),
+            "10⁴ spheres span {width} units"
+        );
+    }
+
+    #[test]
+    fn empty_and_one_sphere_scenes_render() {
+        let mut desc = builtin::cover_with_grid(0);
+        desc.render.width = 16;
+        desc.render.samples_per_pixel = 2;
+        desc.objects.clear();
+        let scene = Scene::from_desc(&desc).expect("empty scene compiles");
+        let (film, stats) = render(&scene, &|_| {});
+        // Every camera ray escapes: one segment each, and the sky's colour.
+        assert_eq!(stats.rays, stats.samples);
+        let ray = scene.camera.ray(8, 4, 0.0, 0.0, &mut Rng::new(1));
+        let sky = scene.background.color(ray.direction);
+        assert!((film.pixel(8, 4) - sky).abs().max_element() < 0.02);
+
+        desc.objects.push(ObjectDesc::Sphere {
+            center: [0.0, 0.0, 0.0],
+            radius: 2.0,
+            material: "big-diffuse".to_string(),
+        });
+        let scene = Scene::from_desc(&desc).expect("one-sphere scene compiles");
+        let (film, stats) = render(&scene, &|_| {});
+        assert!(
+            stats.rays > stats.samples,
+            "camera rays hit the sphere and bounce"
+        );
+        // The sphere fills the centre of the view and is darker than the sky.
+        let (w, h) = (film.width(), film.height());
+        let centre = film.pixel(w / 2, h / 2);
+        assert!(centre.length() < sky.length() && centre != Vec3::ZERO);
+    }
+}
