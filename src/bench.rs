@@ -242,7 +242,8 @@ mod tests {
         }
         let big = sphere_field(10_000);
         let xs = big.objects.iter().filter_map(|o| match o {
-            ObjectDesc::Sphere { center, .. } => Some(center[0]),
+            ObjectDesc::Sphere { center, radius, .. } if *radius == 0.2 => Some(center[0]),
+            _ => None,
         });
         let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
         assert!(

@@ -259,18 +259,19 @@ fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     println!(
-        "{:>9} {:>9} {:>9} {:>10} {:>10} {:>12}",
-        "spheres", "build s", "BVH MB", "median s", "M rays/s", "M samples/s"
+        "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
+        "spheres", "build s", "BVH MB", "rays", "median s", "M rays/s", "M samples/s"
     );
     for &n in fields {
         let p = bench::measure_field(n, spp, runs as usize)
             .map_err(|e| anyhow!("field of {n} spheres: {e}"))?;
         let m = &p.measurement;
         println!(
-            "{:>9} {:>9.3} {:>9.1} {:>10.3} {:>10.2} {:>12.2}",
+            "{:>9} {:>9.3} {:>9.1} {:>10} {:>10.3} {:>10.2} {:>12.2}",
             p.spheres,
             p.build.as_secs_f64(),
             p.bvh_bytes as f64 / 1e6,
+            m.stats.rays,
             m.median.as_secs_f64(),
             m.rays_per_second() / 1e6,
             m.samples_per_second() / 1e6
