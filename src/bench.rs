@@ -1,8 +1,9 @@
 //! Throughput benchmarks on fixed workloads: `lumen bench`.
 
 use crate::render::{render, RenderStats};
+use crate::rng::Rng;
 use crate::scene::builtin;
-use crate::scene::desc::SceneDesc;
+use crate::scene::desc::{AttenuationDesc, BounceDesc, MaterialDesc, ObjectDesc, SceneDesc};
 use crate::scene::{Scene, SceneError};
 use std::time::{Duration, Instant};
 
@@ -69,21 +70,216 @@ pub fn standard_workloads(spp: u32) -> Vec<Workload> {
 /// Renders `workload` `runs` times (after one warm-up) and takes the median time.
 pub fn measure(workload: &Workload, runs: usize) -> Result<Measurement, SceneError> {
     let scene = Scene::from_desc(&workload.desc)?;
-    let _ = render(&scene, &|_| {});
+    Ok(measure_scene(workload.name, &scene, runs))
+}
+
+/// Renders `scene` `runs` times (after one warm-up) and takes the median time.
+pub fn measure_scene(name: &'static str, scene: &Scene, runs: usize) -> Measurement {
+    let _ = render(scene, &|_| {});
     let mut times = Vec::with_capacity(runs);
     let mut stats = RenderStats::default();
     for _ in 0..runs.max(1) {
         let start = Instant::now();
-        let (_, s) = render(&scene, &|_| {});
+        let (_, s) = render(scene, &|_| {});
         times.push(start.elapsed());
         stats = s;
     }
     let mut sorted = times.clone();
     sorted.sort();
-    Ok(Measurement {
-        name: workload.name,
+    Measurement {
+        name,
         stats,
         median: sorted[sorted.len() / 2],
         runs: times,
+    }
+}
+
+/// Seed of the sphere fields' layout.
+const FIELD_SEED: u64 = 0xF1E1D;
+
+/// A cover-like scene with about `n` small spheres (exactly `n` unless `n` is
+/// tiny), at the cover's density: the spheres fill a square of about √n × √n
+/// unit cells around the cover's three big spheres, so the area grows with `n`.
+/// Materials come from a palette of 16 (80% diffuse, 15% metal, 5% glass, as on
+/// the cover), so the scene's memory is the spheres', not the materials'.
+pub fn sphere_field(n: usize) -> SceneDesc {
+    let mut desc = builtin::cover_with_grid(0);
+    desc.caption = format!("cover-like field of {n} small spheres");
+    desc.render.width = 400;
+    let mut rng = Rng::new(FIELD_SEED);
+    let palette: Vec<(String, MaterialDesc)> = (0..16)
+        .map(|i| match i {
+            0..=11 => (
+                format!("field-diffuse{i}"),
+                MaterialDesc::Diffuse {
+                    albedo: [0; 3].map(|_| rng.next_f64() * rng.next_f64()),
+                    bounce: BounceDesc::Lambertian,
+                    attenuation: AttenuationDesc::Scale,
+                },
+            ),
+            12..=14 => (
+                format!("field-metal{i}"),
+                MaterialDesc::Metal {
+                    albedo: [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64()),
+                    fuzz: 0.5 * rng.next_f64(),
+                },
+            ),
+            _ => (
+                "glass".to_string(),
+                MaterialDesc::Dielectric {
+                    ior: 1.5,
+                    refract_only: false,
+                },
+            ),
+        })
+        .collect();
+    for (name, m) in &palette {
+        desc.materials.insert(name.clone(), m.clone());
+    }
+    // Cells of a side×side grid, skipping those under the big spheres.
+    let side = ((n as f64).sqrt().ceil() as i64).max(1) + 2;
+    let half = side / 2;
+    let big = [[0.0, 0.2, 0.0], [-4.0, 0.2, 0.0], [4.0, 0.2, 0.0]];
+    let mut placed = 0;
+    'grid: for a in -half..side - half {
+        for c in -half..side - half {
+            if placed == n {
+                break 'grid;
+            }
+            let center = [
+                a as f64 + 0.9 * rng.next_f64(),
+                0.2,
+                c as f64 + 0.9 * rng.next_f64(),
+            ];
+            let pick = rng.next_f64();
+            if big.iter().any(|b| {
+                let d = [center[0] - b[0], center[2] - b[2]];
+                (d[0] * d[0] + d[1] * d[1]).sqrt() <= 1.2
+            }) {
+                continue;
+            }
+            let k = if pick < 0.8 {
+                (pick / 0.8 * 12.0) as usize
+            } else if pick < 0.95 {
+                12 + ((pick - 0.8) / 0.15 * 3.0) as usize
+            } else {
+                15
+            };
+            desc.objects.push(ObjectDesc::Sphere {
+                center,
+                radius: 0.2,
+                material: palette[k.min(15)].0.clone(),
+            });
+            placed += 1;
+        }
+    }
+    desc
+}
+
+/// One row of the scaling table.
+#[derive(Clone, Debug)]
+pub struct ScalingPoint {
+    /// Spheres in the scene (the field plus ground and three big ones).
+    pub spheres: usize,
+    /// Time to compile the scene (mostly the BVH build).
+    pub build: Duration,
+    /// Bytes held by the BVH.
+    pub bvh_bytes: usize,
+    /// The render measurement.
+    pub measurement: Measurement,
+}
+
+/// Builds and renders the field of about `n` spheres (400×225, `spp`, depth 50).
+pub fn measure_field(n: usize, spp: u32, runs: usize) -> Result<ScalingPoint, SceneError> {
+    let mut desc = sphere_field(n);
+    desc.render.samples_per_pixel = spp;
+    desc.render.max_depth = 50;
+    let spheres = desc.objects.len();
+    let start = Instant::now();
+    let scene = Scene::from_desc(&desc)?;
+    let build = start.elapsed();
+    drop(desc);
+    let measurement = measure_scene("field", &scene, runs);
+    Ok(ScalingPoint {
+        spheres,
+        build,
+        bvh_bytes: scene.bvh_memory_bytes(),
+        measurement,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    #[test]
+    fn sphere_fields_have_the_asked_count_at_constant_density() {
+        for n in [1, 100, 2_000] {
+            let desc = sphere_field(n);
+            let small: Vec<[f64; 3]> = desc
+                .objects
+                .iter()
+                .filter_map(|o| match o {
+                    ObjectDesc::Sphere { center, radius, .. } if *radius == 0.2 => Some(*center),
+                    _ => None,
+                })
+                .collect();
+            assert_eq!(small.len(), n);
+            // Spread over about n unit cells: the bounding square's area is
+            // n plus at most the border cells and those skipped under the big spheres.
+            let extent = |k: usize| {
+                let lo = small.iter().map(|c| c[k]).fold(f64::INFINITY, f64::min);
+                let hi = small.iter().map(|c| c[k]).fold(f64::NEG_INFINITY, f64::max);
+                hi - lo
+            };
+            let area = extent(0) * extent(2);
+            assert!(
+                area <= n as f64 + 6.0 * (n as f64).sqrt() + 40.0,
+                "n = {n}: area {area}"
+            );
+            Scene::from_desc(&desc).expect("field compiles");
+        }
+        let big = sphere_field(10_000);
+        let xs = big.objects.iter().filter_map(|o| match o {
+            ObjectDesc::Sphere { center, radius, .. } if *radius == 0.2 => Some(center[0]),
+            _ => None,
+        });
+        let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
+        assert!(
+            (95.0..110.0).contains(&width),
+            "10⁴ spheres span {width} units"
+        );
+    }
+
+    #[test]
+    fn empty_and_one_sphere_scenes_render() {
+        let mut desc = builtin::cover_with_grid(0);
+        desc.render.width = 16;
+        desc.render.samples_per_pixel = 2;
+        desc.objects.clear();
+        let scene = Scene::from_desc(&desc).expect("empty scene compiles");
+        let (film, stats) = render(&scene, &|_| {});
+        // Every camera ray escapes: one segment each, and the sky's colour.
+        assert_eq!(stats.rays, stats.samples);
+        let ray = scene.camera.ray(8, 4, 0.0, 0.0, &mut Rng::new(1));
+        let sky = scene.background.color(ray.direction);
+        assert!((film.pixel(8, 4) - sky).abs().max_element() < 0.02);
+
+        desc.objects.push(ObjectDesc::Sphere {
+            center: [0.0, 0.0, 0.0],
+            radius: 2.0,
+            material: "big-diffuse".to_string(),
+        });
+        let scene = Scene::from_desc(&desc).expect("one-sphere scene compiles");
+        let (film, stats) = render(&scene, &|_| {});
+        assert!(
+            stats.rays > stats.samples,
+            "camera rays hit the sphere and bounce"
+        );
+        // The sphere fills the centre of the view and is darker than the sky.
+        let (w, h) = (film.width(), film.height());
+        let centre = film.pixel(w / 2, h / 2);
+        assert!(centre.length() < sky.length() && centre != Vec3::ZERO);
+    }
 }

@@ -58,6 +58,14 @@ enum Command {
         /// Worker threads (default: one per core).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         threads: Option<u32>,
+        /// Instead of the standard workloads, render cover-like fields of
+        /// 10², 10³, 10⁴, 10⁵ and 10⁶ small spheres (how cost grows with the scene).
+        #[arg(long, conflicts_with = "field")]
+        scaling: bool,
+        /// Render only the cover-like field of about N small spheres (to measure
+        /// one size's peak memory with /usr/bin/time -v).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+        field: Option<u64>,
     },
 }
 
@@ -147,8 +155,21 @@ fn run(cli: Cli) -> Result<ExitCode> {
             with_threads(settings.threads, || gallery_command(&dir, &settings))?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Bench { spp, runs, threads } => {
-            with_threads(threads, || bench_command(spp, runs))?;
+        Command::Bench {
+            spp,
+            runs,
+            threads,
+            scaling,
+            field,
+        } => {
+            with_threads(threads, || {
+                let fields: Vec<usize> = match (scaling, field) {
+                    (true, _) => vec![100, 1_000, 10_000, 100_000, 1_000_000],
+                    (false, Some(n)) => vec![n as usize],
+                    (false, None) => return bench_command(spp, runs),
+                };
+                scaling_command(&fields, spp, runs)
+            })?;
             Ok(ExitCode::SUCCESS)
         }
     }
@@ -455,6 +476,34 @@ fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
         dir.join("index.html").display()
     );
     eprintln!("{}", summary(&total, &total, start.elapsed()));
+    Ok(())
+}
+
+fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
+    println!(
+        "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores, {spp} spp, depth 50, median of {runs} runs",
+        rayon::current_num_threads(),
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
+    println!(
+        "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
+        "spheres", "build s", "BVH MB", "rays", "median s", "M rays/s", "M samples/s"
+    );
+    for &n in fields {
+        let p = bench::measure_field(n, spp, runs as usize)
+            .map_err(|e| anyhow!("field of {n} spheres: {e}"))?;
+        let m = &p.measurement;
+        println!(
+            "{:>9} {:>9.3} {:>9.1} {:>10} {:>10.3} {:>10.2} {:>12.2}",
+            p.spheres,
+            p.build.as_secs_f64(),
+            p.bvh_bytes as f64 / 1e6,
+            m.stats.rays,
+            m.median.as_secs_f64(),
+            m.rays_per_second() / 1e6,
+            m.samples_per_second() / 1e6
+        );
+    }
     Ok(())
 }
 

@@ -2,6 +2,7 @@
 //! structure that finds the nearest one.
 
 pub mod bvh;
+pub mod bvh_build;
 pub mod hit;
 pub mod sphere;
 

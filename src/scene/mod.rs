@@ -264,6 +264,11 @@ impl Scene {
     pub fn bvh_nodes(&self) -> usize {
         self.bvh.node_count()
     }
+
+    /// Bytes of memory held by the acceleration structure.
+    pub fn bvh_memory_bytes(&self) -> usize {
+        self.bvh.memory_bytes()
+    }
 }
 
 fn unknown_material_message(name: &str, desc: &SceneDesc) -> String {
