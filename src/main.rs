@@ -9,7 +9,8 @@ use lumen::output;
 use lumen::progressive::{parse_duration, Session, SessionError, StopReason};
 use lumen::render::RenderStats;
 use lumen::scene::builtin::{self, BUILTINS};
-use lumen::scene::{Overrides, SceneDesc};
+use lumen::scene::file::{self, Format, SceneFile};
+use lumen::scene::{hint, Overrides, Scene, SceneDesc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -26,9 +27,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a built-in scene to an image file (.ppm, .png, .pfm or .exr).
+    /// Render a built-in scene or a scene file to an image file (.ppm, .png, .pfm or .exr).
     Render {
-        /// Name of a built-in scene (see `lumen scenes`).
+        /// Name of a built-in scene (see `lumen scenes`) or a scene file
+        /// (.toml or .json, see docs/scene-format.md). Command-line settings
+        /// override the scene's own.
         scene: String,
         /// Output image; the extension chooses the format.
         #[arg(short, long)]
@@ -38,8 +41,11 @@ enum Command {
         #[command(flatten)]
         progressive: ProgressiveArgs,
     },
-    /// List the built-in scenes with their captions.
-    Scenes,
+    /// List the built-in scenes with their captions, or export one as a file.
+    Scenes {
+        #[command(subcommand)]
+        action: Option<ScenesCommand>,
+    },
     /// Render every built-in scene into DIR, with an index.html.
     Gallery {
         /// Folder for the images and index.html (created if missing).
@@ -67,6 +73,27 @@ enum Command {
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
         field: Option<u64>,
     },
+}
+
+#[derive(Subcommand)]
+enum ScenesCommand {
+    /// Write a built-in scene (or convert a scene file) as a scene file.
+    Export {
+        /// Name of a built-in scene, or a scene file to convert.
+        name: String,
+        /// Output file (default: standard output); .toml or .json chooses the format.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Format when writing to standard output.
+        #[arg(long, value_enum, default_value_t = FormatArg::Toml)]
+        format: FormatArg,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FormatArg {
+    Toml,
+    Json,
 }
 
 #[derive(Args, Clone, Default)]
@@ -144,13 +171,21 @@ fn run(cli: Cli) -> Result<ExitCode> {
         } => with_threads(settings.threads, || {
             render_command(&scene, &output, &settings, &progressive)
         }),
-        Command::Scenes => {
+        Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {
                 println!("{:width$}  {}", b.name, b.caption);
             }
             Ok(ExitCode::SUCCESS)
         }
+        Command::Scenes {
+            action:
+                Some(ScenesCommand::Export {
+                    name,
+                    output,
+                    format,
+                }),
+        } => export_command(&name, output.as_deref(), format),
         Command::Gallery { dir, settings } => {
             with_threads(settings.threads, || gallery_command(&dir, &settings))?;
             Ok(ExitCode::SUCCESS)
@@ -190,33 +225,84 @@ where
     }
 }
 
-fn load_scene(name: &str) -> Result<SceneDesc> {
-    if let Some(b) = builtin::find(name) {
-        return Ok(b.desc());
-    }
-    let closest = BUILTINS
-        .iter()
-        .map(|b| (strsim_distance(name, b.name), b.name))
-        .min()
-        .filter(|(d, _)| *d <= 3)
-        .map(|(_, n)| format!(" (did you mean '{n}'?)"))
-        .unwrap_or_default();
-    bail!("unknown scene '{name}'{closest}; `lumen scenes` lists the built-in scenes")
+/// Where a scene comes from: a built-in name or a file.
+enum SceneSource {
+    Builtin(SceneDesc),
+    File(SceneFile),
 }
 
-/// Levenshtein distance, for "did you mean" hints.
-fn strsim_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1];
-        for (j, cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != *cb);
-            cur.push(sub.min(prev[j + 1] + 1).min(cur[j] + 1));
+impl SceneSource {
+    fn desc(&self) -> &SceneDesc {
+        match self {
+            SceneSource::Builtin(d) => d,
+            SceneSource::File(f) => &f.desc,
         }
-        prev = cur;
     }
-    prev[b.len()]
+
+    /// The description with the command-line overrides, validated, so that
+    /// a mistake in a file is reported with its line and column before any
+    /// work starts.
+    fn resolve(&self, name: &str, overrides: &Overrides) -> Result<SceneDesc> {
+        let mut desc = self.desc().clone();
+        overrides.apply(&mut desc);
+        match self {
+            SceneSource::Builtin(_) => {
+                Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
+            }
+            SceneSource::File(f) => {
+                f.compile(overrides)?;
+            }
+        }
+        Ok(desc)
+    }
+}
+
+/// A built-in scene by name, or else a scene file by path.
+fn load_scene(name: &str) -> Result<SceneSource> {
+    if let Some(b) = builtin::find(name) {
+        return Ok(SceneSource::Builtin(b.desc()));
+    }
+    let path = Path::new(name);
+    let looks_like_file = Format::from_extension(path).is_some()
+        || name.contains(std::path::MAIN_SEPARATOR)
+        || name.contains('/')
+        || path.exists();
+    if looks_like_file {
+        return Ok(SceneSource::File(SceneFile::read(path)?));
+    }
+    let closest = hint::closest(name, BUILTINS.iter().map(|b| b.name))
+        .map(|n| format!(" (did you mean '{n}'?)"))
+        .unwrap_or_default();
+    bail!(
+        "unknown scene '{name}'{closest}; `lumen scenes` lists the built-in scenes, \
+         and scene files end in .toml or .json"
+    )
+}
+
+fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<()> {
+    let source = load_scene(name)?;
+    let format = match out {
+        Some(path) => Format::from_extension(path).ok_or_else(|| {
+            anyhow!(
+                "{}: scene files must end in .toml or .json",
+                path.display()
+            )
+        })?,
+        None => match format {
+            FormatArg::Toml => Format::Toml,
+            FormatArg::Json => Format::Json,
+        },
+    };
+    let text = file::export(source.desc(), format)?;
+    match out {
+        Some(path) => {
+            output::check_writable(path)?;
+            output::write_bytes_atomic(path, text.as_bytes())?;
+            eprintln!("{name}: written to {}", path.display());
+        }
+        None => print!("{text}"),
+    }
+    Ok(())
 }
 
 fn render_command(
@@ -225,8 +311,7 @@ fn render_command(
     args: &SettingArgs,
     prog: &ProgressiveArgs,
 ) -> Result<ExitCode> {
-    let mut desc = load_scene(name)?;
-    args.overrides().apply(&mut desc);
+    let desc = load_scene(name)?.resolve(name, &args.overrides())?;
     output::ImageFormat::from_path(out)?;
     let ckpt_path = prog
         .checkpoint

@@ -2,7 +2,11 @@
 //! the compiled form the renderer traces.
 
 pub mod builtin;
+mod decode;
 pub mod desc;
+pub mod file;
+pub mod hint;
+pub mod source;
 
 pub use desc::SceneDesc;
 
@@ -35,6 +39,58 @@ pub enum SceneError {
         /// What is wrong.
         message: String,
     },
+    /// An object refers to a material that no entry of `materials` defines.
+    #[error("{field}: {}", unknown_material_message(name, known))]
+    UnknownMaterial {
+        /// Path of the reference, e.g. `objects[3].material`.
+        field: String,
+        /// The name used.
+        name: String,
+        /// The names the scene defines.
+        known: Vec<String>,
+    },
+}
+
+impl SceneError {
+    /// Path of the field at fault, e.g. `objects[3].radius` or `camera.vfov`
+    /// (`render` when the image size as a whole is wrong).
+    pub fn field(&self) -> String {
+        match self {
+            SceneError::Camera(c) => match c {
+                CameraError::FieldOfView(_) => "camera.vfov".into(),
+                CameraError::NoViewDirection(_) => "camera.lookat".into(),
+                CameraError::UpParallelToView(_) => "camera.vup".into(),
+                CameraError::FocusDistance(_) => "camera.focus_dist".into(),
+                CameraError::DefocusAngle(_) => "camera.defocus_angle".into(),
+                CameraError::EmptyImage(..) => "render".into(),
+                CameraError::NotFinite(name) => format!("camera.{name}"),
+            },
+            SceneError::Invalid { field, .. } | SceneError::UnknownMaterial { field, .. } => {
+                field.clone()
+            }
+        }
+    }
+
+    /// What is wrong, without the field path.
+    pub fn message(&self) -> String {
+        match self {
+            SceneError::Camera(c) => c.to_string(),
+            SceneError::Invalid { message, .. } => message.clone(),
+            SceneError::UnknownMaterial { name, known, .. } => unknown_material_message(name, known),
+        }
+    }
+
+    /// A suggestion, where one helps: the closest defined material name to a
+    /// misspelt one.
+    pub fn hint(&self) -> Option<String> {
+        match self {
+            SceneError::UnknownMaterial { name, known, .. } => {
+                hint::closest(name, known.iter().map(String::as_str))
+                    .map(|c| format!("did you mean \"{c}\"?"))
+            }
+            _ => None,
+        }
+    }
 }
 
 fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
@@ -121,16 +177,16 @@ fn vec3(t: [f64; 3]) -> Vec3 {
 
 /// Accepts numbers that stay finite once converted to the renderer's `f32`.
 fn finite(field: &str, values: &[f64]) -> Result<(), SceneError> {
-    if values.iter().all(|v| v.abs() <= f64::from(f32::MAX)) {
-        Ok(())
-    } else {
-        Err(invalid(
+    // `!(a <= b)` also catches NaN.
+    match values.iter().find(|v| !(v.abs() <= f64::from(f32::MAX))) {
+        None => Ok(()),
+        Some(v) => Err(invalid(
             field,
             format!(
-                "must be a finite number of magnitude at most {:e}",
+                "must be a finite number of magnitude at most {:e}, got {v}",
                 f32::MAX
             ),
-        ))
+        )),
     }
 }
 
@@ -220,10 +276,11 @@ impl Scene {
                         ));
                     }
                     let Some(&m) = material_index.get(material.as_str()) else {
-                        return Err(invalid(
-                            format!("objects[{i}].material"),
-                            unknown_material_message(material, desc),
-                        ));
+                        return Err(SceneError::UnknownMaterial {
+                            field: format!("objects[{i}].material"),
+                            name: material.clone(),
+                            known: desc.materials.keys().cloned().collect(),
+                        });
                     };
                     spheres.push(Sphere::new(vec3(*center), *radius as f32));
                     sphere_materials.push(m);
@@ -271,8 +328,7 @@ impl Scene {
     }
 }
 
-fn unknown_material_message(name: &str, desc: &SceneDesc) -> String {
-    let known: Vec<&str> = desc.materials.keys().map(String::as_str).collect();
+fn unknown_material_message(name: &str, known: &[String]) -> String {
     if known.is_empty() {
         format!("no material named \"{name}\": the scene defines no materials")
     } else {

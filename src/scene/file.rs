@@ -1,0 +1,325 @@
+//! Scene files: reading TOML or JSON into a [`SceneDesc`], compiling it with
+//! command-line overrides, writing a description back out, and turning every
+//! mistake into one message with file, line, column, field path and a hint.
+//!
+//! ```
+//! use lumen::scene::file::{Format, SceneFile};
+//! use lumen::scene::Overrides;
+//!
+//! let text = "[render]\nwidth = 16\nsamples_per_pixel = 1\n\n\
+//!             [materials.red]\ntype = \"diffuse\"\nalbedo = [0.8, 0.1, 0.1]\n\n\
+//!             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, -1]\nradius = 0.5\nmaterial = \"red\"\n";
+//! let file = SceneFile::parse("demo.toml", text.to_string(), Format::Toml).unwrap();
+//! let scene = file.compile(&Overrides::default()).unwrap();
+//! assert_eq!((scene.settings.width, scene.settings.height), (16, 9));
+//!
+//! let bad = text.replace("radius = 0.5", "radus = 0.5");
+//! let err = SceneFile::parse("demo.toml", bad, Format::Toml).unwrap_err();
+//! assert!(err.to_string().contains("demo.toml:13:1: objects[0].radus: unknown field"));
+//! assert!(err.to_string().contains("did you mean `radius`?"));
+//! ```
+
+use super::decode;
+use super::source::{self, Node, Value};
+use super::{Overrides, Scene, SceneDesc, SceneError};
+use std::fmt;
+use std::ops::Range;
+use std::path::Path;
+use thiserror::Error;
+
+/// The two scene file formats, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// TOML (`.toml`): the format for people to write.
+    Toml,
+    /// JSON (`.json`): the same schema, for generated scenes.
+    Json,
+}
+
+impl Format {
+    /// The format a file name's extension asks for, if it is `.toml` or `.json`.
+    pub fn from_extension(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "toml" => Some(Format::Toml),
+            "json" => Some(Format::Json),
+            _ => None,
+        }
+    }
+}
+
+/// A scene file that cannot be read or rendered: everything a person needs to
+/// find and fix the mistake.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub struct SceneFileError {
+    /// The file, as given.
+    pub file: String,
+    /// 1-based line and column, where known.
+    pub line_col: Option<(usize, usize)>,
+    /// Path of the field at fault, e.g. `objects[3].material`, where there is one.
+    pub field: Option<String>,
+    /// What is wrong: expected versus got.
+    pub message: String,
+    /// A suggestion, where one helps.
+    pub hint: Option<String>,
+    /// The offending line with the place underlined, where known.
+    pub excerpt: Option<String>,
+}
+
+impl fmt::Display for SceneFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some((line, col)) = self.line_col {
+            write!(f, ":{line}:{col}")?;
+        }
+        write!(f, ": ")?;
+        if let Some(field) = self.field.as_deref().filter(|p| !p.is_empty()) {
+            write!(f, "{field}: ")?;
+        }
+        write!(f, "{}", self.message)?;
+        if let Some(excerpt) = &self.excerpt {
+            write!(f, "\n{excerpt}")?;
+        }
+        if let Some(hint) = &self.hint {
+            write!(f, "\n  = hint: {hint}")?;
+        }
+        Ok(())
+    }
+}
+
+impl SceneFileError {
+    fn plain(file: &str, message: impl Into<String>) -> Self {
+        SceneFileError {
+            file: file.to_string(),
+            line_col: None,
+            field: None,
+            message: message.into(),
+            hint: None,
+            excerpt: None,
+        }
+    }
+}
+
+/// A scene description could not be written out.
+#[derive(Debug, Error)]
+#[error("cannot write the scene as {format:?}: {message}")]
+pub struct ExportError {
+    /// The format asked for.
+    pub format: Format,
+    /// Why.
+    pub message: String,
+}
+
+/// The first line of every exported TOML file.
+const TOML_HEADER: &str = "# A lumen scene. Every field is described in docs/scene-format.md.\n\n";
+
+/// Writes `desc` as a scene file of the given format. Reading the text back
+/// gives `desc` again, and writing that gives the same text.
+pub fn export(desc: &SceneDesc, format: Format) -> Result<String, ExportError> {
+    let failed = |message: String| ExportError { format, message };
+    match format {
+        Format::Toml => toml::to_string(desc)
+            .map(|body| format!("{TOML_HEADER}{body}"))
+            .map_err(|e| failed(e.to_string())),
+        Format::Json => serde_json::to_string_pretty(desc)
+            .map(|body| body + "\n")
+            .map_err(|e| failed(e.to_string())),
+    }
+}
+
+/// A parsed scene file, kept with its text so that errors found later (when
+/// compiling, after overrides) can still point into it.
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    /// The file name used in messages.
+    pub name: String,
+    /// The file's format.
+    pub format: Format,
+    /// The scene it describes, with defaults filled in.
+    pub desc: SceneDesc,
+    source: String,
+    root: Node,
+}
+
+impl SceneFile {
+    /// Reads and parses the file at `path`; the extension (`.toml`, `.json`)
+    /// gives the format.
+    pub fn read(path: &Path) -> Result<SceneFile, SceneFileError> {
+        let name = path.display().to_string();
+        let fail = |message: String| SceneFileError::plain(&name, message);
+        let meta = std::fs::metadata(path).map_err(|e| {
+            fail(match e.kind() {
+                std::io::ErrorKind::NotFound => "no such scene file".to_string(),
+                _ => format!("cannot read the scene file: {e}"),
+            })
+        })?;
+        if meta.is_dir() {
+            return Err(fail(
+                "is a directory; expected a scene file (.toml or .json)".into(),
+            ));
+        }
+        let format = Format::from_extension(path).ok_or_else(|| {
+            fail("unknown scene file type: the name must end in .toml or .json".into())
+        })?;
+        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let offset = e.utf8_error().valid_up_to();
+            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+            let mut err = fail("the file is not UTF-8 text".into());
+            err.line_col = Some(source::line_col(&text, offset));
+            err
+        })?;
+        SceneFile::parse(name, text, format)
+    }
+
+    /// Parses `text` in `format`; `name` is used in messages.
+    pub fn parse(
+        name: impl Into<String>,
+        text: String,
+        format: Format,
+    ) -> Result<SceneFile, SceneFileError> {
+        let name = name.into();
+        let parsed = match format {
+            Format::Toml => source::parse_toml(&text),
+            Format::Json => source::parse_json(&text),
+        };
+        let root = parsed.map_err(|e| {
+            // toml_edit splits its message over lines; keep the message on one.
+            let message = e.message.lines().collect::<Vec<_>>().join("; ");
+            let mut err = SceneFileError::plain(&name, format!("syntax error: {message}"));
+            err.line_col = e.line_col;
+            err.excerpt = e
+                .line_col
+                .map(|lc| excerpt(&text, lc, e.offset.map(|o| o..o + 1)));
+            err
+        })?;
+        let desc = decode::scene(&root).map_err(|e| {
+            let lc = source::line_col(&text, e.span.start);
+            SceneFileError {
+                file: name.clone(),
+                line_col: Some(lc),
+                field: Some(e.path),
+                message: e.message,
+                hint: e.hint,
+                excerpt: Some(excerpt(&text, lc, Some(e.span))),
+            }
+        })?;
+        Ok(SceneFile {
+            name,
+            format,
+            desc,
+            source: text,
+            root,
+        })
+    }
+
+    /// Applies `overrides` and validates and compiles the scene. An error is
+    /// located in the file unless the faulty value came from the overrides.
+    pub fn compile(&self, overrides: &Overrides) -> Result<Scene, SceneFileError> {
+        let mut desc = self.desc.clone();
+        overrides.apply(&mut desc);
+        Scene::from_desc(&desc).map_err(|e| self.locate(&e, overrides))
+    }
+
+    /// `error`, found when compiling this file's scene, with the file's name,
+    /// the line and column of the field at fault, and a hint where one helps.
+    pub fn locate(&self, error: &SceneError, overrides: &Overrides) -> SceneFileError {
+        let field = error.field();
+        let mut err = SceneFileError::plain(&self.name, error.message());
+        err.hint = error.hint();
+        if overridden(overrides).contains(&field.as_str()) {
+            err.message
+                .push_str(" (with the settings given on the command line)");
+        } else if let Some(span) = find(&self.root, &field) {
+            let lc = source::line_col(&self.source, span.start);
+            err.line_col = Some(lc);
+            err.excerpt = Some(excerpt(&self.source, lc, Some(span)));
+        }
+        err.field = Some(field);
+        err
+    }
+}
+
+/// The fields whose values `overrides` replaces.
+fn overridden(o: &Overrides) -> Vec<&'static str> {
+    let mut fields = Vec::new();
+    if o.width.is_some() {
+        fields.extend(["render", "render.width", "render.height"]);
+    }
+    if o.samples_per_pixel.is_some() {
+        fields.push("render.samples_per_pixel");
+    }
+    if o.max_depth.is_some() {
+        fields.push("render.max_depth");
+    }
+    fields
+}
+
+/// The span of the value at `path` (`objects[3].radius`), or of its nearest
+/// ancestor written in the file when the value itself was left to its default.
+fn find(root: &Node, path: &str) -> Option<Range<usize>> {
+    let mut node = root;
+    let mut rest = path;
+    loop {
+        rest = rest.strip_prefix('.').unwrap_or(rest);
+        if rest.is_empty() {
+            return Some(node.span.clone());
+        }
+        let next = match &node.value {
+            Value::Table(entries) => entries
+                .iter()
+                .filter(|e| {
+                    rest.strip_prefix(e.key.as_str())
+                        .is_some_and(|after| after.is_empty() || after.starts_with(['.', '[']))
+                })
+                // Material names may contain dots: prefer the longest match.
+                .max_by_key(|e| e.key.len())
+                .map(|e| (&e.node, e.key.len())),
+            Value::Array(items) => rest
+                .strip_prefix('[')
+                .and_then(|r| r.split_once(']'))
+                .and_then(|(index, _)| {
+                    let i: usize = index.parse().ok()?;
+                    Some((items.get(i)?, index.len() + 2))
+                }),
+            _ => None,
+        };
+        match next {
+            Some((child, consumed)) => {
+                node = child;
+                rest = &rest[consumed..];
+            }
+            // The TOML root has no position of its own.
+            None => return (!std::ptr::eq(node, root)).then(|| node.span.clone()),
+        }
+    }
+}
+
+/// The line `line_col` points into, with `span` (or one character) underlined:
+///
+/// ```text
+///    12 | radius = -1
+///       |          ^^
+/// ```
+fn excerpt(text: &str, (line, col): (usize, usize), span: Option<Range<usize>>) -> String {
+    let line_text = text.lines().nth(line - 1).unwrap_or("");
+    let chars: Vec<char> = line_text.chars().collect();
+    let start = (col - 1).min(chars.len());
+    let width = span
+        .and_then(|s| text.get(s))
+        .map_or(1, |s| s.lines().next().unwrap_or("").chars().count())
+        .clamp(1, (chars.len() - start).max(1));
+    // Keep long lines (one-line JSON) readable: show a window around the place.
+    let from = start.saturating_sub(40);
+    let to = (start + width + 40).min(chars.len());
+    let shown: String = chars[from..to].iter().collect();
+    let lead = if from > 0 { "…" } else { "" };
+    let tail = if to < chars.len() { "…" } else { "" };
+    let number = line.to_string();
+    let pad = " ".repeat(number.len());
+    let offset = " ".repeat(start - from + lead.chars().count());
+    format!(
+        " {pad} |\n {number} | {lead}{shown}{tail}\n {pad} | {offset}{}",
+        "^".repeat(width.min(to - start).max(1))
+    )
+}
