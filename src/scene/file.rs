@@ -302,9 +302,9 @@ fn find(root: &Node, path: &str) -> Option<Range<usize>> {
 ///       |          ^^
 /// ```
 fn excerpt(text: &str, (line, col): (usize, usize), span: Option<Range<usize>>) -> String {
-    let line_text = text.lines().nth(line - 1).unwrap_or("");
+    let line_text = text.lines().nth(line.saturating_sub(1)).unwrap_or("");
     let chars: Vec<char> = line_text.chars().collect();
-    let start = (col - 1).min(chars.len());
+    let start = col.saturating_sub(1).min(chars.len());
     let width = span
         .and_then(|s| text.get(s))
         .map_or(1, |s| s.lines().next().unwrap_or("").chars().count())
