@@ -15,7 +15,7 @@
 //!
 //! let bad = text.replace("radius = 0.5", "radus = 0.5");
 //! let err = SceneFile::parse("demo.toml", bad, Format::Toml).unwrap_err();
-//! assert!(err.to_string().contains("demo.toml:13:1: objects[0].radus: unknown field"));
+//! assert!(err.to_string().contains("demo.toml:12:1: objects[0].radus: unknown field"));
 //! assert!(err.to_string().contains("did you mean `radius`?"));
 //! ```
 

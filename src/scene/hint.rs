@@ -19,18 +19,30 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// The candidate closest to `name`, if it is close enough to be a plausible
 /// misspelling: at most a third of the longer name's length away (and at
 /// least 2 edits are always allowed), so that `radus` suggests `radius` but
-/// `colour` does not suggest `ior`.
+/// `colour` does not suggest `ior`. A shortened name (`samples` for
+/// `samples_per_pixel`) also counts, when no candidate is closer by edits.
 pub fn closest<'a, I>(name: &str, candidates: I) -> Option<&'a str>
 where
     I: IntoIterator<Item = &'a str>,
 {
     let lower = name.to_lowercase();
-    candidates
-        .into_iter()
-        .map(|c| (edit_distance(&lower, &c.to_lowercase()), c))
+    let candidates: Vec<&str> = candidates.into_iter().collect();
+    let by_edits = candidates
+        .iter()
+        .map(|&c| (edit_distance(&lower, &c.to_lowercase()), c))
         .filter(|&(d, c)| d <= (name.chars().count().max(c.chars().count()) / 3).max(2))
         .min_by_key(|&(d, _)| d)
-        .map(|(_, c)| c)
+        .map(|(_, c)| c);
+    by_edits.or_else(|| {
+        (lower.chars().count() >= 3)
+            .then(|| {
+                candidates
+                    .iter()
+                    .copied()
+                    .find(|c| c.to_lowercase().starts_with(&lower))
+            })
+            .flatten()
+    })
 }
 
 #[cfg(test)]
@@ -53,6 +65,8 @@ mod tests {
         assert_eq!(closest("centre", fields), Some("center"));
         assert_eq!(closest("Material", fields), Some("material"));
         assert_eq!(closest("colour", fields), None);
+        assert_eq!(closest("mat", fields), Some("material"));
+        assert_eq!(closest("ma", fields), None);
         assert_eq!(closest("x", Vec::<&str>::new()), None);
     }
 }
