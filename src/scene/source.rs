@@ -181,7 +181,8 @@ fn toml_value(value: &toml_edit::Value, fallback: Range<usize>) -> Node {
 pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
     // serde_json validates the syntax (and bounds the nesting depth) first,
     // so the scanner below only ever sees well-formed JSON.
-    if let Err(e) = serde_json::from_str::<serde::de::IgnoredAny>(text) {
+    // (Into a `Value`: skipping with `IgnoredAny` does not bound the depth.)
+    if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
         let full = e.to_string();
         let message = full
             .rfind(" at line ")
@@ -194,7 +195,11 @@ pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
             message,
         });
     }
-    let mut scanner = Scanner { text, pos: 0 };
+    let mut scanner = Scanner {
+        text,
+        pos: 0,
+        depth: 0,
+    };
     scanner.skip_ws();
     let node = scanner.value();
     node.ok_or_else(|| SyntaxError {
@@ -209,7 +214,11 @@ pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
 struct Scanner<'a> {
     text: &'a str,
     pos: usize,
+    depth: usize,
 }
+
+/// Deeper than serde_json accepts anyway; a guard against stack overflow.
+const MAX_DEPTH: usize = 256;
 
 impl Scanner<'_> {
     fn peek(&self) -> Option<u8> {
@@ -228,6 +237,16 @@ impl Scanner<'_> {
     }
 
     fn value(&mut self) -> Option<Node> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return None;
+        }
+        let node = self.value_inner();
+        self.depth -= 1;
+        node
+    }
+
+    fn value_inner(&mut self) -> Option<Node> {
         self.skip_ws();
         let start = self.pos;
         let value = match self.peek()? {

@@ -1,0 +1,135 @@
+//! The scene file reader never panics: arbitrary bytes, and valid files
+//! mangled by random edits, give either a scene or an error message. A
+//! bounded number of cases keeps this to seconds in the normal test suite.
+
+use lumen::render::render;
+use lumen::scene::file::{Format, SceneFile};
+use lumen::scene::Overrides;
+use proptest::prelude::*;
+use proptest::test_runner::Config;
+
+/// Valid files to mangle: a small built-in, both hand-written examples.
+const SEEDS: &[(&str, Format)] = &[
+    (include_str!("../examples/glass-hollow.toml"), Format::Toml),
+    (include_str!("../examples/still-life.toml"), Format::Toml),
+    (include_str!("../examples/ring.json"), Format::Json),
+];
+
+/// Fragments that tend to reach error paths: syntax, types, non-finite and
+/// out-of-range numbers, unknown names, multi-byte characters.
+const TOKENS: &[&str] = &[
+    "", "\n", "=", "[", "]", "{", "}", "\"", ",", ":", ".", "[[objects]]", "[render]",
+    "nan", "-inf", "inf", "1e999", "-1", "0", "0.0", "1e300", "99999999999999999999",
+    "4294967296", "-9223372036854775808", "true", "null", "type", "\"metal\"",
+    "\"sphere\"", "radius", "material", "\"nowhere\"", "vfov = 180", "width = 0",
+    "é", "\u{1F600}", "\\u0000", "\\", "#", "'", "1979-05-27T07:32:00Z",
+];
+
+#[derive(Clone, Debug)]
+enum Edit {
+    Delete { at: usize, len: usize },
+    Insert { at: usize, token: usize },
+    Duplicate { at: usize, len: usize },
+}
+
+fn edit() -> impl Strategy<Value = Edit> {
+    prop_oneof![
+        (any::<usize>(), 0usize..40).prop_map(|(at, len)| Edit::Delete { at, len }),
+        (any::<usize>(), 0..TOKENS.len()).prop_map(|(at, token)| Edit::Insert { at, token }),
+        (any::<usize>(), 0usize..200).prop_map(|(at, len)| Edit::Duplicate { at, len }),
+    ]
+}
+
+/// The nearest character boundary at or below `at % (len + 1)`.
+fn boundary(text: &str, at: usize) -> usize {
+    let mut i = at % (text.len() + 1);
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+fn apply(text: &mut String, e: &Edit) {
+    match *e {
+        Edit::Delete { at, len } => {
+            let a = boundary(text, at);
+            let b = boundary(text, a + len.min(text.len() - a));
+            text.replace_range(a..b.max(a), "");
+        }
+        Edit::Insert { at, token } => {
+            let a = boundary(text, at);
+            text.insert_str(a, TOKENS[token]);
+        }
+        Edit::Duplicate { at, len } => {
+            let a = boundary(text, at);
+            let b = boundary(text, a + len.min(text.len() - a)).max(a);
+            let piece = text[a..b].to_string();
+            text.insert_str(b, &piece);
+        }
+    }
+}
+
+/// Parses, compiles and (when valid) renders a few pixels: nothing may panic,
+/// and every error must format.
+fn exercise(text: String, format: Format) {
+    match SceneFile::parse("fuzz", text, format) {
+        Err(e) => {
+            let message = e.to_string();
+            assert!(message.starts_with("fuzz"), "{message}");
+        }
+        Ok(file) => {
+            let tiny = Overrides {
+                width: Some(4),
+                samples_per_pixel: Some(1),
+                max_depth: Some(3),
+                seed: None,
+            };
+            match file.compile(&tiny) {
+                Err(e) => assert!(e.to_string().starts_with("fuzz")),
+                // Refuse huge heights kept in proportion to a tiny width.
+                Ok(scene) if scene.settings.height <= 64 => {
+                    render(&scene, &|_| {});
+                }
+                Ok(_) => {}
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(Config { cases: 256, failure_persistence: None, ..Config::default() })]
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+        let text = String::from_utf8_lossy(&bytes).into_owned();
+        exercise(text.clone(), Format::Toml);
+        exercise(text, Format::Json);
+    }
+
+    #[test]
+    fn mangled_valid_files_never_panic(
+        seed in 0..SEEDS.len(),
+        edits in proptest::collection::vec(edit(), 1..6),
+    ) {
+        let (original, format) = SEEDS[seed];
+        let mut text = original.to_string();
+        for e in &edits {
+            apply(&mut text, e);
+        }
+        exercise(text, format);
+    }
+}
+
+#[test]
+fn deep_toml_nesting_is_an_error_not_a_stack_overflow() {
+    let deep_toml = format!("a = {}{}", "[".repeat(100_000), "]".repeat(100_000));
+    assert!(SceneFile::parse("deep.toml", deep_toml, Format::Toml).is_err());
+    let deep_toml = format!("a = {}{}", "{a=".repeat(100_000), "}".repeat(100_000));
+    assert!(SceneFile::parse("deep.toml", deep_toml, Format::Toml).is_err());
+}
+
+#[test]
+fn deep_json_nesting_is_an_error_not_a_stack_overflow() {
+    let deep_json = format!("{}{}", "[".repeat(100_000), "]".repeat(100_000));
+    assert!(SceneFile::parse("deep.json", deep_json, Format::Json).is_err());
+}
