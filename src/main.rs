@@ -185,7 +185,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     output,
                     format,
                 }),
-        } => export_command(&name, output.as_deref(), format),
+        } => {
+            export_command(&name, output.as_deref(), format)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Gallery { dir, settings } => {
             with_threads(settings.threads, || gallery_command(&dir, &settings))?;
             Ok(ExitCode::SUCCESS)
@@ -282,12 +285,8 @@ fn load_scene(name: &str) -> Result<SceneSource> {
 fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<()> {
     let source = load_scene(name)?;
     let format = match out {
-        Some(path) => Format::from_extension(path).ok_or_else(|| {
-            anyhow!(
-                "{}: scene files must end in .toml or .json",
-                path.display()
-            )
-        })?,
+        Some(path) => Format::from_extension(path)
+            .ok_or_else(|| anyhow!("{}: scene files must end in .toml or .json", path.display()))?,
         None => match format {
             FormatArg::Toml => Format::Toml,
             FormatArg::Json => Format::Json,

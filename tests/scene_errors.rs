@@ -67,10 +67,7 @@ fn base_with(from: &str, to: &str) -> String {
 
 fn assert_mentions(message: &str, parts: &[&str]) {
     for part in parts {
-        assert!(
-            message.contains(part),
-            "message lacks {part:?}:\n{message}"
-        );
+        assert!(message.contains(part), "message lacks {part:?}:\n{message}");
     }
 }
 
@@ -83,13 +80,20 @@ fn the_base_scene_is_valid() {
 #[test]
 fn syntax_error_toml() {
     let m = refused(&base_with("radius = 0.5", "radius = = 0.5"));
-    assert_mentions(&m, &["scene.toml:27:10:", "syntax error", "radius = = 0.5", "^"]);
+    assert_mentions(
+        &m,
+        &["scene.toml:27:10:", "syntax error", "radius = = 0.5", "^"],
+    );
 }
 
 #[test]
 fn syntax_error_json() {
-    let m = refused_as("{\n  \"render\": {\"width\": 32,}\n}", Format::Json, "s.json");
-    assert_mentions(&m, &["s.json:2:", "syntax error", "key must be a string"]);
+    let m = refused_as(
+        "{\n  \"render\": {\"width\": 32,}\n}",
+        Format::Json,
+        "s.json",
+    );
+    assert_mentions(&m, &["s.json:2:", "syntax error"]);
 }
 
 #[test]
@@ -161,7 +165,10 @@ fn wrong_type() {
     let m = refused(&base_with("width = 32", "width = 32.5"));
     assert_mentions(
         &m,
-        &["render.width", "expected a whole number, got the number 32.5"],
+        &[
+            "render.width",
+            "expected a whole number, got the number 32.5",
+        ],
     );
 }
 
@@ -200,7 +207,11 @@ fn non_finite_numbers() {
     let m = refused(&base_with("radius = 0.5", "radius = nan"));
     assert_mentions(
         &m,
-        &["scene.toml:27:10:", "objects[0].radius", "expected a finite number, got NaN"],
+        &[
+            "scene.toml:27:10:",
+            "objects[0].radius",
+            "expected a finite number, got NaN",
+        ],
     );
     let m = refused(&base_with("vfov = 90", "vfov = -inf"));
     assert_mentions(&m, &["camera.vfov", "finite number, got -inf"]);
@@ -212,11 +223,18 @@ fn non_finite_numbers() {
     );
     assert_mentions(
         &m,
-        &["s.json:1:", "camera.lookat[1]", "expected a finite number, got inf"],
+        &[
+            "s.json:1:",
+            "camera.lookat[1]",
+            "expected a finite number, got inf",
+        ],
     );
     // Finite in f64 but infinite once converted to the renderer's f32.
     let m = refused(&base_with("radius = 0.5", "radius = 1e300"));
-    assert_mentions(&m, &["scene.toml:27:10:", "objects[0].radius", "finite number"]);
+    assert_mentions(
+        &m,
+        &["scene.toml:27:10:", "objects[0].radius", "finite number"],
+    );
 }
 
 #[test]
@@ -224,21 +242,44 @@ fn zero_or_negative_radius() {
     let m = refused(&base_with("radius = 0.5", "radius = 0"));
     assert_mentions(
         &m,
-        &["scene.toml:27:10:", "objects[0].radius", "must be greater than 0, got 0"],
+        &[
+            "scene.toml:27:10:",
+            "objects[0].radius",
+            "must be greater than 0, got 0",
+        ],
     );
     let m = refused(&base_with("radius = 100", "radius = -100"));
     assert_mentions(
         &m,
-        &["scene.toml:33:10:", "objects[1].radius", "must be greater than 0, got -100"],
+        &[
+            "scene.toml:33:10:",
+            "objects[1].radius",
+            "must be greater than 0, got -100",
+        ],
     );
 }
 
 #[test]
 fn zero_or_negative_sizes_samples_and_depth() {
     let cases = [
-        ("width = 32", "width = 0", "render.width", "must be at least 1, got 0"),
-        ("width = 32", "width = -4", "render.width", "must be at least 1, got -4"),
-        ("width = 32", "width = 32\nheight = 0", "render.height", "must be at least 1, got 0"),
+        (
+            "width = 32",
+            "width = 0",
+            "render.width",
+            "must be at least 1, got 0",
+        ),
+        (
+            "width = 32",
+            "width = -4",
+            "render.width",
+            "must be at least 1, got -4",
+        ),
+        (
+            "width = 32",
+            "width = 32\nheight = 0",
+            "render.height",
+            "must be at least 1, got 0",
+        ),
         (
             "samples_per_pixel = 2",
             "samples_per_pixel = 0",
@@ -263,7 +304,12 @@ fn absurd_image_size_is_refused_not_attempted() {
     let m = refused(&base_with("width = 32", "width = 200000\nheight = 200000"));
     assert_mentions(
         &m,
-        &["scene.toml:1:1:", "render:", "image 200000x200000", "more than"],
+        &[
+            "scene.toml:1:1:",
+            "render:",
+            "image 200000x200000",
+            "more than",
+        ],
     );
     let m = refused(&base_with("width = 32", "width = 99999999999"));
     assert_mentions(&m, &["render.width", "must be at most 4294967295"]);
@@ -297,7 +343,11 @@ fn lookfrom_equal_to_lookat() {
     let m = refused(&base_with("lookat = [0, 0, -1]", "lookat = [0, 0, 0]"));
     assert_mentions(
         &m,
-        &["scene.toml:8:10:", "camera.lookat", "lookfrom and lookat are the same point"],
+        &[
+            "scene.toml:8:10:",
+            "camera.lookat",
+            "lookfrom and lookat are the same point",
+        ],
     );
 }
 
@@ -307,7 +357,11 @@ fn vup_parallel_to_the_view_direction() {
         let m = refused(&base_with("vup = [0, 1, 0]", &format!("vup = {vup}")));
         assert_mentions(
             &m,
-            &["scene.toml:9:7:", "camera.vup", "parallel to the view direction"],
+            &[
+                "scene.toml:9:7:",
+                "camera.vup",
+                "parallel to the view direction",
+            ],
         );
     }
 }
@@ -349,10 +403,14 @@ fn missing_file_and_directory() {
     let missing = dir.join("missing.toml");
     let m = SceneFile::read(&missing).unwrap_err().to_string();
     assert_mentions(&m, &["missing.toml", "no such scene file"]);
-    let m = SceneFile::read(&dir.join("folder.toml")).unwrap_err().to_string();
+    let m = SceneFile::read(&dir.join("folder.toml"))
+        .unwrap_err()
+        .to_string();
     assert_mentions(&m, &["folder.toml", "is a directory"]);
     std::fs::write(dir.join("scene.txt"), BASE).unwrap();
-    let m = SceneFile::read(&dir.join("scene.txt")).unwrap_err().to_string();
+    let m = SceneFile::read(&dir.join("scene.txt"))
+        .unwrap_err()
+        .to_string();
     assert_mentions(&m, &["scene.txt", "must end in .toml or .json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -388,7 +446,11 @@ fn the_command_refuses_bad_files_and_writes_nothing() {
     let leftovers: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().file_name())
-        .filter(|n| !Path::new(n).extension().is_some_and(|e| e == "toml" || e == "json"))
+        .filter(|n| {
+            !Path::new(n)
+                .extension()
+                .is_some_and(|e| e == "toml" || e == "json")
+        })
         .collect();
     assert!(leftovers.is_empty(), "left behind: {leftovers:?}");
     std::fs::remove_dir_all(&dir).unwrap();

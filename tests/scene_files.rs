@@ -42,8 +42,8 @@ fn export_parse_export_is_identical_for_every_builtin() {
 fn examples_folder_holds_the_current_export_of_every_builtin() {
     for b in BUILTINS {
         let path = examples_dir().join(format!("{}.toml", b.name));
-        let on_disk = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let on_disk =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert_eq!(
             on_disk,
             export(&b.desc(), Format::Toml).unwrap(),
@@ -135,7 +135,8 @@ fn toml_and_json_of_the_same_scene_agree() {
 
 #[test]
 fn overrides_replace_the_files_settings() {
-    let text = "[render]\nwidth = 100\nheight = 50\nsamples_per_pixel = 7\nmax_depth = 3\nseed = 9\n";
+    let text =
+        "[render]\nwidth = 100\nheight = 50\nsamples_per_pixel = 7\nmax_depth = 3\nseed = 9\n";
     let file = SceneFile::parse("s.toml", text.into(), Format::Toml).unwrap();
     let own = file.compile(&Overrides::default()).unwrap();
     assert_eq!(

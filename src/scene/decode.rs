@@ -93,7 +93,11 @@ impl<'a> Table<'a> {
             );
             err.hint = Some(
                 if let Some((_, owner)) = elsewhere.iter().find(|(k, _)| *k == e.key) {
-                    format!("`{}` belongs to {owner}; {what} has {}", e.key, quoted(known))
+                    format!(
+                        "`{}` belongs to {owner}; {what} has {}",
+                        e.key,
+                        quoted(known)
+                    )
                 } else if let Some(close) = hint::closest(&e.key, known.iter().copied()) {
                     format!("did you mean `{close}`?")
                 } else {

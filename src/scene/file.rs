@@ -48,10 +48,28 @@ impl Format {
     }
 }
 
-/// A scene file that cannot be read or rendered: everything a person needs to
-/// find and fix the mistake.
+/// A scene file that cannot be read or rendered; its message (`Display`) is
+/// everything a person needs to find and fix the mistake.
 #[derive(Clone, Debug, PartialEq, Error)]
-pub struct SceneFileError {
+#[error("{0}")]
+pub struct SceneFileError(pub Box<Diagnostic>);
+
+impl From<Diagnostic> for SceneFileError {
+    fn from(d: Diagnostic) -> Self {
+        SceneFileError(Box::new(d))
+    }
+}
+
+impl std::ops::Deref for SceneFileError {
+    type Target = Diagnostic;
+    fn deref(&self) -> &Diagnostic {
+        &self.0
+    }
+}
+
+/// The parts of a [`SceneFileError`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnostic {
     /// The file, as given.
     pub file: String,
     /// 1-based line and column, where known.
@@ -66,7 +84,7 @@ pub struct SceneFileError {
     pub excerpt: Option<String>,
 }
 
-impl fmt::Display for SceneFileError {
+impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.file)?;
         if let Some((line, col)) = self.line_col {
@@ -87,9 +105,9 @@ impl fmt::Display for SceneFileError {
     }
 }
 
-impl SceneFileError {
+impl Diagnostic {
     fn plain(file: &str, message: impl Into<String>) -> Self {
-        SceneFileError {
+        Diagnostic {
             file: file.to_string(),
             line_col: None,
             field: None,
@@ -146,7 +164,7 @@ impl SceneFile {
     /// gives the format.
     pub fn read(path: &Path) -> Result<SceneFile, SceneFileError> {
         let name = path.display().to_string();
-        let fail = |message: String| SceneFileError::plain(&name, message);
+        let fail = |message: String| Diagnostic::plain(&name, message);
         let meta = std::fs::metadata(path).map_err(|e| {
             fail(match e.kind() {
                 std::io::ErrorKind::NotFound => "no such scene file".to_string(),
@@ -154,9 +172,9 @@ impl SceneFile {
             })
         })?;
         if meta.is_dir() {
-            return Err(fail(
-                "is a directory; expected a scene file (.toml or .json)".into(),
-            ));
+            return Err(
+                fail("is a directory; expected a scene file (.toml or .json)".into()).into(),
+            );
         }
         let format = Format::from_extension(path).ok_or_else(|| {
             fail("unknown scene file type: the name must end in .toml or .json".into())
@@ -186,7 +204,7 @@ impl SceneFile {
         let root = parsed.map_err(|e| {
             // toml_edit splits its message over lines; keep the message on one.
             let message = e.message.lines().collect::<Vec<_>>().join("; ");
-            let mut err = SceneFileError::plain(&name, format!("syntax error: {message}"));
+            let mut err = Diagnostic::plain(&name, format!("syntax error: {message}"));
             err.line_col = e.line_col;
             err.excerpt = e
                 .line_col
@@ -195,7 +213,7 @@ impl SceneFile {
         })?;
         let desc = decode::scene(&root).map_err(|e| {
             let lc = source::line_col(&text, e.span.start);
-            SceneFileError {
+            Diagnostic {
                 file: name.clone(),
                 line_col: Some(lc),
                 field: Some(e.path),
@@ -225,7 +243,7 @@ impl SceneFile {
     /// the line and column of the field at fault, and a hint where one helps.
     pub fn locate(&self, error: &SceneError, overrides: &Overrides) -> SceneFileError {
         let field = error.field();
-        let mut err = SceneFileError::plain(&self.name, error.message());
+        let mut err = Diagnostic::plain(&self.name, error.message());
         err.hint = error.hint();
         if overridden(overrides).contains(&field.as_str()) {
             err.message
@@ -236,7 +254,7 @@ impl SceneFile {
             err.excerpt = Some(excerpt(&self.source, lc, Some(span)));
         }
         err.field = Some(field);
-        err
+        err.into()
     }
 }
 

@@ -76,7 +76,9 @@ impl SceneError {
         match self {
             SceneError::Camera(c) => c.to_string(),
             SceneError::Invalid { message, .. } => message.clone(),
-            SceneError::UnknownMaterial { name, known, .. } => unknown_material_message(name, known),
+            SceneError::UnknownMaterial { name, known, .. } => {
+                unknown_material_message(name, known)
+            }
         }
     }
 

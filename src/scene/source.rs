@@ -181,8 +181,17 @@ fn toml_value(value: &toml_edit::Value, fallback: Range<usize>) -> Node {
 pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
     // serde_json validates the syntax (and bounds the nesting depth) first,
     // so the scanner below only ever sees well-formed JSON.
-    // (Into a `Value`: skipping with `IgnoredAny` does not bound the depth.)
-    if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
+    // (Skipping with `IgnoredAny` accepts numbers too large for f64, which
+    // the decoder then refuses with the field's path, but does not bound the
+    // nesting depth: that is checked first.)
+    if let Some(offset) = too_deep(text) {
+        return Err(SyntaxError {
+            offset: Some(offset),
+            line_col: Some(line_col(text, offset)),
+            message: format!("arrays and objects nested more than {MAX_DEPTH} deep"),
+        });
+    }
+    if let Err(e) = serde_json::from_str::<serde::de::IgnoredAny>(text) {
         let full = e.to_string();
         let message = full
             .rfind(" at line ")
@@ -209,6 +218,34 @@ pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
     })
 }
 
+/// The offset of the first bracket nested deeper than [`MAX_DEPTH`], if any.
+fn too_deep(text: &str) -> Option<usize> {
+    let (mut depth, mut in_string, mut escaped) = (0usize, false, false);
+    for (i, b) in text.bytes().enumerate() {
+        if in_string {
+            match b {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_DEPTH {
+                    return Some(i);
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    None
+}
+
 /// Walks valid JSON recording byte spans. Returns `None` rather than panic on
 /// anything unexpected.
 struct Scanner<'a> {
@@ -217,8 +254,9 @@ struct Scanner<'a> {
     depth: usize,
 }
 
-/// Deeper than serde_json accepts anyway; a guard against stack overflow.
-const MAX_DEPTH: usize = 256;
+/// Deepest nesting of JSON arrays and objects accepted: far more than any
+/// scene needs, far less than would overflow the stack.
+const MAX_DEPTH: usize = 64;
 
 impl Scanner<'_> {
     fn peek(&self) -> Option<u8> {
@@ -342,7 +380,10 @@ impl Scanner<'_> {
 
     fn number(&mut self) -> Option<Value> {
         let start = self.pos;
-        while matches!(self.peek(), Some(b'-' | b'+' | b'.' | b'e' | b'E' | b'0'..=b'9')) {
+        while matches!(
+            self.peek(),
+            Some(b'-' | b'+' | b'.' | b'e' | b'E' | b'0'..=b'9')
+        ) {
             self.pos += 1;
         }
         let token = self.text.get(start..self.pos)?;
