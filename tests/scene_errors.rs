@@ -129,6 +129,16 @@ fn unknown_field_of_another_kind_says_where_it_belongs() {
 }
 
 #[test]
+fn repeated_json_field() {
+    let m = refused_as(
+        "{\"render\": {\"width\": 32,\n \"width\": 64}}",
+        Format::Json,
+        "s.json",
+    );
+    assert_mentions(&m, &["s.json:2:2:", "render.width", "given twice"]);
+}
+
+#[test]
 fn unknown_kind_suggests_the_closest() {
     let m = refused(&base_with("type = \"metal\"", "type = \"metl\""));
     assert_mentions(

@@ -82,7 +82,15 @@ impl<'a> Table<'a> {
                 format!("expected {what} (a table), got {}", node.value.describe()),
             ));
         };
-        for e in entries {
+        for (i, e) in entries.iter().enumerate() {
+            // TOML refuses repeated keys itself; JSON parsers usually keep the last.
+            if entries[..i].iter().any(|earlier| earlier.key == e.key) {
+                return Err(error(
+                    &child(path, &e.key),
+                    &e.key_span,
+                    format!("field `{}` is given twice in {what}", e.key),
+                ));
+            }
             if known.contains(&e.key.as_str()) {
                 continue;
             }
@@ -291,6 +299,13 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
         };
         for e in entries {
             let path = child("materials", &e.key);
+            if desc.materials.contains_key(&e.key) {
+                return Err(error(
+                    &path,
+                    &e.key_span,
+                    format!("material `{}` is defined twice", e.key),
+                ));
+            }
             desc.materials
                 .insert(e.key.clone(), material(&e.node, &path)?);
         }
