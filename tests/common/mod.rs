@@ -188,3 +188,20 @@ pub fn assert_agree(what: &str, a: (f64, f64), b: (f64, f64)) {
         b.1
     );
 }
+
+/// Reads an OpenEXR file's first RGBA layer: its size and its RGB pixels, row-major.
+pub fn read_exr_rgb(path: &std::path::Path) -> ((usize, usize), Vec<[f32; 3]>) {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![[0.0f32; 3]; res.width() * res.height()]),
+        |(w, px): &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let size = img.layer_data.size;
+    (
+        (size.width(), size.height()),
+        img.layer_data.channel_data.pixels.1,
+    )
+}
