@@ -20,6 +20,10 @@ pub fn radiance(scene: &Scene, ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color
 /// multiplying its colour by the surface's attenuation, until it escapes to
 /// the background (which lights it), is absorbed (black), or reaches
 /// `max_depth` segments (black: it never found light in time).
+///
+/// Always inlined, with the BVH traversal, into the render loop, so that the
+/// loop's instruction-set versions (`render::Isa`) cover the whole path.
+#[inline(always)]
 fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color {
     let settings = &scene.settings;
     // Hits closer than epsilon are the surface the ray leaves from, seen again

@@ -565,9 +565,10 @@ fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
 
 fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
     println!(
-        "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores, {spp} spp, depth 50, median of {runs} runs",
+        "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+        lumen::render::Isa::detect().name()
     );
     println!(
         "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
@@ -593,9 +594,10 @@ fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
 
 fn bench_command(spp: u32, runs: u32) -> Result<()> {
     println!(
-        "lumen bench: {} worker threads on {} cores, {spp} spp, depth 50, median of {runs} runs",
+        "lumen bench: {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+        lumen::render::Isa::detect().name()
     );
     println!(
         "{:<24} {:>10} {:>14} {:>16}",

@@ -92,30 +92,16 @@ pub fn render_samples_cancellable(
     progress: &(dyn Fn(u64) + Sync),
     should_stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<RenderStats> {
-    let s = &scene.settings;
     let width = film.width();
     let row_samples = u64::from(width) * u64::from(samples.len() as u32);
+    let isa = Isa::detect();
     film.rows_mut()
         .enumerate()
         .map(|(y, (sums, counts))| {
             if should_stop() {
                 return None;
             }
-            let mut stats = RenderStats::default();
-            for x in 0..width {
-                let pixel = y as u64 * u64::from(width) + u64::from(x);
-                let (sum, count) = (&mut sums[x as usize], &mut counts[x as usize]);
-                for index in samples.clone() {
-                    let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
-                    let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, &mut rng);
-                    let ray = scene.camera.ray(x, y as u32, dx, dy, &mut rng);
-                    let c = radiance(scene, ray, &mut rng, &mut stats.rays);
-                    stats.samples += 1;
-                    if !accumulate(sum, count, c) {
-                        stats.dropped += 1;
-                    }
-                }
-            }
+            let stats = render_row(isa, scene, y as u32, samples.clone(), sums, counts);
             progress(row_samples);
             Some(stats)
         })
@@ -127,6 +113,114 @@ pub fn render_samples_cancellable(
                 Some(a)
             },
         )
+}
+
+/// The instruction set the render loop is compiled for, chosen at run time.
+///
+/// The binary targets the architecture's baseline (SSE2 on x86-64, NEON on
+/// aarch64) so it runs anywhere; the per-row loop, with everything it inlines
+/// (camera, path loop, materials, BVH traversal), is compiled a second time
+/// for AVX2, FMA and BMI and used when the processor has them. Rust never
+/// fuses a multiply and an add by itself, so both versions compute the same
+/// floating-point operations and give bit-identical images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// The architecture's baseline instructions.
+    Baseline,
+    /// x86-64 with AVX2, FMA, BMI1 and BMI2.
+    Avx2,
+}
+
+impl Isa {
+    /// The best version this processor can run.
+    pub fn detect() -> Isa {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx2")
+                && is_x86_feature_detected!("fma")
+                && is_x86_feature_detected!("bmi1")
+                && is_x86_feature_detected!("bmi2")
+            {
+                return Isa::Avx2;
+            }
+        }
+        Isa::Baseline
+    }
+
+    /// A short name for reports (`avx2`, or `sse2`/`neon`/`scalar` for the baseline).
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Avx2 => "avx2",
+            Isa::Baseline if cfg!(target_arch = "x86_64") => "sse2",
+            Isa::Baseline if cfg!(target_arch = "aarch64") => "neon",
+            Isa::Baseline => "scalar",
+        }
+    }
+}
+
+/// Renders samples `samples` of every pixel of row `y` with the code compiled
+/// for `isa` (which must be supported: use [`Isa::detect`]).
+fn render_row(
+    isa: Isa,
+    scene: &Scene,
+    y: u32,
+    samples: Range<u32>,
+    sums: &mut [[f64; 3]],
+    counts: &mut [u32],
+) -> RenderStats {
+    match isa {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => {
+            // SAFETY: `Isa::Avx2` is only produced by `Isa::detect` when the
+            // processor has every feature `render_row_avx2` is compiled for.
+            #[allow(unsafe_code)]
+            unsafe {
+                render_row_avx2(scene, y, samples, sums, counts)
+            }
+        }
+        _ => render_row_generic(scene, y, samples, sums, counts),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2")]
+#[allow(unsafe_code)]
+unsafe fn render_row_avx2(
+    scene: &Scene,
+    y: u32,
+    samples: Range<u32>,
+    sums: &mut [[f64; 3]],
+    counts: &mut [u32],
+) -> RenderStats {
+    render_row_generic(scene, y, samples, sums, counts)
+}
+
+/// The body of the row loop, inlined into each instruction-set version.
+#[inline(always)]
+fn render_row_generic(
+    scene: &Scene,
+    y: u32,
+    samples: Range<u32>,
+    sums: &mut [[f64; 3]],
+    counts: &mut [u32],
+) -> RenderStats {
+    let s = &scene.settings;
+    let mut stats = RenderStats::default();
+    let width = sums.len().min(counts.len());
+    for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
+        let pixel = u64::from(y) * width as u64 + x as u64;
+        for index in samples.clone() {
+            let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
+            let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, &mut rng);
+            let ray = scene.camera.ray(x as u32, y, dx, dy, &mut rng);
+            let c = radiance(scene, ray, &mut rng, &mut stats.rays);
+            stats.samples += 1;
+            if !accumulate(sum, count, c) {
+                stats.dropped += 1;
+            }
+        }
+    }
+    stats
 }
 
 /// Adds one sample's colour to a pixel's sum and count, unless it is NaN or
@@ -155,6 +249,31 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderSt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::builtin;
+
+    #[test]
+    fn every_instruction_set_version_renders_the_same_bits() {
+        let mut desc = builtin::cover();
+        desc.render.width = 48;
+        desc.render.samples_per_pixel = 2;
+        let scene = Scene::from_desc(&desc).expect("the cover compiles");
+        let width = scene.settings.width as usize;
+        let isa = Isa::detect();
+        for y in 0..scene.settings.height {
+            let mut base = (vec![[0.0f64; 3]; width], vec![0u32; width]);
+            let mut best = base.clone();
+            let a = render_row(Isa::Baseline, &scene, y, 0..2, &mut base.0, &mut base.1);
+            let b = render_row(isa, &scene, y, 0..2, &mut best.0, &mut best.1);
+            assert_eq!(a, b, "row {y}: counts differ between baseline and {isa:?}");
+            let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(&base.0),
+                bits(&best.0),
+                "row {y}: baseline and {isa:?} differ"
+            );
+            assert_eq!(base.1, best.1);
+        }
+    }
 
     #[test]
     fn non_finite_samples_are_dropped_and_finite_ones_added() {

@@ -38,7 +38,7 @@ pub struct Scatter {
 impl Material {
     /// Scatters a ray arriving along unit `direction` at `hit`; `None` means
     /// the ray is absorbed.
-    #[inline]
+    #[inline(always)]
     pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
         match self {
             Material::Diffuse(m) => m.scatter(hit, rng),

@@ -307,7 +307,7 @@ impl Scene {
     }
 
     /// The nearest hit of `ray` within `interval`.
-    #[inline]
+    #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let hit = self.bvh.hit(ray, interval)?;
         let sphere = &self.spheres[hit.index as usize];
