@@ -56,7 +56,7 @@ impl Diffuse {
     }
 
     /// Scatters at `hit`; `None` when the ray is absorbed.
-    #[inline]
+    #[inline(always)]
     pub fn scatter(&self, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
         let attenuation = match self.attenuation {
             Attenuation::Scale => self.albedo,
