@@ -174,16 +174,7 @@ impl Bvh {
         ];
         let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
         let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
-        let sphere_ray = SphereRay {
-            ox: Vec4::splat(o.x),
-            oy: Vec4::splat(o.y),
-            oz: Vec4::splat(o.z),
-            dx: Vec4::splat(d.x),
-            dy: Vec4::splat(d.y),
-            dz: Vec4::splat(d.z),
-            a: Vec4::splat(d.length_squared()),
-            t_min: Vec4::splat(interval.min),
-        };
+        let sphere_ray = SphereRay::new(ray, interval);
         let t_min = Vec4::splat(interval.min);
         let mut closest = interval.max;
         let mut best = NO_CHILD;
@@ -274,6 +265,21 @@ struct SphereRay {
 }
 
 impl SphereRay {
+    #[inline(always)]
+    fn new(ray: &Ray, interval: Interval) -> Self {
+        let (o, d) = (ray.origin, ray.direction);
+        SphereRay {
+            ox: Vec4::splat(o.x),
+            oy: Vec4::splat(o.y),
+            oz: Vec4::splat(o.z),
+            dx: Vec4::splat(d.x),
+            dy: Vec4::splat(d.y),
+            dz: Vec4::splat(d.z),
+            a: Vec4::splat(d.length_squared()),
+            t_min: Vec4::splat(interval.min),
+        }
+    }
+
     /// The nearest hit among the packet's spheres closer than `closest`, the
     /// lowest lane winning ties; distances are bit-identical to
     /// [`Sphere::hit`] whichever version runs.
@@ -600,6 +606,44 @@ mod tests {
                 assert_eq!(bvh.hit(&ray, all).map(|h| h.t), expected);
             }
         }
+    }
+
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_and_four_lane_packet_tests_agree_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let mut rng = Rng::new(11);
+        // Leaves of 1 to 8 spheres in a small box, with duplicates (ties)
+        // and rays from inside and outside, so every branch is taken.
+        let mut spheres = random_spheres(&mut rng, 300, 3.0);
+        spheres.extend_from_within(..40);
+        let bvh = Bvh::new(&spheres);
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let origin = Vec3::new(
+                rng.range_f32(-6.0, 6.0),
+                rng.range_f32(-6.0, 6.0),
+                rng.range_f32(-6.0, 6.0),
+            );
+            let d = crate::sampling::unit_vector(&mut rng) * rng.range_f32(0.5, 2.0);
+            let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
+            let ray = SphereRay::new(&Ray::new(origin, d), interval);
+            for p in &bvh.packets {
+                let halves = ray.hit_packet_halves(p, interval.max);
+                // SAFETY: AVX2 was detected above.
+                #[allow(unsafe_code)]
+                let wide = unsafe { ray.hit_packet_avx2(p, interval.max) };
+                let bits = |h: Option<(f32, u32)>| h.map(|(t, i)| (t.to_bits(), i));
+                assert_eq!(bits(halves), bits(wide));
+                hits += usize::from(wide.is_some());
+            }
+        }
+        assert!(
+            hits > 1000,
+            "only {hits} packet hits: the test exercises too little"
+        );
     }
 
     #[test]
