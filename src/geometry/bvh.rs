@@ -204,6 +204,11 @@ impl Bvh {
                 let t_near = tx0.max(ty0).max(tz0).max(t_min);
                 let t_far = tx1.min(ty1).min(tz1).min(Vec4::splat(closest));
                 let mut mask = t_near.cmple(t_far).bitmask() & node.used;
+                if mask != 0 && mask & (mask - 1) == 0 {
+                    // One child hit (the most common case): go on with it.
+                    current = node.children[mask.trailing_zeros() as usize & 3];
+                    continue;
+                }
                 if mask != 0 {
                     // Push the hit children farthest first; go on with the nearest.
                     let t_near = t_near.to_array();
@@ -262,6 +267,8 @@ struct SphereRay {
     /// |direction|².
     a: Vec4,
     t_min: Vec4,
+    /// Whether the processor has AVX2 (asked once per ray, not per packet).
+    avx2: bool,
 }
 
 impl SphereRay {
@@ -277,6 +284,10 @@ impl SphereRay {
             dz: Vec4::splat(d.z),
             a: Vec4::splat(d.length_squared()),
             t_min: Vec4::splat(interval.min),
+            #[cfg(target_arch = "x86_64")]
+            avx2: std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            avx2: false,
         }
     }
 
@@ -286,7 +297,7 @@ impl SphereRay {
     #[inline(always)]
     fn hit_packet(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if self.avx2 {
             // SAFETY: the processor has AVX2, checked just above.
             #[allow(unsafe_code)]
             return unsafe { self.hit_packet_avx2(p, closest) };
