@@ -85,9 +85,10 @@ fn ks_threshold(n: usize) -> f64 {
 fn check_model(model: BounceModel, mean_cos: f64, cdf: impl Fn(f64) -> f64 + Copy) {
     for (i, normal) in normals().into_iter().enumerate() {
         let cos = cosines(model, normal, 100 + i as u64);
-        // Near-tangent Lambertian directions come from N + u with u ≈ −N, a
-        // sum that cancels in f32; the rounding leaves cosθ within ~1e-4 of 0.
-        let below: Vec<f64> = cos.iter().copied().filter(|&c| c < -1e-4).collect();
+        // Near-tangent directions come from N + u with u ≈ −N, a sum that
+        // cancels in f32; bounce_direction falls back to N before rounding
+        // can tip them under the surface.
+        let below: Vec<f64> = cos.iter().copied().filter(|&c| c < 0.0).collect();
         assert!(below.is_empty(), "{model:?}: below the surface: {below:?}");
         let (m, se) = mean_and_se(cos.iter().copied());
         assert_close(

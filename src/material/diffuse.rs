@@ -84,10 +84,13 @@ pub fn bounce_direction(model: BounceModel, normal: Vec3, rng: &mut Rng) -> Vec3
         BounceModel::Lambertian => normal + sampling::unit_vector(rng),
         BounceModel::Hemisphere => sampling::on_hemisphere(rng, normal),
     };
-    // A sample opposite the normal cancels it; fall back to the normal rather
-    // than normalising a (near) zero vector into NaN.
+    // A sample opposite the normal cancels it. For N + u with unit u, the exact
+    // cosθ of the result is |d|/2, while f32 cancellation tilts a short d by
+    // up to ~1e-7/|d| radians: below |d|² = 1e-6 rounding could tip the
+    // direction under the surface (or to NaN at zero), so take the normal.
+    // The fallback is hit with probability 2.5e-7 (|d|² is uniform on [0, 4]).
     let len2 = d.length_squared();
-    if len2 < 1e-12 {
+    if len2 < 1e-6 {
         normal
     } else {
         d / len2.sqrt()
