@@ -131,34 +131,108 @@ pub fn default_path(output: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
-impl Checkpoint {
-    /// The checkpoint's bytes, header included.
-    pub fn encode(&self) -> Vec<u8> {
-        let (sums, counts) = self.film.raw();
-        let mut p = Vec::with_capacity(64 + self.description.len() + sums.len() * 28);
-        for text in [&self.lumen_version, &self.description] {
-            p.extend_from_slice(&(text.len() as u32).to_le_bytes());
-            p.extend_from_slice(text.as_bytes());
+/// A checkpoint to be written, borrowing the state it saves: a render in
+/// progress saves its film without copying it.
+#[derive(Clone, Copy, Debug)]
+pub struct CheckpointView<'a> {
+    /// Version of lumen that writes it.
+    pub lumen_version: &'a str,
+    /// Canonical JSON of the scene description (see [`description_text`]).
+    pub description: &'a str,
+    /// Samples per pixel held by the film.
+    pub spp_done: u32,
+    /// Counts gathered while rendering those samples.
+    pub stats: RenderStats,
+    /// The accumulated samples.
+    pub film: &'a Film,
+}
+
+impl CheckpointView<'_> {
+    /// Feeds the payload to `sink` piece by piece, so that it can be hashed
+    /// and written without being held in memory (a 1200×675 film is 23 MB).
+    fn payload(&self, sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>) -> std::io::Result<()> {
+        for text in [self.lumen_version, self.description] {
+            sink(&(text.len() as u32).to_le_bytes())?;
+            sink(text.as_bytes())?;
         }
         for v in [self.spp_done, self.film.width(), self.film.height()] {
-            p.extend_from_slice(&v.to_le_bytes());
+            sink(&v.to_le_bytes())?;
         }
         for v in [self.stats.samples, self.stats.rays, self.stats.dropped] {
-            p.extend_from_slice(&v.to_le_bytes());
+            sink(&v.to_le_bytes())?;
         }
-        for s in sums.iter().flatten() {
-            p.extend_from_slice(&s.to_le_bytes());
+        let (sums, counts) = self.film.raw();
+        let mut buf = Vec::with_capacity(4096 * 24);
+        for chunk in sums.chunks(4096) {
+            buf.clear();
+            for v in chunk.iter().flatten() {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            sink(&buf)?;
         }
-        for c in counts {
-            p.extend_from_slice(&c.to_le_bytes());
+        for chunk in counts.chunks(4096) {
+            buf.clear();
+            for c in chunk {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+            sink(&buf)?;
         }
-        let mut out = Vec::with_capacity(HEADER_LEN + p.len());
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&(p.len() as u64).to_le_bytes());
-        out.extend_from_slice(&crc32fast::hash(&p).to_le_bytes());
-        out.extend_from_slice(&p);
+        Ok(())
+    }
+
+    /// Writes the checkpoint, header included, to `out`: one pass over the
+    /// payload computes its checksum, a second writes it.
+    pub fn encode_to(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        let mut hasher = crc32fast::Hasher::new();
+        let mut len = 0u64;
+        self.payload(&mut |bytes| {
+            hasher.update(bytes);
+            len += bytes.len() as u64;
+            Ok(())
+        })?;
+        out.write_all(MAGIC)?;
+        out.write_all(&VERSION.to_le_bytes())?;
+        out.write_all(&len.to_le_bytes())?;
+        out.write_all(&hasher.finalize().to_le_bytes())?;
+        self.payload(&mut |bytes| out.write_all(bytes))
+    }
+
+    /// The checkpoint's bytes, header included.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        self.encode_to(&mut out)
+            .expect("writing to memory cannot fail");
         out
+    }
+
+    /// Writes the checkpoint to `path` atomically (temporary file + rename),
+    /// so a kill at any moment leaves the previous checkpoint or this one.
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
+        output::write_atomic(path, |tmp| {
+            let file = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
+            let mut out = std::io::BufWriter::new(file);
+            self.encode_to(&mut out)
+                .and_then(|()| std::io::Write::flush(&mut out))
+                .map_err(|e| e.to_string())
+        })
+    }
+}
+
+impl Checkpoint {
+    /// This checkpoint, ready to be written.
+    pub fn view(&self) -> CheckpointView<'_> {
+        CheckpointView {
+            lumen_version: &self.lumen_version,
+            description: &self.description,
+            spp_done: self.spp_done,
+            stats: self.stats,
+            film: &self.film,
+        }
+    }
+
+    /// The checkpoint's bytes, header included.
+    pub fn encode(&self) -> Vec<u8> {
+        self.view().encode()
     }
 
     /// Reads a checkpoint from `bytes`; `path` only names it in errors.
@@ -240,10 +314,9 @@ impl Checkpoint {
         })
     }
 
-    /// Writes the checkpoint to `path` atomically (temporary file + rename),
-    /// so a kill at any moment leaves the previous checkpoint or this one.
+    /// Writes the checkpoint to `path` atomically.
     pub fn write(&self, path: &Path) -> Result<(), OutputError> {
-        output::write_bytes_atomic(path, &self.encode())
+        self.view().write(path)
     }
 
     /// Reads and verifies the checkpoint at `path`.

@@ -87,29 +87,31 @@ impl Film {
 
     /// All pixels' mean linear colours, row-major, top row first.
     pub fn linear(&self) -> Vec<Color> {
-        (0..self.height)
-            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
-            .map(|(x, y)| self.pixel(x, y))
-            .collect()
+        self.pixels().collect()
     }
 
     /// Display values: gamma `gamma` applied to each channel, then clamped to [0, 1].
     pub fn display(&self, gamma: f32) -> Vec<[f32; 3]> {
-        self.linear()
-            .into_iter()
-            .map(|c| {
-                let f = |v: f32| to_display(v, gamma);
-                [f(c.x), f(c.y), f(c.z)]
-            })
+        self.pixels()
+            .map(|c| [c.x, c.y, c.z].map(|v| to_display(v, gamma)))
             .collect()
     }
 
-    /// 8-bit sRGB-like bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.
+    /// 8-bit bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.
+    /// Computed pixel by pixel, with no full-size intermediate image.
     pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
-        self.display(gamma)
-            .into_iter()
-            .flat_map(|p| p.map(|v| (256.0 * v.clamp(0.0, 0.999)) as u8))
-            .collect()
+        let mut bytes = Vec::with_capacity(self.sums.len() * 3);
+        for c in self.pixels() {
+            for v in [c.x, c.y, c.z] {
+                bytes.push((256.0 * to_display(v, gamma).clamp(0.0, 0.999)) as u8);
+            }
+        }
+        bytes
+    }
+
+    /// The mean linear colour of every pixel, row-major, top row first.
+    pub fn pixels(&self) -> impl Iterator<Item = Color> + '_ {
+        (0..self.height).flat_map(move |y| (0..self.width).map(move |x| self.pixel(x, y)))
     }
 }
 

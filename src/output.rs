@@ -147,16 +147,13 @@ pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputErr
                     .map_err(|e| e.to_string())
             })
         }
-        ImageFormat::Exr => {
-            let pixels = film.linear();
-            write_atomic(path, |tmp| {
-                exr::prelude::write_rgb_file(tmp, w as usize, h as usize, |x, y| {
-                    let c = pixels[y * w as usize + x];
-                    (c.x, c.y, c.z)
-                })
-                .map_err(|e| e.to_string())
+        ImageFormat::Exr => write_atomic(path, |tmp| {
+            exr::prelude::write_rgb_file(tmp, w as usize, h as usize, |x, y| {
+                let c = film.pixel(x as u32, y as u32);
+                (c.x, c.y, c.z)
             })
-        }
+            .map_err(|e| e.to_string())
+        }),
     }
 }
 

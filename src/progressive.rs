@@ -35,7 +35,7 @@
 //! assert_eq!(session.spp_done(), 24);
 //! ```
 
-use crate::checkpoint::{description_text, Checkpoint, CheckpointError};
+use crate::checkpoint::{description_text, Checkpoint, CheckpointError, CheckpointView};
 use crate::film::Film;
 use crate::render::{render_samples_cancellable, RenderStats};
 use crate::scene::{Scene, SceneDesc, SceneError};
@@ -226,13 +226,13 @@ impl Session {
     }
 
     /// The state to save so that a later run can continue this one.
-    pub fn checkpoint(&self) -> Checkpoint {
-        Checkpoint {
-            lumen_version: env!("CARGO_PKG_VERSION").into(),
-            description: self.description.clone(),
+    pub fn checkpoint(&self) -> CheckpointView<'_> {
+        CheckpointView {
+            lumen_version: env!("CARGO_PKG_VERSION"),
+            description: &self.description,
             spp_done: self.spp_done,
             stats: self.stats,
-            film: self.film.clone(),
+            film: &self.film,
         }
     }
 
