@@ -321,6 +321,15 @@ fn absurd_image_size_is_refused_not_attempted() {
             "more than",
         ],
     );
+    // The limit is 2^26 pixels: 8192x8192 compiles (no film is allocated
+    // before rendering), one more column does not.
+    let at_limit = base_with("width = 32", "width = 8192\nheight = 8192");
+    SceneFile::parse("scene.toml", at_limit, Format::Toml)
+        .unwrap()
+        .compile(&Overrides::default())
+        .unwrap();
+    let m = refused(&base_with("width = 32", "width = 8193\nheight = 8192"));
+    assert_mentions(&m, &["image 8193x8192", "more than"]);
     let m = refused(&base_with("width = 32", "width = 99999999999"));
     assert_mentions(&m, &["render.width", "must be at most 4294967295"]);
     // Too large only because of the command line: said so, no file position.

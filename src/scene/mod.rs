@@ -22,8 +22,10 @@ use desc::{
 use std::collections::HashMap;
 use thiserror::Error;
 
-/// Largest accepted image, in pixels: the film needs 28 bytes a pixel.
-pub const MAX_PIXELS: u64 = 1 << 28;
+/// Largest accepted image, in pixels (e.g. 8192×8192). The film needs 28
+/// bytes a pixel and a pass in flight keeps a copy, so this caps the render's
+/// memory near 3.8 GB: larger images are refused, not attempted.
+pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// A scene description that cannot be rendered.
 #[derive(Debug, Error)]
