@@ -17,6 +17,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
 use std::time::{Duration, Instant};
 
+/// Most worker threads accepted by `--threads` (far more than any machine
+/// lumen runs on has cores; each thread costs a stack).
+const MAX_THREADS: i64 = 1024;
+
 /// lumen: a physically based path tracer following Ray Tracing in One Weekend.
 #[derive(Parser)]
 #[command(name = "lumen", version, about, propagate_version = true)]
@@ -62,7 +66,7 @@ enum Command {
         #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
         runs: u32,
         /// Worker threads (default: one per core).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
         threads: Option<u32>,
         /// Instead of the standard workloads, render cover-like fields of
         /// 10², 10³, 10⁴, 10⁵ and 10⁶ small spheres (how cost grows with the scene).
@@ -111,7 +115,7 @@ struct SettingArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Worker threads (default: one per core). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
     threads: Option<u32>,
 }
 
@@ -150,6 +154,24 @@ impl SettingArgs {
 /// Exit status of a render stopped by Ctrl-C or SIGTERM (128 + SIGINT).
 const EXIT_INTERRUPTED: u8 = 130;
 
+/// Writes to standard output. A closed pipe (`lumen scenes | head -1`) ends
+/// the output quietly; any other failure is an error, never a panic.
+fn write_stdout(text: &str) -> Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write to standard output"),
+    }
+}
+
+/// `println!` through [`write_stdout`].
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        write_stdout(&format!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
@@ -174,7 +196,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {
-                println!("{:width$}  {}", b.name, b.caption);
+                outln!("{:width$}  {}", b.name, b.caption)?;
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -299,7 +321,53 @@ fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<(
             output::write_bytes_atomic(path, text.as_bytes())?;
             eprintln!("{name}: written to {}", path.display());
         }
-        None => print!("{text}"),
+        None => write_stdout(&text)?,
+    }
+    Ok(())
+}
+
+/// Where a path points once its directory is resolved (the file itself may
+/// not exist yet): `./out.png`, `out.png` and `$PWD/out.png` are one place.
+fn resolved(path: &Path) -> PathBuf {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    match path.file_name() {
+        Some(name) => dir.join(name),
+        None => dir,
+    }
+}
+
+/// The checkpoint is overwritten after every pass and deleted at the end:
+/// it must be neither the output image nor the scene file, and a file
+/// already there must be a checkpoint, not something of the user's.
+fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
+    let place = resolved(ckpt);
+    if place == resolved(out) {
+        bail!(
+            "{}: the checkpoint cannot be the output image; choose another --checkpoint",
+            ckpt.display()
+        );
+    }
+    if Path::new(scene).is_file() && place == resolved(Path::new(scene)) {
+        bail!(
+            "{}: the checkpoint cannot be the scene file; choose another --checkpoint",
+            ckpt.display()
+        );
+    }
+    if ckpt.is_file() {
+        let mut magic = [0u8; checkpoint::MAGIC.len()];
+        let is_checkpoint = std::fs::File::open(ckpt)
+            .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+            .is_ok_and(|()| &magic == checkpoint::MAGIC);
+        if !is_checkpoint {
+            bail!(
+                "{}: exists and is not a lumen checkpoint; refusing to overwrite it (choose another --checkpoint)",
+                ckpt.display()
+            );
+        }
     }
     Ok(())
 }
@@ -316,12 +384,7 @@ fn render_command(
         .checkpoint
         .clone()
         .unwrap_or_else(|| checkpoint::default_path(out));
-    if ckpt_path == out {
-        bail!(
-            "{}: the checkpoint cannot be the output image",
-            out.display()
-        );
-    }
+    check_checkpoint_path(&ckpt_path, out, name)?;
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
     output::check_writable(&ckpt_path).context("checkpoint")?;
@@ -564,21 +627,27 @@ fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
 }
 
 fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
-    println!(
+    outln!(
         "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
         lumen::render::Isa::detect().name()
-    );
-    println!(
+    )?;
+    outln!(
         "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
-        "spheres", "build s", "BVH MB", "rays", "median s", "M rays/s", "M samples/s"
-    );
+        "spheres",
+        "build s",
+        "BVH MB",
+        "rays",
+        "median s",
+        "M rays/s",
+        "M samples/s"
+    )?;
     for &n in fields {
         let p = bench::measure_field(n, spp, runs as usize)
             .map_err(|e| anyhow!("field of {n} spheres: {e}"))?;
         let m = &p.measurement;
-        println!(
+        outln!(
             "{:>9} {:>9.3} {:>9.1} {:>10} {:>10.3} {:>10.2} {:>12.2}",
             p.spheres,
             p.build.as_secs_f64(),
@@ -587,31 +656,34 @@ fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
             m.median.as_secs_f64(),
             m.rays_per_second() / 1e6,
             m.samples_per_second() / 1e6
-        );
+        )?;
     }
     Ok(())
 }
 
 fn bench_command(spp: u32, runs: u32) -> Result<()> {
-    println!(
+    outln!(
         "lumen bench: {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
         lumen::render::Isa::detect().name()
-    );
-    println!(
+    )?;
+    outln!(
         "{:<24} {:>10} {:>14} {:>16}",
-        "workload", "median s", "M rays/s", "M samples/s"
-    );
+        "workload",
+        "median s",
+        "M rays/s",
+        "M samples/s"
+    )?;
     for w in bench::standard_workloads(spp) {
         let m = bench::measure(&w, runs as usize).map_err(|e| anyhow!("{}: {e}", w.name))?;
-        println!(
+        outln!(
             "{:<24} {:>10.3} {:>14.2} {:>16.2}",
             m.name,
             m.median.as_secs_f64(),
             m.rays_per_second() / 1e6,
             m.samples_per_second() / 1e6
-        );
+        )?;
     }
     Ok(())
 }

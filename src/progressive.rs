@@ -276,8 +276,8 @@ impl Session {
     /// exceeded: the next pass is started only if, predicted from the
     /// previous pass's time per sample, it ends within the budget, and a
     /// pass still running when the budget is spent is abandoned. The first
-    /// pass of a render without samples is always finished, since an image
-    /// needs at least one sample.
+    /// pass of every run is always finished: an image needs a sample, and a
+    /// resumed render must progress even if one pass outgrows the budget.
     ///
     /// `on_pass` is called after every finished pass (to save the image and
     /// a checkpoint); its error ends the run.
@@ -308,7 +308,9 @@ impl Session {
                     return Ok(summary);
                 }
             }
-            let must_finish = self.spp_done == 0;
+            // Every run adds at least one pass, or a resumed render whose
+            // passes outgrow the budget would never progress.
+            let must_finish = summary.passes == 0;
             let should_stop = || {
                 stop.load(Ordering::Relaxed)
                     || (!must_finish && deadline.is_some_and(|d| Instant::now() >= d))

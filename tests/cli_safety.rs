@@ -1,0 +1,130 @@
+//! The command line never destroys a user's files and never panics on a
+//! closed or full standard output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn lumen(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lumen"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lumen-safety-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn refused_with(out: &Output, words: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "accepted: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for w in words {
+        assert!(err.contains(w), "{err:?} lacks {w:?}");
+    }
+}
+
+#[test]
+fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() {
+    let dir = scratch("ckpt");
+    fn with<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        [extra, &["--width", "8", "--spp", "2"][..]].concat()
+    }
+
+    // The output image, however it is spelled.
+    let spelled = dir.join("out.png");
+    for ckpt in ["out.png", "./out.png", spelled.to_str().unwrap()] {
+        let out = lumen(
+            &dir,
+            &with(&["render", "gradient", "-o", "out.png", "--checkpoint", ckpt]),
+        );
+        refused_with(&out, &["checkpoint cannot be the output image"]);
+        assert!(!dir.join("out.png").exists());
+    }
+
+    // The scene file being rendered.
+    assert!(
+        lumen(&dir, &["scenes", "export", "gradient", "-o", "g.toml"])
+            .status
+            .success()
+    );
+    let scene = std::fs::read(dir.join("g.toml")).unwrap();
+    let out = lumen(
+        &dir,
+        &with(&[
+            "render",
+            "g.toml",
+            "-o",
+            "x.png",
+            "--checkpoint",
+            "./g.toml",
+        ]),
+    );
+    refused_with(&out, &["checkpoint cannot be the scene file"]);
+    assert_eq!(std::fs::read(dir.join("g.toml")).unwrap(), scene);
+
+    // Any other existing file that is not a checkpoint.
+    std::fs::write(dir.join("notes.txt"), "keep me").unwrap();
+    let out = lumen(
+        &dir,
+        &with(&[
+            "render",
+            "gradient",
+            "-o",
+            "y.png",
+            "--checkpoint",
+            "notes.txt",
+        ]),
+    );
+    refused_with(&out, &["notes.txt", "not a lumen checkpoint"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
+        "keep me"
+    );
+    assert!(!dir.join("y.png").exists());
+
+    // A real checkpoint there is fine (it is replaced).
+    let ok = lumen(&dir, &with(&["render", "gradient", "-o", "z.png"]));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_closed_pipe_ends_output_quietly_and_a_full_device_is_an_error() {
+    // Read one line, then close the pipe while lumen still writes.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lumen"))
+        .args(["scenes", "export", "cover"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut first = [0u8; 16];
+    std::io::Read::read_exact(&mut stdout, &mut first).unwrap();
+    drop(stdout);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(out.status.success(), "{err}");
+
+    if Path::new("/dev/full").exists() {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_lumen"))
+            .arg("scenes")
+            .stdout(full)
+            .output()
+            .unwrap();
+        refused_with(&out, &["cannot write to standard output"]);
+    }
+}
