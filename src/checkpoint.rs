@@ -35,6 +35,12 @@ use thiserror::Error;
 pub const MAGIC: &[u8; 8] = b"LUMENCKP";
 /// The format version this lumen writes and reads.
 pub const VERSION: u32 = 1;
+/// Identifies the code that computes samples: the crate version and a
+/// revision of the sample computation. Any change that alters the value of a
+/// sample (random stream, sampling, intersection arithmetic, materials) must
+/// bump the revision, so that a checkpoint written before it is refused
+/// rather than mixed with different samples.
+pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.2");
 /// Extension added to an output path to name its default checkpoint.
 pub const EXTENSION: &str = "lumen-ckpt";
 
@@ -335,7 +341,7 @@ impl Checkpoint {
             path: path.to_path_buf(),
             differences,
         };
-        let ours = env!("CARGO_PKG_VERSION");
+        let ours = RENDERER_ID;
         if self.lumen_version != ours {
             return Err(mismatch(format!(
                 "written by lumen {}, this is lumen {ours}",
@@ -451,7 +457,7 @@ mod tests {
         let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, f64::MAX]).collect();
         let counts = (0..n as u32).collect();
         let ckpt = Checkpoint {
-            lumen_version: env!("CARGO_PKG_VERSION").into(),
+            lumen_version: RENDERER_ID.into(),
             description: description_text(&desc),
             spp_done: 3,
             stats: RenderStats {

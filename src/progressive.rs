@@ -228,7 +228,7 @@ impl Session {
     /// The state to save so that a later run can continue this one.
     pub fn checkpoint(&self) -> CheckpointView<'_> {
         CheckpointView {
-            lumen_version: env!("CARGO_PKG_VERSION"),
+            lumen_version: crate::checkpoint::RENDERER_ID,
             description: &self.description,
             spp_done: self.spp_done,
             stats: self.stats,
