@@ -65,6 +65,9 @@ pub enum CameraError {
     /// The image has no pixels.
     #[error("image size {0}x{1} has no pixels")]
     EmptyImage(u32, u32),
+    /// The set-up's numbers are too large for `f32` arithmetic.
+    #[error("lookfrom, lookat and focus_dist are too large for f32 arithmetic (keep them below about 1e18)")]
+    Overflow,
     /// A value is NaN or infinite.
     #[error("camera {0} is not a finite number")]
     NotFinite(&'static str),
@@ -112,8 +115,11 @@ impl Camera {
             return Err(CameraError::EmptyImage(width, height));
         }
         let view = s.lookfrom - s.lookat;
-        if view.length_squared() == 0.0 {
+        if view == Vec3::ZERO {
             return Err(CameraError::NoViewDirection(s.lookfrom));
+        }
+        if !view.length_squared().is_finite() {
+            return Err(CameraError::Overflow);
         }
         let w = view.normalize();
         let side = s.vup.cross(w);
@@ -134,6 +140,10 @@ impl Camera {
         let upper_left = s.lookfrom - s.focus_dist * w - viewport_u / 2.0 - viewport_v / 2.0;
         let pixel00 = upper_left + 0.5 * (pixel_du + pixel_dv);
         let defocus_radius = s.focus_dist * (s.defocus_angle.to_radians() / 2.0).tan();
+        let derived = [u, v, w, pixel_du, pixel_dv, pixel00];
+        if !(derived.iter().all(|d| d.is_finite()) && defocus_radius.is_finite()) {
+            return Err(CameraError::Overflow);
+        }
         Ok(Camera {
             center: s.lookfrom,
             pixel00,

@@ -511,3 +511,26 @@ fn the_command_exports_and_renders_a_scene_file() {
     assert!(png.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn numbers_too_large_or_small_for_f32_arithmetic() {
+    // Far-apart camera points overflow the view vector in f32.
+    let m = refused(&base_with(
+        "lookfrom = [0, 0, 0]\nlookat = [0, 0, -1]",
+        "lookfrom = [3e38, 0, 0]\nlookat = [-3e38, 0, 0]",
+    ));
+    assert_mentions(&m, &["scene.toml:", "camera:", "too large for f32"]);
+    let m = refused(&base_with(
+        "lookfrom = [0, 0, 0]",
+        "lookfrom = [1e20, 0, 0]",
+    ));
+    assert_mentions(&m, &["camera:", "too large for f32"]);
+    // A radius whose square overflows would make the sphere invisible.
+    let m = refused(&base_with("radius = 0.5", "radius = 1e30"));
+    assert_mentions(&m, &["scene.toml:", "objects[0]", "at most 1e18"]);
+    // Positive in f64 but zero in f32.
+    let m = refused(&base_with("ior = 1.5", "ior = 1e-60"));
+    assert_mentions(&m, &["materials.glass.ior", "greater than 0"]);
+    let m = refused(&base_with("width = 32", "width = 32\ngamma = 1e-60"));
+    assert_mentions(&m, &["render.gamma", "greater than 0"]);
+}

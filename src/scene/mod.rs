@@ -22,6 +22,10 @@ use desc::{
 use std::collections::HashMap;
 use thiserror::Error;
 
+/// Largest magnitude of an object's coordinates and radius: the sphere test
+/// squares lengths of this order in `f32` (whose maximum is about 3.4e38).
+pub const MAX_COORDINATE: f64 = 1e18;
+
 /// Largest accepted image, in pixels (e.g. 8192×8192). The film needs 28
 /// bytes a pixel and a pass in flight keeps a copy, so this caps the render's
 /// memory near 3.8 GB: larger images are refused, not attempted.
@@ -65,6 +69,7 @@ impl SceneError {
                 CameraError::FocusDistance(_) => "camera.focus_dist".into(),
                 CameraError::DefocusAngle(_) => "camera.defocus_angle".into(),
                 CameraError::EmptyImage(..) => "render".into(),
+                CameraError::Overflow => "camera".into(),
                 CameraError::NotFinite(name) => format!("camera.{name}"),
             },
             SceneError::Invalid { field, .. } | SceneError::UnknownMaterial { field, .. } => {
@@ -238,7 +243,16 @@ impl Scene {
                 finite("camera.focus_dist", &[d])?;
                 d as f32
             }
-            None => (lookfrom - lookat).length(),
+            None => {
+                let d: f64 = (0..3)
+                    .map(|i| (cam.lookfrom[i] - cam.lookat[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if !(d as f32).is_finite() {
+                    return Err(SceneError::Camera(CameraError::Overflow));
+                }
+                d as f32
+            }
         };
         let camera = Camera::new(
             &CameraSettings {
@@ -278,10 +292,21 @@ impl Scene {
                 } => {
                     finite(&format!("objects[{i}].center"), center)?;
                     finite(&format!("objects[{i}].radius"), &[*radius])?;
-                    if !(*radius > 0.0) || *radius as f32 <= 0.0 {
+                    if !(*radius as f32 > 0.0) {
                         return Err(invalid(
                             format!("objects[{i}].radius"),
                             format!("must be greater than 0, got {radius}"),
+                        ));
+                    }
+                    // The intersection squares the radius and distances of
+                    // the order of the centre's coordinates, in f32.
+                    let extent = center.iter().fold(*radius, |m, c| m.max(c.abs()));
+                    if extent > MAX_COORDINATE {
+                        return Err(invalid(
+                            format!("objects[{i}]"),
+                            format!(
+                                "centre and radius must be at most {MAX_COORDINATE:e} in size, so that their squares fit in f32"
+                            ),
                         ));
                     }
                     let Some(&m) = material_index.get(material.as_str()) else {
@@ -394,7 +419,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         ));
     }
     finite("render.gamma", &[r.gamma])?;
-    if !(r.gamma > 0.0) {
+    if !(r.gamma as f32 > 0.0) {
         return Err(invalid(
             "render.gamma",
             format!("must be greater than 0, got {}", r.gamma),
@@ -454,7 +479,7 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
         }
         MaterialDesc::Dielectric { ior, refract_only } => {
             finite(&format!("{field}.ior"), &[*ior])?;
-            if !(*ior > 0.0) {
+            if !(*ior as f32 > 0.0) {
                 return Err(invalid(
                     format!("{field}.ior"),
                     format!("index of refraction must be greater than 0, got {ior}"),
