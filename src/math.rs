@@ -10,7 +10,8 @@ pub type Point3 = Vec3;
 /// A linear RGB colour; components are not limited to `[0, 1]` (high dynamic range).
 pub type Color = Vec3;
 
-/// A closed interval of ray parameters `[min, max]`.
+/// An interval of ray parameters from `min` to `max`; hits are accepted
+/// strictly inside it (see [`Interval::surrounds`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Interval {
     /// Smallest accepted value.

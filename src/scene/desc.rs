@@ -222,7 +222,8 @@ pub enum AttenuationDesc {
     /// Multiply the colour by the albedo.
     #[default]
     Scale,
-    /// Absorb rays with probability 1 − albedo.
+    /// Absorb rays with probability 1 − p, p = the albedo's largest
+    /// component; survivors are multiplied by albedo / p.
     Absorb,
 }
 
