@@ -48,10 +48,11 @@ scenes! {
     "aa-1spp", "Antialiasing: one sample per pixel shows jaggies" => || normals(ShadingDesc::NormalsBrightened, true, 1);
     "aa-100spp", "Antialiasing: 100 random samples per pixel, averaged" => || normals(ShadingDesc::NormalsBrightened, true, 100);
     "diffuse-first", "First diffuse attempt: one bounce, objects with an intrinsic colour" => diffuse_first;
-    "diffuse-absorb-half", "Diffuse with reflectivity 0.5: every bounce halves the colour" => || diffuse_grey(1.0, false, 50);
-    "diffuse-gamma2", "Gamma corrected, gamma = 2" => || diffuse_grey(2.0, false, 50);
-    "diffuse-blue-background", "Plain blue background" => || diffuse_grey(2.0, true, 50);
+    "diffuse-absorb-half", "One bounce, colour multiplied by a reflectivity of 0.5" => || diffuse_grey(1.0, false, 2);
+    "diffuse-gamma2", "One bounce, gamma corrected (gamma = 2)" => || diffuse_grey(2.0, false, 2);
+    "diffuse-blue-background", "One bounce, plain blue background" => || diffuse_grey(2.0, true, 2);
     "diffuse-zero-bounces", "Zero bounces (max depth 1): only the background lights anything" => || diffuse_grey(2.0, true, 1);
+    "diffuse-recursive", "Bounces traced recursively up to depth 50, each halving the colour: contact shadows appear" => || diffuse_grey(2.0, true, 50);
     "shadow-acne", "Shadow acne: with epsilon 0 bounce rays hit their own surface" => || acne(0.0);
     "shadow-acne-fixed", "Shadow acne fixed by ignoring hits closer than 0.001" => || acne(0.001);
     "bounce-cube", "Bounce towards a random point on a cube around p + N" => || bounce(BounceDesc::Cube);
