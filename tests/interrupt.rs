@@ -120,7 +120,14 @@ fn sigkill_during_checkpoint_writes_leaves_a_usable_checkpoint() {
     let ckpt_path = default_path(&out);
     let mut kills_during_a_write = 0;
     let mut last_spp = 0;
-    for round in 0..8 {
+    let mut rounds = 0;
+    // Eight rounds, or more (up to 24) until a kill lands mid-write: whether
+    // one does depends on timing, which a loaded machine can stretch.
+    for round in 0..24 {
+        if round >= 8 && kills_during_a_write > 0 {
+            break;
+        }
+        rounds += 1;
         let resume = ckpt_path.exists();
         let extra: &[&str] = if resume { &["--resume"] } else { &[] };
         let r = spawn(RENDER, &out, extra);
@@ -160,7 +167,7 @@ fn sigkill_during_checkpoint_writes_leaves_a_usable_checkpoint() {
         }
     }
     eprintln!(
-        "{kills_during_a_write} of 8 kills landed during a checkpoint write; {last_spp} spp saved"
+        "{kills_during_a_write} of {rounds} kills landed during a checkpoint write; {last_spp} spp saved"
     );
     assert!(
         kills_during_a_write > 0,

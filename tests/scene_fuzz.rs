@@ -6,7 +6,7 @@ use lumen::render::render;
 use lumen::scene::file::{Format, SceneFile};
 use lumen::scene::Overrides;
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+use proptest::test_runner::{Config, RngSeed};
 
 /// Valid files to mangle: a small built-in, both hand-written examples.
 const SEEDS: &[(&str, Format)] = &[
@@ -133,7 +133,14 @@ fn exercise(text: String, format: Format) {
 }
 
 proptest! {
-    #![proptest_config(Config { cases: 256, failure_persistence: None, ..Config::default() })]
+    // A fixed seed: a failure seen in CI is reproduced by running the test
+    // again (PROPTEST_RNG_SEED overrides it to explore other cases).
+    #![proptest_config(Config {
+        cases: 256,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(0x5CE7E),
+        ..Config::default()
+    })]
 
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
