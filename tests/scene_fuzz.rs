@@ -134,7 +134,7 @@ fn exercise(text: String, format: Format) {
 
 proptest! {
     // A fixed seed: a failure seen in CI is reproduced by running the test
-    // again (PROPTEST_RNG_SEED overrides it to explore other cases).
+    // again; change the seed here to explore other cases.
     #![proptest_config(Config {
         cases: 256,
         failure_persistence: None,
