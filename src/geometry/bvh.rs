@@ -126,9 +126,15 @@ impl Bvh {
             + self.packets.capacity() * std::mem::size_of::<Packet>()
     }
 
-    /// The nearest sphere hit by `ray` within `interval`.
+    /// The nearest sphere hit by `ray` within `interval`; the ray's direction
+    /// must have unit length (see [`Sphere::hit`]).
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
+        debug_assert!(
+            (ray.direction.length_squared() - 1.0).abs() < 1e-4,
+            "ray direction {} is not unit length",
+            ray.direction
+        );
         if self.nodes.is_empty() {
             return None;
         }
@@ -264,8 +270,6 @@ struct SphereRay {
     dx: Vec4,
     dy: Vec4,
     dz: Vec4,
-    /// |direction|².
-    a: Vec4,
     t_min: Vec4,
     /// Whether the processor has AVX2 (asked once per ray, not per packet).
     avx2: bool,
@@ -282,7 +286,6 @@ impl SphereRay {
             dx: Vec4::splat(d.x),
             dy: Vec4::splat(d.y),
             dz: Vec4::splat(d.z),
-            a: Vec4::splat(d.length_squared()),
             t_min: Vec4::splat(interval.min),
             #[cfg(target_arch = "x86_64")]
             avx2: std::arch::is_x86_feature_detected!("avx2"),
@@ -329,18 +332,17 @@ impl SphereRay {
         let fz = self.oz - p.cz[half];
         let half_b = fx * self.dx + fy * self.dy + fz * self.dz;
         let c = fx * fx + fy * fy + fz * fz - radius2;
-        let k = half_b / self.a;
-        let lx = fx - k * self.dx;
-        let ly = fy - k * self.dy;
-        let lz = fz - k * self.dz;
-        let discriminant = self.a * (radius2 - (lx * lx + ly * ly + lz * lz));
+        let lx = fx - half_b * self.dx;
+        let ly = fy - half_b * self.dy;
+        let lz = fz - half_b * self.dz;
+        let discriminant = radius2 - (lx * lx + ly * ly + lz * lz);
         let real = discriminant.cmpge(Vec4::ZERO);
         if !real.any() {
             return None;
         }
         let sqrt_d = sqrt4(discriminant);
         let q = -half_b - sqrt_d.copysign(half_b);
-        let (r1, r2) = (c / q, q / self.a);
+        let (r1, r2) = (c / q, q);
         let ordered = r1.cmple(r2);
         let near = Vec4::select(ordered, r1, r2);
         let far = Vec4::select(ordered, r2, r1);
@@ -382,7 +384,7 @@ impl SphereRay {
         }
         let (ox, oy, oz) = (wide!(self.ox), wide!(self.oy), wide!(self.oz));
         let (dx, dy, dz) = (wide!(self.dx), wide!(self.dy), wide!(self.dz));
-        let (a, t_min) = (wide!(self.a), wide!(self.t_min));
+        let t_min = wide!(self.t_min);
         let zero = _mm256_setzero_ps();
         let sign = _mm256_set1_ps(-0.0);
         let radius2 = load!(p.radius2);
@@ -397,11 +399,10 @@ impl SphereRay {
         };
         let half_b = dot(fx, fy, fz, dx, dy, dz);
         let c = _mm256_sub_ps(dot(fx, fy, fz, fx, fy, fz), radius2);
-        let k = _mm256_div_ps(half_b, a);
-        let lx = _mm256_sub_ps(fx, _mm256_mul_ps(k, dx));
-        let ly = _mm256_sub_ps(fy, _mm256_mul_ps(k, dy));
-        let lz = _mm256_sub_ps(fz, _mm256_mul_ps(k, dz));
-        let discriminant = _mm256_mul_ps(a, _mm256_sub_ps(radius2, dot(lx, ly, lz, lx, ly, lz)));
+        let lx = _mm256_sub_ps(fx, _mm256_mul_ps(half_b, dx));
+        let ly = _mm256_sub_ps(fy, _mm256_mul_ps(half_b, dy));
+        let lz = _mm256_sub_ps(fz, _mm256_mul_ps(half_b, dz));
+        let discriminant = _mm256_sub_ps(radius2, dot(lx, ly, lz, lx, ly, lz));
         let real = _mm256_cmp_ps::<_CMP_GE_OQ>(discriminant, zero);
         if _mm256_movemask_ps(real) == 0 {
             return None;
@@ -409,7 +410,7 @@ impl SphereRay {
         let sqrt_d = _mm256_sqrt_ps(discriminant);
         let signed_sqrt = _mm256_or_ps(_mm256_and_ps(half_b, sign), _mm256_andnot_ps(sign, sqrt_d));
         let q = _mm256_sub_ps(_mm256_xor_ps(half_b, sign), signed_sqrt);
-        let (r1, r2) = (_mm256_div_ps(c, q), _mm256_div_ps(q, a));
+        let (r1, r2) = (_mm256_div_ps(c, q), q);
         let ordered = _mm256_cmp_ps::<_CMP_LE_OQ>(r1, r2);
         let near = _mm256_blendv_ps(r2, r1, ordered);
         let far = _mm256_blendv_ps(r1, r2, ordered);
@@ -638,7 +639,7 @@ mod tests {
                 rng.range_f32(-6.0, 6.0),
                 rng.range_f32(-6.0, 6.0),
             );
-            let d = crate::sampling::unit_vector(&mut rng) * rng.range_f32(0.5, 2.0);
+            let d = crate::sampling::unit_vector(&mut rng);
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
             let ray = SphereRay::new(&Ray::new(origin, d), interval);
             for p in &bvh.packets {

@@ -25,6 +25,10 @@ impl Sphere {
 
     /// The nearest root of the ray–sphere quadratic inside `interval`, if any.
     ///
+    /// The ray's direction must have unit length (every ray the camera and the
+    /// materials make has), so that a = B·B = 1 drops out of the formulas: one
+    /// division per sphere instead of three.
+    ///
     /// In `f32` the textbook discriminant b² − ac loses every significant digit
     /// when a small ray grazes a large sphere (the radius-1000 ground of the
     /// cover scene shows rings). Following Haines et al., *Ray Tracing Gems*
@@ -33,22 +37,27 @@ impl Sphere {
     /// cancellation-free pair t = c/q, t = q/a.
     #[inline]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
+        debug_assert!(
+            (ray.direction.length_squared() - 1.0).abs() < 1e-4,
+            "ray direction {} is not unit length",
+            ray.direction
+        );
         let f = ray.origin - self.center;
-        let a = ray.direction.length_squared();
         let half_b = f.dot(ray.direction);
         let c = f.length_squared() - self.radius * self.radius;
-        let l = f - (half_b / a) * ray.direction;
-        let discriminant = a * (self.radius * self.radius - l.length_squared());
+        let l = f - half_b * ray.direction;
+        let discriminant = self.radius * self.radius - l.length_squared();
         if discriminant < 0.0 {
             return None;
         }
         let sqrt_d = discriminant.sqrt();
         let q = -half_b - sqrt_d.copysign(half_b);
-        // q is zero only for a degenerate ray (zero direction through the centre).
+        // q is zero only for a ray that starts on the sphere tangent to it:
+        // it touches at t = 0, which no interval of the renderer includes.
         if q == 0.0 {
             return None;
         }
-        let (r1, r2) = (c / q, q / a);
+        let (r1, r2) = (c / q, q);
         let (near, far) = if r1 <= r2 { (r1, r2) } else { (r2, r1) };
         if interval.surrounds(near) {
             Some(near)

@@ -333,7 +333,8 @@ impl Scene {
         })
     }
 
-    /// The nearest hit of `ray` within `interval`.
+    /// The nearest hit of `ray` within `interval`; the ray's direction must
+    /// have unit length.
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let hit = self.bvh.hit(ray, interval)?;
