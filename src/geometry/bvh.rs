@@ -86,6 +86,9 @@ pub struct Bvh {
     /// Node 0 is the root; empty when there are no spheres.
     nodes: Vec<Node>,
     packets: Vec<Packet>,
+    /// Whether the processor has AVX2, asked once when the tree is built:
+    /// asking for every ray cost ≈ 20 instructions per ray.
+    avx2: bool,
 }
 
 impl Bvh {
@@ -95,6 +98,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(binary.len() / 3 + 1),
             packets: Vec::with_capacity(spheres.len().div_ceil(2)),
+            avx2: has_avx2(),
         };
         if binary.is_empty() {
             return bvh;
@@ -180,7 +184,7 @@ impl Bvh {
         ];
         let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
         let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
-        let sphere_ray = SphereRay::new(ray, interval);
+        let sphere_ray = SphereRay::new(ray, interval, self.avx2);
         let t_min = Vec4::splat(interval.min);
         let mut closest = interval.max;
         let mut best = NO_CHILD;
@@ -271,13 +275,13 @@ struct SphereRay {
     dy: Vec4,
     dz: Vec4,
     t_min: Vec4,
-    /// Whether the processor has AVX2 (asked once per ray, not per packet).
+    /// Whether the processor has AVX2 (the tree's answer).
     avx2: bool,
 }
 
 impl SphereRay {
     #[inline(always)]
-    fn new(ray: &Ray, interval: Interval) -> Self {
+    fn new(ray: &Ray, interval: Interval, avx2: bool) -> Self {
         let (o, d) = (ray.origin, ray.direction);
         SphereRay {
             ox: Vec4::splat(o.x),
@@ -287,10 +291,7 @@ impl SphereRay {
             dy: Vec4::splat(d.y),
             dz: Vec4::splat(d.z),
             t_min: Vec4::splat(interval.min),
-            #[cfg(target_arch = "x86_64")]
-            avx2: std::arch::is_x86_feature_detected!("avx2"),
-            #[cfg(not(target_arch = "x86_64"))]
-            avx2: false,
+            avx2,
         }
     }
 
@@ -301,7 +302,7 @@ impl SphereRay {
     fn hit_packet(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
-            // SAFETY: the processor has AVX2, checked just above.
+            // SAFETY: `avx2` is true only when `has_avx2` found AVX2.
             #[allow(unsafe_code)]
             return unsafe { self.hit_packet_avx2(p, closest) };
         }
@@ -443,6 +444,18 @@ impl SphereRay {
         let equal = _mm256_cmp_ps::<_CMP_EQ_OQ>(t, _mm256_set1_ps(t_best));
         let lane = (_mm256_movemask_ps(equal) as u32).trailing_zeros() as usize & 7;
         Some((t_best, p.index[lane]))
+    }
+}
+
+/// Whether the 8-lane AVX2 packet test can run on this processor.
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
@@ -641,7 +654,7 @@ mod tests {
             );
             let d = crate::sampling::unit_vector(&mut rng);
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
-            let ray = SphereRay::new(&Ray::new(origin, d), interval);
+            let ray = SphereRay::new(&Ray::new(origin, d), interval, true);
             for p in &bvh.packets {
                 let halves = ray.hit_packet_halves(p, interval.max);
                 // SAFETY: AVX2 was detected above.
