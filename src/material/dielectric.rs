@@ -61,7 +61,9 @@ impl Dielectric {
             Some(r) if self.refract_only || reflectance(cos_theta, eta_ratio) <= rng.next_f32() => {
                 r.normalize()
             }
-            _ => reflect(direction, hit.normal),
+            // The normal (P − C)/R is unit only to within ~1e-4 on small
+            // spheres far from the origin; the sphere tests need unit rays.
+            _ => reflect(direction, hit.normal).normalize(),
         };
         Some(Scatter {
             attenuation: Color::ONE,

@@ -88,10 +88,11 @@ pub fn bounce_direction(model: BounceModel, normal: Vec3, rng: &mut Rng) -> Vec3
     // cosθ of the result is |d|/2, while f32 cancellation tilts a short d by
     // up to ~1e-7/|d| radians: below |d|² = 1e-6 rounding could tip the
     // direction under the surface (or to NaN at zero), so take the normal.
-    // The fallback is hit with probability 2.5e-7 (|d|² is uniform on [0, 4]).
+    // The fallback is hit with probability 2.5e-7 (|d|² is uniform on [0, 4]);
+    // it is normalised because the hit normal is unit only to within ~1e-4.
     let len2 = d.length_squared();
     if len2 < 1e-6 {
-        normal
+        normal.normalize()
     } else {
         d / len2.sqrt()
     }
