@@ -41,17 +41,32 @@ impl RenderStats {
 
 /// The sub-pixel offset in [-0.5, 0.5)² of sample `index` of `spp`.
 ///
-/// Stratified sampling puts the first k² samples (k = ⌊√spp⌋) one in each cell
-/// of a k×k grid over the pixel; any remaining samples, and all samples of
-/// random sampling, are uniform over the pixel.
+/// - Random: uniform over the pixel.
+/// - Centre: the pixel's centre, every time (the notes' single ray a pixel).
+/// - Stratified: the first k² samples (k = ⌊√spp⌋) fall one in each cell of
+///   a k×k grid over the pixel, uniform within its cell; any remaining
+///   samples are uniform over the pixel. Which cell a sample index gets is a
+///   permutation drawn by `pixel_key` (see [`stratum`]), so that the samples
+///   of an unfinished render (a pass, a stop) are spread over the pixel
+///   rather than all in its first rows of cells.
 #[inline]
-pub fn pixel_offset(sampling: Sampling, index: u32, spp: u32, rng: &mut Rng) -> (f32, f32) {
+pub fn pixel_offset(
+    sampling: Sampling,
+    index: u32,
+    spp: u32,
+    pixel_key: u64,
+    rng: &mut Rng,
+) -> (f32, f32) {
+    if sampling == Sampling::Center {
+        return (0.0, 0.0);
+    }
     let (jx, jy) = (rng.next_f32(), rng.next_f32());
     if sampling == Sampling::Stratified {
         let k = (spp as f64).sqrt() as u32;
         if index < k * k {
+            let cell_index = stratum(index, k * k, pixel_key);
             let inv = 1.0 / k as f32;
-            let (cx, cy) = ((index % k) as f32, (index / k) as f32);
+            let (cx, cy) = ((cell_index % k) as f32, (cell_index / k) as f32);
             // In f32, (c + j)·(1/k) rounds to 1 when j is the largest value
             // below 1 in the last cell: keep it below 1 so the offset stays < 0.5.
             let below_one = 1.0 - f32::EPSILON / 2.0;
@@ -60,6 +75,41 @@ pub fn pixel_offset(sampling: Sampling, index: u32, spp: u32, rng: &mut Rng) -> 
         }
     }
     (jx - 0.5, jy - 0.5)
+}
+
+/// The key of a pixel's stratum permutation, from the render seed and the
+/// pixel index.
+#[inline]
+pub fn pixel_key(seed: u64, pixel: u64) -> u64 {
+    crate::rng::mix64(seed ^ crate::rng::mix64(pixel ^ 0x5354_5241_5441))
+}
+
+/// The grid cell, in `0..cells`, of stratified sample `index < cells`: a
+/// permutation of the indices chosen by `key`.
+///
+/// A keyed bijection of the `b`-bit integers (xor, multiplications by odd
+/// constants and xor-shifts are each invertible modulo 2^b) is applied until
+/// the value falls below `cells` ("cycle walking", which keeps it a
+/// bijection of `0..cells`), then rotated by a keyed amount, so that for a
+/// random key every index is equally likely to get every cell.
+#[inline]
+pub fn stratum(index: u32, cells: u32, key: u64) -> u32 {
+    debug_assert!(index < cells);
+    let mask = cells.next_power_of_two() - 1;
+    let (k0, k1) = (key as u32, (key >> 32) as u32);
+    let mut i = index;
+    loop {
+        i ^= k0 & mask;
+        i = i.wrapping_mul(0x2C1B_3C6D | 1) & mask;
+        i ^= i >> 3;
+        i = i.wrapping_add(k0 >> 16) & mask;
+        i = i.wrapping_mul(0x297A_2D39) & mask;
+        i ^= i >> 2;
+        if i < cells {
+            break;
+        }
+    }
+    ((u64::from(i) + u64::from(k1)) % u64::from(cells)) as u32
 }
 
 /// Adds samples `samples` (a range of sample indices, each in
@@ -209,9 +259,10 @@ fn render_row_generic(
     let width = sums.len().min(counts.len());
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
+        let key = pixel_key(s.seed, pixel);
         for index in samples.clone() {
             let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
-            let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, &mut rng);
+            let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, key, &mut rng);
             let ray = scene.camera.ray(x as u32, y, dx, dy, &mut rng);
             let c = radiance(scene, ray, &mut rng, &mut stats.rays);
             stats.samples += 1;

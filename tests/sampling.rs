@@ -3,7 +3,7 @@
 mod common;
 
 use common::{assert_agree, builtin_scene, pixel_stats};
-use lumen::render::{pixel_offset, render};
+use lumen::render::{pixel_key, pixel_offset, render, stratum};
 use lumen::rng::Rng;
 use lumen::scene::Sampling;
 
@@ -19,7 +19,8 @@ fn stratified_samples_fill_every_stratum_exactly_once() {
             let mut seen = vec![0u32; (k * k) as usize];
             for index in 0..spp {
                 let mut rng = Rng::for_sample(1, pixel, u64::from(index));
-                let (dx, dy) = pixel_offset(Sampling::Stratified, index, spp, &mut rng);
+                let key = pixel_key(1, pixel);
+                let (dx, dy) = pixel_offset(Sampling::Stratified, index, spp, key, &mut rng);
                 assert!((-0.5..0.5).contains(&dx) && (-0.5..0.5).contains(&dy));
                 if index >= k * k {
                     continue; // the samples beyond k² are uniform
@@ -29,7 +30,8 @@ fn stratified_samples_fill_every_stratum_exactly_once() {
                 let (cx, cy) = (cx.min(k - 1), cy.min(k - 1));
                 // The cell the sample is in must be the one its index owns,
                 // up to rounding at a cell boundary.
-                let (ix, iy) = (index % k, index / k);
+                let owned = stratum(index, k * k, key);
+                let (ix, iy) = (owned % k, owned / k);
                 let inside = |t: f64, c: u32| {
                     let lo = f64::from(c) / f64::from(k) - BOUNDARY;
                     let hi = f64::from(c + 1) / f64::from(k) + BOUNDARY;
@@ -52,6 +54,72 @@ fn stratified_samples_fill_every_stratum_exactly_once() {
 }
 
 #[test]
+fn strata_are_permutations_and_every_prefix_is_spread_over_the_pixel() {
+    for cells in [1u32, 2, 4, 9, 16, 25, 100, 1024] {
+        for key in 0..50u64 {
+            let key = lumen::rng::mix64(key);
+            let mut seen = vec![false; cells as usize];
+            for index in 0..cells {
+                let c = stratum(index, cells, key);
+                assert!(
+                    c < cells && !seen[c as usize],
+                    "cells {cells}: not a permutation"
+                );
+                seen[c as usize] = true;
+            }
+        }
+    }
+    // A render stopped after one sample per pixel must not be biased towards
+    // a corner: over many pixels the first sample's offset has mean 0 and
+    // variance 1/12 per axis (uniform over the pixel), 5 standard errors.
+    let (spp, n) = (16u32, 100_000u64);
+    let (mut sx, mut sy) = (0.0f64, 0.0f64);
+    let mut first_cells = vec![0u64; 16];
+    for pixel in 0..n {
+        let key = pixel_key(9, pixel);
+        let mut rng = Rng::for_sample(9, pixel, 0);
+        let (dx, dy) = pixel_offset(Sampling::Stratified, 0, spp, key, &mut rng);
+        sx += f64::from(dx);
+        sy += f64::from(dy);
+        first_cells[stratum(0, 16, key) as usize] += 1;
+    }
+    let se = (1.0 / 12.0 / n as f64).sqrt();
+    assert!(
+        (sx / n as f64).abs() < 5.0 * se,
+        "mean dx {}",
+        sx / n as f64
+    );
+    assert!(
+        (sy / n as f64).abs() < 5.0 * se,
+        "mean dy {}",
+        sy / n as f64
+    );
+    // Every cell is equally likely for the first sample: chi-square with 15
+    // degrees of freedom; 44.3 is its 0.9999 quantile.
+    let expected = n as f64 / 16.0;
+    let chi2: f64 = first_cells
+        .iter()
+        .map(|&o| (o as f64 - expected).powi(2) / expected)
+        .sum();
+    assert!(
+        chi2 < 44.3,
+        "first-sample cells {first_cells:?}, chi2 {chi2}"
+    );
+}
+
+#[test]
+fn centre_sampling_always_hits_the_pixel_centre() {
+    for index in 0..8 {
+        let mut rng = Rng::for_sample(3, 7, index);
+        let key = pixel_key(3, 7);
+        assert_eq!(
+            pixel_offset(Sampling::Center, index as u32, 8, key, &mut rng),
+            (0.0, 0.0)
+        );
+    }
+}
+
+#[test]
 fn offsets_stay_below_half_even_at_the_end_of_the_last_stratum() {
     // The largest uniform value, 1 − 2⁻²⁴, in the last cell of a 2×2 grid is
     // (1 + 0.99999994)·0.5, which rounds to 1 in f32: the offset must still be
@@ -62,7 +130,7 @@ fn offsets_stay_below_half_even_at_the_end_of_the_last_stratum() {
         for pixel in 0..(1u64 << 24) {
             let index = 3;
             let mut rng = Rng::for_sample(0, pixel, index);
-            let (dx, dy) = pixel_offset(sampling, index as u32, 4, &mut rng);
+            let (dx, dy) = pixel_offset(sampling, index as u32, 4, pixel_key(0, pixel), &mut rng);
             max = max.max(dx).max(dy);
         }
         assert!(max < 0.5, "{sampling:?}: offset {max}");
@@ -80,7 +148,7 @@ fn random_offsets_are_uniform_over_the_pixel() {
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for i in 0..n {
         let mut rng = Rng::for_sample(2, i, 0);
-        let (dx, _) = pixel_offset(Sampling::Random, 0, 16, &mut rng);
+        let (dx, _) = pixel_offset(Sampling::Random, 0, 16, pixel_key(2, i), &mut rng);
         s += f64::from(dx);
         s2 += f64::from(dx) * f64::from(dx);
     }

@@ -45,7 +45,7 @@ scenes! {
     "normals-unit", "The unit normal used directly as a colour" => || normals(ShadingDesc::NormalsUnit, false, 1);
     "normals-raw", "The un-normalised normal P - C as a colour: it looks dark" => || normals(ShadingDesc::NormalsRaw, false, 1);
     "normals-brightened", "Normals brightened with grey: 0.5 * (N + 1)" => || normals(ShadingDesc::NormalsBrightened, false, 1);
-    "aa-1spp", "Antialiasing: one sample per pixel shows jaggies" => || normals(ShadingDesc::NormalsBrightened, true, 1);
+    "aa-1spp", "Antialiasing: one ray through each pixel centre shows jaggies" => || normals(ShadingDesc::NormalsBrightened, true, 1);
     "aa-100spp", "Antialiasing: 100 random samples per pixel, averaged" => || normals(ShadingDesc::NormalsBrightened, true, 100);
     "diffuse-first", "First diffuse attempt: one bounce, objects with an intrinsic colour" => diffuse_first;
     "diffuse-absorb-half", "One bounce, colour multiplied by a reflectivity of 0.5" => || diffuse_grey(1.0, false, 2);
@@ -135,10 +135,17 @@ impl Builder {
     }
 }
 
+/// Settings of a figure: a single sample goes through the pixel's centre, as
+/// in the notes' figures before antialiasing; more samples are jittered.
 fn render(spp: u32, gamma: f64) -> RenderDesc {
     RenderDesc {
         samples_per_pixel: spp,
         gamma,
+        sampling: if spp == 1 {
+            SamplingDesc::Center
+        } else {
+            SamplingDesc::Random
+        },
         ..RenderDesc::default()
     }
 }

@@ -331,6 +331,7 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
 const SAMPLINGS: &[(&str, SamplingDesc)] = &[
     ("random", SamplingDesc::Random),
     ("stratified", SamplingDesc::Stratified),
+    ("center", SamplingDesc::Center),
 ];
 
 const SHADINGS: &[(&str, ShadingDesc)] = &[

@@ -89,6 +89,9 @@ pub enum SamplingDesc {
     /// One random point in each cell of a √N×√N grid (the remaining samples,
     /// when N is not square, are random).
     Stratified,
+    /// The pixel's centre for every sample: no antialiasing (the notes'
+    /// one-sample figures).
+    Center,
 }
 
 /// What the colour of a camera ray shows.
