@@ -82,8 +82,13 @@ pub fn parse_duration(text: &str) -> Result<Duration, String> {
     let bad = || format!("'{text}' is not a duration; write e.g. 90s, 1.5m or 2h");
     let value: f64 = number.trim().parse().map_err(|_| bad())?;
     let seconds = value * unit;
-    if !(seconds > 0.0) || !seconds.is_finite() || seconds > 1e9 {
+    if !(seconds > 0.0) {
         return Err(format!("'{text}': a duration must be positive"));
+    }
+    if !(seconds <= 1e9) {
+        return Err(format!(
+            "'{text}': a duration must be at most 1e9 seconds (31 years)"
+        ));
     }
     Ok(Duration::from_secs_f64(seconds))
 }
@@ -368,6 +373,8 @@ mod tests {
         for bad in ["", "s", "0s", "-1m", "ten", "5d", "nan", "inf"] {
             assert!(parse_duration(bad).is_err(), "{bad}");
         }
+        assert!(parse_duration("2e9s").unwrap_err().contains("at most"));
+        assert!(parse_duration("-1m").unwrap_err().contains("positive"));
     }
 
     fn small_desc() -> SceneDesc {

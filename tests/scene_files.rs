@@ -158,3 +158,34 @@ fn overrides_replace_the_files_settings() {
     assert_eq!((s.width, s.height), (40, 20), "height keeps the proportion");
     assert_eq!((s.samples_per_pixel, s.max_depth, s.seed), (3, 5, 11));
 }
+
+/// `SceneDesc` also derives serde's `Deserialize` for library users; it must
+/// read every example exactly as lumen's own reader does.
+#[test]
+fn serde_derive_and_the_scene_reader_agree_on_every_example() {
+    let mut checked = 0;
+    for entry in std::fs::read_dir(examples_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (ours, theirs): (_, lumen::scene::SceneDesc) =
+            match path.extension().and_then(|e| e.to_str()) {
+                Some("toml") => (
+                    SceneFile::parse("x", text.clone(), Format::Toml)
+                        .unwrap()
+                        .desc,
+                    toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display())),
+                ),
+                Some("json") => (
+                    SceneFile::parse("x", text.clone(), Format::Json)
+                        .unwrap()
+                        .desc,
+                    serde_json::from_str(&text)
+                        .unwrap_or_else(|e| panic!("{}: {e}", path.display())),
+                ),
+                _ => continue,
+            };
+        assert_eq!(ours, theirs, "{}", path.display());
+        checked += 1;
+    }
+    assert!(checked > BUILTINS.len());
+}
