@@ -1,0 +1,90 @@
+//! `lumen gallery` and `lumen bench`.
+
+use crate::{progress_bar, summary, write_stdout, SettingArgs};
+use anyhow::{anyhow, Result};
+use lumen::bench;
+use lumen::render::RenderStats;
+use lumen::scene::builtin::BUILTINS;
+use std::path::Path;
+use std::time::Instant;
+
+pub(crate) fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
+    let start = Instant::now();
+    let mut total = RenderStats::default();
+    let bar = progress_bar(BUILTINS.len() as u64);
+    lumen::gallery::make_gallery(dir, &args.overrides(), &mut |name, stats| {
+        bar.inc(1);
+        bar.set_message(name.to_string());
+        total.add(stats);
+    })?;
+    bar.finish_and_clear();
+    eprintln!(
+        "gallery of {} scenes written to {}",
+        BUILTINS.len(),
+        dir.join("index.html").display()
+    );
+    eprintln!("{}", summary(&total, &total, start.elapsed()));
+    Ok(())
+}
+
+pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
+    outln!(
+        "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
+        rayon::current_num_threads(),
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+        lumen::render::Isa::detect().name()
+    )?;
+    outln!(
+        "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
+        "spheres",
+        "build s",
+        "BVH MB",
+        "rays",
+        "median s",
+        "M rays/s",
+        "M samples/s"
+    )?;
+    for &n in fields {
+        let p = bench::measure_field(n, spp, runs as usize)
+            .map_err(|e| anyhow!("field of {n} spheres: {e}"))?;
+        let m = &p.measurement;
+        outln!(
+            "{:>9} {:>9.3} {:>9.1} {:>10} {:>10.3} {:>10.2} {:>12.2}",
+            p.spheres,
+            p.build.as_secs_f64(),
+            p.bvh_bytes as f64 / 1e6,
+            m.stats.rays,
+            m.median.as_secs_f64(),
+            m.rays_per_second() / 1e6,
+            m.samples_per_second() / 1e6
+        )?;
+    }
+    Ok(())
+}
+
+pub(crate) fn bench_command(spp: u32, runs: u32) -> Result<()> {
+    outln!(
+        "lumen bench: {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
+        rayon::current_num_threads(),
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+        lumen::render::Isa::detect().name()
+    )?;
+    outln!(
+        "{:<24} {:>10} {:>14} {:>16}",
+        "workload",
+        "median s",
+        "M rays/s",
+        "M samples/s"
+    )?;
+    for w in bench::standard_workloads(spp) {
+        let m = bench::measure(&w, runs as usize).map_err(|e| anyhow!("{}: {e}", w.name))?;
+        outln!(
+            "{:<24} {:>10.3} {:>14.2} {:>16.2}",
+            m.name,
+            m.median.as_secs_f64(),
+            m.rays_per_second() / 1e6,
+            m.samples_per_second() / 1e6
+        )?;
+    }
+    Ok(())
+}

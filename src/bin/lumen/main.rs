@@ -1,0 +1,276 @@
+//! The `lumen` command: a thin layer over the library.
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use lumen::progressive::parse_duration;
+use lumen::render::RenderStats;
+use lumen::scene::builtin::BUILTINS;
+use lumen::scene::Overrides;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// Most worker threads accepted by `--threads` (far more than any machine
+/// lumen runs on has cores; each thread costs a stack).
+const MAX_THREADS: i64 = 1024;
+
+/// lumen: a physically based path tracer following Ray Tracing in One Weekend.
+#[derive(Parser)]
+#[command(name = "lumen", version, about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a built-in scene or a scene file to an image file (.ppm, .png, .pfm or .exr).
+    Render {
+        /// Name of a built-in scene (see `lumen scenes`) or a scene file
+        /// (.toml or .json, see docs/scene-format.md). Command-line settings
+        /// override the scene's own.
+        scene: String,
+        /// Output image; the extension chooses the format.
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        settings: SettingArgs,
+        #[command(flatten)]
+        progressive: ProgressiveArgs,
+    },
+    /// List the built-in scenes with their captions, or export one as a file.
+    Scenes {
+        #[command(subcommand)]
+        action: Option<ScenesCommand>,
+    },
+    /// Render every built-in scene into DIR, with an index.html.
+    Gallery {
+        /// Folder for the images and index.html (created if missing).
+        dir: PathBuf,
+        #[command(flatten)]
+        settings: SettingArgs,
+    },
+    /// Measure throughput (rays/s, samples/s) on fixed workloads.
+    Bench {
+        /// Samples per pixel of each workload.
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..))]
+        spp: u32,
+        /// Timed runs per workload; the median is reported.
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+        runs: u32,
+        /// Worker threads (default: one per core).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
+        threads: Option<u32>,
+        /// Instead of the standard workloads, render cover-like fields of
+        /// 10², 10³, 10⁴, 10⁵ and 10⁶ small spheres (how cost grows with the scene).
+        #[arg(long, conflicts_with = "field")]
+        scaling: bool,
+        /// Render only the cover-like field of about N small spheres (to measure
+        /// one size's peak memory with /usr/bin/time -v).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+        field: Option<u64>,
+    },
+}
+
+#[derive(Subcommand)]
+enum ScenesCommand {
+    /// Write a built-in scene (or convert a scene file) as a scene file.
+    Export {
+        /// Name of a built-in scene, or a scene file to convert.
+        name: String,
+        /// Output file (default: standard output); .toml or .json chooses the format.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Format when writing to standard output.
+        #[arg(long, value_enum, default_value_t = FormatArg::Toml)]
+        format: FormatArg,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FormatArg {
+    Toml,
+    Json,
+}
+
+#[derive(Args, Clone, Default)]
+struct SettingArgs {
+    /// Image width in pixels (the height follows the aspect ratio).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    width: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    spp: Option<u32>,
+    /// Maximum path depth in ray segments (1 = no bounces).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    depth: Option<u32>,
+    /// Random seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: one per core). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
+    threads: Option<u32>,
+}
+
+/// How a render is saved, stopped and resumed.
+#[derive(Args, Clone, Default)]
+struct ProgressiveArgs {
+    /// Checkpoint file, saved during the render so that it can be resumed
+    /// [default: the output path + .lumen-ckpt].
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Save the image and the checkpoint at most this often (e.g. 30s, 5m)
+    /// instead of after every pass.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    checkpoint_interval: Option<Duration>,
+    /// Continue the render saved in the checkpoint; the scene and settings
+    /// must be the same as when it was made.
+    #[arg(long)]
+    resume: bool,
+    /// Stop after the last pass that ends within this time (e.g. 90s, 10m,
+    /// 2h) and write the image; --spp stays the upper bound.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
+    time_limit: Option<Duration>,
+}
+
+impl SettingArgs {
+    fn overrides(&self) -> Overrides {
+        Overrides {
+            width: self.width,
+            samples_per_pixel: self.spp,
+            max_depth: self.depth,
+            seed: self.seed,
+        }
+    }
+}
+
+/// Writes to standard output. A closed pipe (`lumen scenes | head -1`) ends
+/// the output quietly; any other failure is an error, never a panic.
+fn write_stdout(text: &str) -> Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write to standard output"),
+    }
+}
+
+/// `println!` through [`write_stdout`].
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        write_stdout(&format!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+mod commands;
+mod render;
+mod scenes;
+mod signals;
+
+use commands::{bench_command, gallery_command, scaling_command};
+use render::render_command;
+use scenes::export_command;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("lumen: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Render {
+            scene,
+            output,
+            settings,
+            progressive,
+        } => with_threads(settings.threads, || {
+            render_command(&scene, &output, &settings, &progressive)
+        }),
+        Command::Scenes { action: None } => {
+            let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
+            for b in BUILTINS {
+                outln!("{:width$}  {}", b.name, b.caption)?;
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Scenes {
+            action:
+                Some(ScenesCommand::Export {
+                    name,
+                    output,
+                    format,
+                }),
+        } => {
+            export_command(&name, output.as_deref(), format)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Gallery { dir, settings } => {
+            with_threads(settings.threads, || gallery_command(&dir, &settings))?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bench {
+            spp,
+            runs,
+            threads,
+            scaling,
+            field,
+        } => {
+            with_threads(threads, || {
+                let fields: Vec<usize> = match (scaling, field) {
+                    (true, _) => vec![100, 1_000, 10_000, 100_000, 1_000_000],
+                    (false, Some(n)) => vec![n as usize],
+                    (false, None) => return bench_command(spp, runs),
+                };
+                scaling_command(&fields, spp, runs)
+            })?;
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// Runs `f` on a thread pool of `threads` workers, or on rayon's default pool.
+fn with_threads<T>(threads: Option<u32>, f: impl FnOnce() -> Result<T> + Send) -> Result<T>
+where
+    T: Send,
+{
+    match threads {
+        None => f(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .context("cannot start worker threads")?
+            .install(f),
+    }
+}
+
+/// One line of counts: rates of this run (`run`) over `elapsed`, totals of
+/// the whole image (`all`, which includes earlier runs when resumed).
+fn summary(run: &RenderStats, all: &RenderStats, elapsed: Duration) -> String {
+    format!(
+        "time {:.2} s, {:.2} M samples/s, {:.2} M rays/s, {} rays, {} dropped samples",
+        elapsed.as_secs_f64(),
+        run.samples_per_second(elapsed) / 1e6,
+        run.rays_per_second(elapsed) / 1e6,
+        all.rays,
+        all.dropped
+    )
+}
+
+fn progress_bar(total: u64) -> ProgressBar {
+    // indicatif draws nothing when stderr is not a terminal.
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta}",
+        )
+        .expect("progress template is valid"),
+    );
+    bar
+}

@@ -1,0 +1,208 @@
+//! `lumen render`: a progressive render with checkpoints, interrupts and a time limit.
+
+use crate::scenes::load_scene;
+use crate::signals::{install_stop_handler, quit_if_asked, saving, EXIT_INTERRUPTED};
+use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs};
+use anyhow::{anyhow, bail, Context, Result};
+use lumen::checkpoint::{self, Checkpoint};
+use lumen::output;
+use lumen::progressive::{Session, SessionError, StopReason};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Where a path points once its directory is resolved (the file itself may
+/// not exist yet): `./out.png`, `out.png` and `$PWD/out.png` are one place.
+fn resolved(path: &Path) -> PathBuf {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    match path.file_name() {
+        Some(name) => dir.join(name),
+        None => dir,
+    }
+}
+
+/// The checkpoint is overwritten after every pass and deleted at the end:
+/// it must be neither the output image nor the scene file, and a file
+/// already there must be a checkpoint, not something of the user's.
+fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
+    let place = resolved(ckpt);
+    if place == resolved(out) {
+        bail!(
+            "{}: the checkpoint cannot be the output image; choose another --checkpoint",
+            ckpt.display()
+        );
+    }
+    if Path::new(scene).is_file() && place == resolved(Path::new(scene)) {
+        bail!(
+            "{}: the checkpoint cannot be the scene file; choose another --checkpoint",
+            ckpt.display()
+        );
+    }
+    if ckpt.is_file() {
+        let mut magic = [0u8; checkpoint::MAGIC.len()];
+        let is_checkpoint = std::fs::File::open(ckpt)
+            .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+            .is_ok_and(|()| &magic == checkpoint::MAGIC);
+        if !is_checkpoint {
+            bail!(
+                "{}: exists and is not a lumen checkpoint; refusing to overwrite it (choose another --checkpoint)",
+                ckpt.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn render_command(
+    name: &str,
+    out: &Path,
+    args: &SettingArgs,
+    prog: &ProgressiveArgs,
+) -> Result<ExitCode> {
+    let desc = load_scene(name)?.resolve(name, &args.overrides())?;
+    output::ImageFormat::from_path(out)?;
+    let ckpt_path = prog
+        .checkpoint
+        .clone()
+        .unwrap_or_else(|| checkpoint::default_path(out));
+    check_checkpoint_path(&ckpt_path, out, name)?;
+    // Refuse unwritable destinations now, not after a long render.
+    output::check_writable(out)?;
+    output::check_writable(&ckpt_path).context("checkpoint")?;
+    let compile_error = |e: SessionError| match e {
+        SessionError::Scene(e) => anyhow!("scene '{name}': {e}"),
+        e => anyhow!(e),
+    };
+    let mut session = if prog.resume {
+        if !ckpt_path.exists() {
+            bail!(
+                "--resume: there is no checkpoint at {}",
+                ckpt_path.display()
+            );
+        }
+        let ckpt = Checkpoint::read(&ckpt_path)?;
+        Session::resume(&desc, ckpt, &ckpt_path).map_err(compile_error)?
+    } else {
+        let session = Session::new(&desc).map_err(compile_error)?;
+        if ckpt_path.exists() {
+            eprintln!(
+                "lumen: note: starting afresh; the checkpoint {} will be replaced (--resume continues it)",
+                ckpt_path.display()
+            );
+        }
+        session
+    };
+
+    let stop = Arc::new(AtomicBool::new(false));
+    install_stop_handler(
+        &stop,
+        [output::temp_path(out), output::temp_path(&ckpt_path)],
+    )?;
+
+    let s = session.scene().settings.clone();
+    let resumed_from = session.spp_done();
+    eprintln!(
+        "{name}: {}x{} at {} spp, depth {}{}",
+        s.width,
+        s.height,
+        s.samples_per_pixel,
+        s.max_depth,
+        if prog.resume {
+            format!(
+                ", resuming at {resumed_from} spp from {}",
+                ckpt_path.display()
+            )
+        } else {
+            String::new()
+        }
+    );
+    let save = |session: &Session| -> Result<()> {
+        let _saving = saving();
+        output::write_image(out, session.film(), s.gamma)?;
+        session
+            .checkpoint()
+            .write(&ckpt_path)
+            .context("cannot save the checkpoint")?;
+        quit_if_asked();
+        Ok(())
+    };
+    let pixels = u64::from(s.width) * u64::from(s.height);
+    let bar = progress_bar(pixels * u64::from(s.samples_per_pixel - resumed_from));
+    let start = Instant::now();
+    let mut last_save = start;
+    let run = session.run(&stop, prog.time_limit, &|n| bar.inc(n), &mut |session,
+                                                                          pass|
+     -> Result<
+        (),
+    > {
+        bar.suspend(|| {
+            eprintln!(
+                "pass {}: samples {}..{} in {:.3} s, {} of {} spp",
+                pass.number,
+                pass.samples.start,
+                pass.samples.end,
+                pass.duration.as_secs_f64(),
+                session.spp_done(),
+                session.spp_total()
+            )
+        });
+        // The finished image is written once, below.
+        let due = prog
+            .checkpoint_interval
+            .is_none_or(|every| last_save.elapsed() >= every);
+        if !session.is_complete() && due {
+            save(session)?;
+            last_save = Instant::now();
+        }
+        Ok(())
+    })?;
+    let elapsed = start.elapsed();
+    bar.finish_and_clear();
+    let (held, total) = (session.spp_done(), session.spp_total());
+    let code = match run.reason {
+        StopReason::Complete => {
+            let _saving = saving();
+            output::write_image(out, session.film(), s.gamma)?;
+            quit_if_asked();
+            match std::fs::remove_file(&ckpt_path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    eprintln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
+                }
+                _ => {}
+            }
+            eprintln!("{name}: {total} spp written to {}", out.display());
+            ExitCode::SUCCESS
+        }
+        reason if held == 0 => {
+            debug_assert_eq!(reason, StopReason::Interrupted);
+            eprintln!("lumen: interrupted before the first pass finished; nothing written");
+            ExitCode::from(EXIT_INTERRUPTED)
+        }
+        reason => {
+            save(&session)?;
+            let why = if reason == StopReason::Interrupted {
+                "interrupted"
+            } else {
+                "time limit reached"
+            };
+            eprintln!(
+                "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
+                out.display(),
+                ckpt_path.display()
+            );
+            if reason == StopReason::Interrupted {
+                ExitCode::from(EXIT_INTERRUPTED)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+    };
+    eprintln!("{}", summary(&run.stats, &session.stats(), elapsed));
+    Ok(code)
+}

@@ -1,0 +1,85 @@
+//! Where scenes come from (built-in names or files) and `lumen scenes export`.
+
+use crate::{write_stdout, FormatArg};
+use anyhow::{anyhow, bail, Context, Result};
+use lumen::output;
+use lumen::scene::builtin::{self, BUILTINS};
+use lumen::scene::file::{self, Format, SceneFile};
+use lumen::scene::{hint, Overrides, Scene, SceneDesc};
+use std::path::Path;
+
+/// Where a scene comes from: a built-in name or a file.
+pub(crate) enum SceneSource {
+    Builtin(SceneDesc),
+    File(SceneFile),
+}
+
+impl SceneSource {
+    pub(crate) fn desc(&self) -> &SceneDesc {
+        match self {
+            SceneSource::Builtin(d) => d,
+            SceneSource::File(f) => &f.desc,
+        }
+    }
+
+    /// The description with the command-line overrides, validated, so that
+    /// a mistake in a file is reported with its line and column before any
+    /// work starts.
+    pub(crate) fn resolve(&self, name: &str, overrides: &Overrides) -> Result<SceneDesc> {
+        let mut desc = self.desc().clone();
+        overrides.apply(&mut desc);
+        match self {
+            SceneSource::Builtin(_) => {
+                Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
+            }
+            SceneSource::File(f) => {
+                f.compile(overrides)?;
+            }
+        }
+        Ok(desc)
+    }
+}
+
+/// A built-in scene by name, or else a scene file by path.
+pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
+    if let Some(b) = builtin::find(name) {
+        return Ok(SceneSource::Builtin(b.desc()));
+    }
+    let path = Path::new(name);
+    let looks_like_file = Format::from_extension(path).is_some()
+        || name.contains(std::path::MAIN_SEPARATOR)
+        || name.contains('/')
+        || path.exists();
+    if looks_like_file {
+        return Ok(SceneSource::File(SceneFile::read(path)?));
+    }
+    let closest = hint::closest(name, BUILTINS.iter().map(|b| b.name))
+        .map(|n| format!(" (did you mean '{n}'?)"))
+        .unwrap_or_default();
+    bail!(
+        "unknown scene '{name}'{closest}; `lumen scenes` lists the built-in scenes, \
+         and scene files end in .toml or .json"
+    )
+}
+
+pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<()> {
+    let source = load_scene(name)?;
+    let format = match out {
+        Some(path) => Format::from_extension(path)
+            .ok_or_else(|| anyhow!("{}: scene files must end in .toml or .json", path.display()))?,
+        None => match format {
+            FormatArg::Toml => Format::Toml,
+            FormatArg::Json => Format::Json,
+        },
+    };
+    let text = file::export(source.desc(), format)?;
+    match out {
+        Some(path) => {
+            output::check_writable(path)?;
+            output::write_bytes_atomic(path, text.as_bytes())?;
+            eprintln!("{name}: written to {}", path.display());
+        }
+        None => write_stdout(&text)?,
+    }
+    Ok(())
+}
