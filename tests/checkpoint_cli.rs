@@ -196,10 +196,17 @@ fn time_limit_stops_at_the_last_pass_within_budget() {
     let dir = temp_dir("time-limit");
     let out = dir.join("out.pfm");
     let args = ["render", "cover", "--width", "160", "--spp", "100000"];
+    let started = std::time::Instant::now();
     let (status, err) = run(&args, &out, &["--time-limit", "1s"]);
+    let wall = started.elapsed().as_secs_f64();
     assert!(status.success(), "{err}");
     assert!(err.contains("time limit reached"), "{err}");
     let done = passes(&err);
+    // The whole process, saves and start-up included, ends within the budget
+    // plus one pass plus a generous allowance for start-up and saving: a
+    // render that ignored the limit would run for minutes.
+    let longest = done.iter().map(|p| p.1).fold(0.0, f64::max);
+    assert!(wall < 1.0 + longest + 3.0, "ran {wall} s: {err}");
     let held: u32 = done.iter().map(|p| p.0).sum();
     assert_eq!(held, held_spp(&err));
     assert!(held > 0 && held < 100_000);
