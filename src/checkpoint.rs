@@ -337,22 +337,28 @@ impl Checkpoint {
     /// Checks that this checkpoint was made for a render of `desc` (overrides
     /// applied) by this version of lumen; the error names what differs.
     pub fn check_matches(&self, desc: &SceneDesc, path: &Path) -> Result<(), CheckpointError> {
-        let mismatch = |differences: String| CheckpointError::Mismatch {
-            path: path.to_path_buf(),
-            differences,
-        };
-        let ours = RENDERER_ID;
-        if self.lumen_version != ours {
-            return Err(mismatch(format!(
-                "written by lumen {}, this is lumen {ours}",
-                self.lumen_version
-            )));
+        self.check_description(&description_text(desc), path)
+    }
+
+    /// Checks that this checkpoint was made by this renderer for the render
+    /// whose canonical description (see [`description_text`]) is `ours`.
+    pub fn check_description(&self, ours: &str, path: &Path) -> Result<(), CheckpointError> {
+        if self.lumen_version != RENDERER_ID {
+            return Err(CheckpointError::Mismatch {
+                path: path.to_path_buf(),
+                differences: format!(
+                    "written by lumen {}, this is lumen {RENDERER_ID}",
+                    self.lumen_version
+                ),
+            });
         }
-        let ours = description_text(desc);
         if self.description == ours {
             return Ok(());
         }
-        Err(mismatch(describe_differences(&self.description, &ours)))
+        Err(CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+            differences: describe_differences(&self.description, ours),
+        })
     }
 }
 

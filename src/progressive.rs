@@ -151,15 +151,20 @@ pub struct RunSummary {
 impl Session {
     /// A new render of `desc` with no samples yet.
     pub fn new(desc: &SceneDesc) -> Result<Self, SessionError> {
-        let scene = Scene::from_desc(desc)?;
+        Ok(Self::with_scene(desc, Scene::from_desc(desc)?))
+    }
+
+    /// A new render of `desc` already compiled into `scene` (which must be
+    /// `Scene::from_desc(desc)`): spares building the scene twice.
+    pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Self {
         let film = Film::new(scene.settings.width, scene.settings.height);
-        Ok(Self {
+        Self {
             scene,
             description: description_text(desc),
             film,
             stats: RenderStats::default(),
             spp_done: 0,
-        })
+        }
     }
 
     /// Continues the render of `desc` saved in `checkpoint` (read from
@@ -170,8 +175,18 @@ impl Session {
         checkpoint: Checkpoint,
         path: &Path,
     ) -> Result<Self, SessionError> {
+        // Checked before compiling, so a mismatch is reported as such even
+        // when the checkpoint's scene would not compile any more.
         checkpoint.check_matches(desc, path)?;
-        let mut session = Self::new(desc)?;
+        Self::new(desc)?.restore(checkpoint, path)
+    }
+
+    /// Continues this new session from `checkpoint` (read from `path`, which
+    /// names it in errors). Refused unless the checkpoint was made for the
+    /// same description, overrides included.
+    pub fn restore(mut self, checkpoint: Checkpoint, path: &Path) -> Result<Self, SessionError> {
+        checkpoint.check_description(&self.description, path)?;
+        let session = &mut self;
         let s = &session.scene.settings;
         let malformed = |message: String| CheckpointError::Malformed {
             path: path.to_path_buf(),
@@ -197,7 +212,7 @@ impl Session {
         session.film = checkpoint.film;
         session.stats = checkpoint.stats;
         session.spp_done = checkpoint.spp_done;
-        Ok(session)
+        Ok(self)
     }
 
     /// The compiled scene.

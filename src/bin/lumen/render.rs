@@ -3,10 +3,10 @@
 use crate::scenes::load_scene;
 use crate::signals::{install_stop_handler, quit_if_asked, saving, EXIT_INTERRUPTED};
 use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use lumen::checkpoint::{self, Checkpoint};
 use lumen::output;
-use lumen::progressive::{Session, SessionError, StopReason};
+use lumen::progressive::{Session, StopReason};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -65,7 +65,7 @@ pub(crate) fn render_command(
     args: &SettingArgs,
     prog: &ProgressiveArgs,
 ) -> Result<ExitCode> {
-    let desc = load_scene(name)?.resolve(name, &args.overrides())?;
+    let (desc, scene) = load_scene(name)?.resolve(name, &args.overrides())?;
     output::ImageFormat::from_path(out)?;
     let ckpt_path = prog
         .checkpoint
@@ -75,10 +75,7 @@ pub(crate) fn render_command(
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
     output::check_writable(&ckpt_path).context("checkpoint")?;
-    let compile_error = |e: SessionError| match e {
-        SessionError::Scene(e) => anyhow!("scene '{name}': {e}"),
-        e => anyhow!(e),
-    };
+    let session = Session::with_scene(&desc, scene);
     let mut session = if prog.resume {
         if !ckpt_path.exists() {
             bail!(
@@ -87,9 +84,8 @@ pub(crate) fn render_command(
             );
         }
         let ckpt = Checkpoint::read(&ckpt_path)?;
-        Session::resume(&desc, ckpt, &ckpt_path).map_err(compile_error)?
+        session.restore(ckpt, &ckpt_path)?
     } else {
-        let session = Session::new(&desc).map_err(compile_error)?;
         if ckpt_path.exists() {
             eprintln!(
                 "lumen: note: starting afresh; the checkpoint {} will be replaced (--resume continues it)",

@@ -22,21 +22,19 @@ impl SceneSource {
         }
     }
 
-    /// The description with the command-line overrides, validated, so that
-    /// a mistake in a file is reported with its line and column before any
-    /// work starts.
-    pub(crate) fn resolve(&self, name: &str, overrides: &Overrides) -> Result<SceneDesc> {
+    /// The description with the command-line overrides, and the scene
+    /// compiled from it; a mistake in a file is reported with its line and
+    /// column before any work starts.
+    pub(crate) fn resolve(&self, name: &str, overrides: &Overrides) -> Result<(SceneDesc, Scene)> {
         let mut desc = self.desc().clone();
         overrides.apply(&mut desc);
-        match self {
+        let scene = match self {
             SceneSource::Builtin(_) => {
-                Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
+                Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?
             }
-            SceneSource::File(f) => {
-                f.compile(overrides)?;
-            }
-        }
-        Ok(desc)
+            SceneSource::File(f) => f.compile(overrides)?,
+        };
+        Ok((desc, scene))
     }
 }
 
