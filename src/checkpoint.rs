@@ -19,7 +19,7 @@
 //! | 4 | CRC-32 of the payload |
 //! | *n* | payload |
 //!
-//! The payload: the lumen version and the description (each as a u32 length
+//! The payload: the renderer identity and the description (each as a u32 length
 //! and UTF-8 bytes), samples per pixel done (u32), width and height (u32),
 //! samples, rays and dropped samples (u64 each), then every pixel's three
 //! `f64` sums and finally every pixel's `u32` count, row-major, top row first.
@@ -49,9 +49,9 @@ const HEADER_LEN: usize = 8 + 4 + 8 + 4;
 /// The state of an unfinished render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkpoint {
-    /// Version of lumen that wrote it; another version may compute other
-    /// samples, so it is part of what must match.
-    pub lumen_version: String,
+    /// [`RENDERER_ID`] of the lumen that wrote it; other code may compute
+    /// other samples, so it is part of what must match.
+    pub renderer_id: String,
     /// Canonical JSON of the scene description, overrides applied
     /// (see [`description_text`]).
     pub description: String,
@@ -141,8 +141,8 @@ pub fn default_path(output: &Path) -> PathBuf {
 /// progress saves its film without copying it.
 #[derive(Clone, Copy, Debug)]
 pub struct CheckpointView<'a> {
-    /// Version of lumen that writes it.
-    pub lumen_version: &'a str,
+    /// [`RENDERER_ID`] of the lumen that writes it.
+    pub renderer_id: &'a str,
     /// Canonical JSON of the scene description (see [`description_text`]).
     pub description: &'a str,
     /// Samples per pixel held by the film.
@@ -157,7 +157,7 @@ impl CheckpointView<'_> {
     /// Feeds the payload to `sink` piece by piece, so that it can be hashed
     /// and written without being held in memory (a 1200×675 film is 23 MB).
     fn payload(&self, sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>) -> std::io::Result<()> {
-        for text in [self.lumen_version, self.description] {
+        for text in [self.renderer_id, self.description] {
             sink(&(text.len() as u32).to_le_bytes())?;
             sink(text.as_bytes())?;
         }
@@ -228,7 +228,7 @@ impl Checkpoint {
     /// This checkpoint, ready to be written.
     pub fn view(&self) -> CheckpointView<'_> {
         CheckpointView {
-            lumen_version: &self.lumen_version,
+            renderer_id: &self.renderer_id,
             description: &self.description,
             spp_done: self.spp_done,
             stats: self.stats,
@@ -283,7 +283,7 @@ impl Checkpoint {
 
     fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
         let mut r = Reader(payload);
-        let lumen_version = r.text().ok_or("bad version text")?;
+        let renderer_id = r.text().ok_or("bad renderer identity")?;
         let description = r.text().ok_or("bad description text")?;
         let spp_done = r.u32().ok_or("missing sample count")?;
         let width = r.u32().ok_or("missing width")?;
@@ -312,7 +312,7 @@ impl Checkpoint {
             .collect();
         let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
         Ok(Self {
-            lumen_version,
+            renderer_id,
             description,
             spp_done,
             stats,
@@ -343,12 +343,12 @@ impl Checkpoint {
     /// Checks that this checkpoint was made by this renderer for the render
     /// whose canonical description (see [`description_text`]) is `ours`.
     pub fn check_description(&self, ours: &str, path: &Path) -> Result<(), CheckpointError> {
-        if self.lumen_version != RENDERER_ID {
+        if self.renderer_id != RENDERER_ID {
             return Err(CheckpointError::Mismatch {
                 path: path.to_path_buf(),
                 differences: format!(
                     "written by lumen {}, this is lumen {RENDERER_ID}",
-                    self.lumen_version
+                    self.renderer_id
                 ),
             });
         }
@@ -463,7 +463,7 @@ mod tests {
         let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, f64::MAX]).collect();
         let counts = (0..n as u32).collect();
         let ckpt = Checkpoint {
-            lumen_version: RENDERER_ID.into(),
+            renderer_id: RENDERER_ID.into(),
             description: description_text(&desc),
             spp_done: 3,
             stats: RenderStats {

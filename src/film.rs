@@ -52,6 +52,15 @@ impl Film {
             .zip(self.counts.par_chunks_mut(w))
     }
 
+    /// Makes this film a copy of `other` (of the same size) without
+    /// allocating: a pass keeps the film it started from this way.
+    pub fn copy_from(&mut self, other: &Film) {
+        self.width = other.width;
+        self.height = other.height;
+        self.sums.clone_from(&other.sums);
+        self.counts.clone_from(&other.counts);
+    }
+
     /// The raw per-pixel sums and counts (for checkpoints).
     pub fn raw(&self) -> (&[[f64; 3]], &[u32]) {
         (&self.sums, &self.counts)
@@ -88,13 +97,6 @@ impl Film {
     /// All pixels' mean linear colours, row-major, top row first.
     pub fn linear(&self) -> Vec<Color> {
         self.pixels().collect()
-    }
-
-    /// Display values: gamma `gamma` applied to each channel, then clamped to [0, 1].
-    pub fn display(&self, gamma: f32) -> Vec<[f32; 3]> {
-        self.pixels()
-            .map(|c| [c.x, c.y, c.z].map(|v| to_display(v, gamma)))
-            .collect()
     }
 
     /// 8-bit bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.

@@ -44,6 +44,7 @@ pub mod film;
 pub mod gallery;
 pub mod geometry;
 pub mod integrator;
+pub mod isa;
 pub mod material;
 pub mod math;
 pub mod output;

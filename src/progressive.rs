@@ -98,6 +98,9 @@ pub struct Session {
     scene: Scene,
     description: String,
     film: Film,
+    /// The film as the pass in flight found it, to put back if the pass is
+    /// abandoned; kept between passes so that no pass allocates one.
+    backup: Film,
     stats: RenderStats,
     spp_done: u32,
 }
@@ -162,6 +165,7 @@ impl Session {
             scene,
             description: description_text(desc),
             film,
+            backup: Film::new(0, 0),
             stats: RenderStats::default(),
             spp_done: 0,
         }
@@ -248,7 +252,7 @@ impl Session {
     /// The state to save so that a later run can continue this one.
     pub fn checkpoint(&self) -> CheckpointView<'_> {
         CheckpointView {
-            lumen_version: crate::checkpoint::RENDERER_ID,
+            renderer_id: crate::checkpoint::RENDERER_ID,
             description: &self.description,
             spp_done: self.spp_done,
             stats: self.stats,
@@ -268,7 +272,7 @@ impl Session {
         let samples = self.spp_done..self.spp_done + n;
         // A pass abandoned half-way has added samples to some rows only:
         // keep the film as it was to put it back.
-        let before = self.film.clone();
+        self.backup.copy_from(&self.film);
         let start = Instant::now();
         let result = render_samples_cancellable(
             &self.scene,
@@ -285,7 +289,7 @@ impl Session {
                 Some((samples, duration, stats))
             }
             None => {
-                self.film = before;
+                std::mem::swap(&mut self.film, &mut self.backup);
                 None
             }
         }

@@ -2,6 +2,7 @@
 
 use crate::film::Film;
 use crate::integrator::radiance;
+pub use crate::isa::Isa;
 use crate::math::Color;
 use crate::rng::Rng;
 use crate::scene::{Sampling, Scene};
@@ -100,7 +101,7 @@ pub fn stratum(index: u32, cells: u32, key: u64) -> u32 {
     let mut i = index;
     loop {
         i ^= k0 & mask;
-        i = i.wrapping_mul(0x2C1B_3C6D | 1) & mask;
+        i = i.wrapping_mul(0x2C1B_3C6D) & mask;
         i ^= i >> 3;
         i = i.wrapping_add(k0 >> 16) & mask;
         i = i.wrapping_mul(0x297A_2D39) & mask;
@@ -165,49 +166,6 @@ pub fn render_samples_cancellable(
         )
 }
 
-/// The instruction set the render loop is compiled for, chosen at run time.
-///
-/// The binary targets the architecture's baseline (SSE2 on x86-64, NEON on
-/// aarch64) so it runs anywhere; the per-row loop, with everything it inlines
-/// (camera, path loop, materials, BVH traversal), is compiled a second time
-/// for AVX2, FMA and BMI and used when the processor has them. Rust never
-/// fuses a multiply and an add by itself, so both versions compute the same
-/// floating-point operations and give bit-identical images.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Isa {
-    /// The architecture's baseline instructions.
-    Baseline,
-    /// x86-64 with AVX2, FMA, BMI1 and BMI2.
-    Avx2,
-}
-
-impl Isa {
-    /// The best version this processor can run.
-    pub fn detect() -> Isa {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if is_x86_feature_detected!("avx2")
-                && is_x86_feature_detected!("fma")
-                && is_x86_feature_detected!("bmi1")
-                && is_x86_feature_detected!("bmi2")
-            {
-                return Isa::Avx2;
-            }
-        }
-        Isa::Baseline
-    }
-
-    /// A short name for reports (`avx2`, or `sse2`/`neon`/`scalar` for the baseline).
-    pub fn name(self) -> &'static str {
-        match self {
-            Isa::Avx2 => "avx2",
-            Isa::Baseline if cfg!(target_arch = "x86_64") => "sse2",
-            Isa::Baseline if cfg!(target_arch = "aarch64") => "neon",
-            Isa::Baseline => "scalar",
-        }
-    }
-}
-
 /// Renders samples `samples` of every pixel of row `y` with the code compiled
 /// for `isa` (which must be supported: use [`Isa::detect`]).
 fn render_row(
@@ -259,7 +217,12 @@ fn render_row_generic(
     let width = sums.len().min(counts.len());
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
-        let key = pixel_key(s.seed, pixel);
+        // Only stratified sampling permutes its cells.
+        let key = if s.sampling == Sampling::Stratified {
+            pixel_key(s.seed, pixel)
+        } else {
+            0
+        };
         for index in samples.clone() {
             let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
             let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, key, &mut rng);

@@ -14,6 +14,7 @@
 
 use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, MAX_LEAF};
 use crate::geometry::Sphere;
+use crate::isa::Isa;
 use crate::math::Interval;
 use crate::ray::Ray;
 use glam::Vec4;
@@ -98,7 +99,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(binary.len() / 3 + 1),
             packets: Vec::with_capacity(spheres.len().div_ceil(2)),
-            avx2: has_avx2(),
+            avx2: Isa::detect() == Isa::Avx2,
         };
         if binary.is_empty() {
             return bvh;
@@ -185,7 +186,6 @@ impl Bvh {
         let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
         let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
         let sphere_ray = SphereRay::new(ray, interval, self.avx2);
-        let t_min = Vec4::splat(interval.min);
         let mut closest = interval.max;
         let mut best = NO_CHILD;
 
@@ -211,7 +211,7 @@ impl Bvh {
                 let tz1 = (p[2][1 - near[2]] - o4[2]) * inv4[2];
                 // The bound given last wins when a lane is NaN (0·∞ for a ray
                 // lying in a box's plane), so a NaN never culls a box it may hit.
-                let t_near = tx0.max(ty0).max(tz0).max(t_min);
+                let t_near = tx0.max(ty0).max(tz0).max(sphere_ray.t_min);
                 let t_far = tx1.min(ty1).min(tz1).min(Vec4::splat(closest));
                 let mut mask = t_near.cmple(t_far).bitmask() & node.used;
                 if mask != 0 && mask & (mask - 1) == 0 {
@@ -302,7 +302,7 @@ impl SphereRay {
     fn hit_packet(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
-            // SAFETY: `avx2` is true only when `has_avx2` found AVX2.
+            // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
             #[allow(unsafe_code)]
             return unsafe { self.hit_packet_avx2(p, closest) };
         }
@@ -444,18 +444,6 @@ impl SphereRay {
         let equal = _mm256_cmp_ps::<_CMP_EQ_OQ>(t, _mm256_set1_ps(t_best));
         let lane = (_mm256_movemask_ps(equal) as u32).trailing_zeros() as usize & 7;
         Some((t_best, p.index[lane]))
-    }
-}
-
-/// Whether the 8-lane AVX2 packet test can run on this processor.
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 

@@ -32,7 +32,7 @@ pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<(
         "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
-        lumen::render::Isa::detect().name()
+        lumen::isa::Isa::detect().name()
     )?;
     outln!(
         "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
@@ -67,7 +67,7 @@ pub(crate) fn bench_command(spp: u32, runs: u32) -> Result<()> {
         "lumen bench: {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
         rayon::current_num_threads(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
-        lumen::render::Isa::detect().name()
+        lumen::isa::Isa::detect().name()
     )?;
     outln!(
         "{:<24} {:>10} {:>14} {:>16}",
