@@ -138,6 +138,25 @@ impl<'a> Table<'a> {
     fn path(&self, key: &str) -> String {
         child(self.path, key)
     }
+
+    /// Required field `key`, read by `read` (`float`, `triple`, ...).
+    fn require<T>(
+        &self,
+        key: &str,
+        what: &str,
+        read: impl Fn(&'a Node, &str) -> Result<T>,
+    ) -> Result<T> {
+        read(self.required(key, what)?, &self.path(key))
+    }
+
+    /// Optional field `key`, read by `read`; `None` when it is absent.
+    fn optional<T>(
+        &self,
+        key: &str,
+        read: impl Fn(&'a Node, &str) -> Result<T>,
+    ) -> Result<Option<T>> {
+        self.get(key).map(|n| read(n, &self.path(key))).transpose()
+    }
 }
 
 fn float(node: &Node, path: &str) -> Result<f64> {
@@ -361,38 +380,28 @@ fn render(node: &Node) -> Result<RenderDesc> {
         ],
         &[],
     )?;
-    let mut r = RenderDesc::default();
-    if let Some(n) = t.get("width") {
-        r.width = u32_field(n, &t.path("width"), 1)?;
-    }
-    if let Some(n) = t.get("height") {
-        r.height = Some(u32_field(n, &t.path("height"), 1)?);
-    }
-    if let Some(n) = t.get("aspect_ratio") {
-        r.aspect_ratio = float(n, &t.path("aspect_ratio"))?;
-    }
-    if let Some(n) = t.get("samples_per_pixel") {
-        r.samples_per_pixel = u32_field(n, &t.path("samples_per_pixel"), 1)?;
-    }
-    if let Some(n) = t.get("max_depth") {
-        r.max_depth = u32_field(n, &t.path("max_depth"), 1)?;
-    }
-    if let Some(n) = t.get("seed") {
-        r.seed = integer(n, &t.path("seed"), 0, u64::MAX)?;
-    }
-    if let Some(n) = t.get("sampling") {
-        r.sampling = keyword(n, &t.path("sampling"), SAMPLINGS)?;
-    }
-    if let Some(n) = t.get("gamma") {
-        r.gamma = float(n, &t.path("gamma"))?;
-    }
-    if let Some(n) = t.get("epsilon") {
-        r.epsilon = float(n, &t.path("epsilon"))?;
-    }
-    if let Some(n) = t.get("shading") {
-        r.shading = keyword(n, &t.path("shading"), SHADINGS)?;
-    }
-    Ok(r)
+    let d = RenderDesc::default();
+    let positive = |n: &Node, p: &str| u32_field(n, p, 1);
+    Ok(RenderDesc {
+        width: t.optional("width", positive)?.unwrap_or(d.width),
+        height: t.optional("height", positive)?,
+        aspect_ratio: t.optional("aspect_ratio", float)?.unwrap_or(d.aspect_ratio),
+        samples_per_pixel: t
+            .optional("samples_per_pixel", positive)?
+            .unwrap_or(d.samples_per_pixel),
+        max_depth: t.optional("max_depth", positive)?.unwrap_or(d.max_depth),
+        seed: t
+            .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
+            .unwrap_or(d.seed),
+        sampling: t
+            .optional("sampling", |n, p| keyword(n, p, SAMPLINGS))?
+            .unwrap_or(d.sampling),
+        gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
+        epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),
+        shading: t
+            .optional("shading", |n, p| keyword(n, p, SHADINGS))?
+            .unwrap_or(d.shading),
+    })
 }
 
 fn camera(node: &Node) -> Result<CameraDesc> {
@@ -410,26 +419,17 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         ],
         &[],
     )?;
-    let mut c = CameraDesc::default();
-    if let Some(n) = t.get("vfov") {
-        c.vfov = float(n, &t.path("vfov"))?;
-    }
-    if let Some(n) = t.get("lookfrom") {
-        c.lookfrom = triple(n, &t.path("lookfrom"))?;
-    }
-    if let Some(n) = t.get("lookat") {
-        c.lookat = triple(n, &t.path("lookat"))?;
-    }
-    if let Some(n) = t.get("vup") {
-        c.vup = triple(n, &t.path("vup"))?;
-    }
-    if let Some(n) = t.get("defocus_angle") {
-        c.defocus_angle = float(n, &t.path("defocus_angle"))?;
-    }
-    if let Some(n) = t.get("focus_dist") {
-        c.focus_dist = Some(float(n, &t.path("focus_dist"))?);
-    }
-    Ok(c)
+    let d = CameraDesc::default();
+    Ok(CameraDesc {
+        vfov: t.optional("vfov", float)?.unwrap_or(d.vfov),
+        lookfrom: t.optional("lookfrom", triple)?.unwrap_or(d.lookfrom),
+        lookat: t.optional("lookat", triple)?.unwrap_or(d.lookat),
+        vup: t.optional("vup", triple)?.unwrap_or(d.vup),
+        defocus_angle: t
+            .optional("defocus_angle", float)?
+            .unwrap_or(d.defocus_angle),
+        focus_dist: t.optional("focus_dist", float)?,
+    })
 }
 
 #[derive(Clone, Copy)]
@@ -466,8 +466,8 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
                 &[("color", "a solid background")],
             )?;
             BackgroundDesc::Gradient {
-                bottom: triple(t.required("bottom", what)?, &t.path("bottom"))?,
-                top: triple(t.required("top", what)?, &t.path("top"))?,
+                bottom: t.require("bottom", what, triple)?,
+                top: t.require("top", what, triple)?,
             }
         }
         BackgroundKind::Solid => {
@@ -483,11 +483,23 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
                 ],
             )?;
             BackgroundDesc::Solid {
-                color: triple(t.required("color", what)?, &t.path("color"))?,
+                color: t.require("color", what, triple)?,
             }
         }
     })
 }
+
+const BOUNCES: &[(&str, BounceDesc)] = &[
+    ("cube", BounceDesc::Cube),
+    ("sphere-volume", BounceDesc::SphereVolume),
+    ("lambertian", BounceDesc::Lambertian),
+    ("hemisphere", BounceDesc::Hemisphere),
+];
+
+const ATTENUATIONS: &[(&str, AttenuationDesc)] = &[
+    ("scale", AttenuationDesc::Scale),
+    ("absorb", AttenuationDesc::Absorb),
+];
 
 #[derive(Clone, Copy)]
 enum MaterialKind {
@@ -534,31 +546,13 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
                 ],
             )?;
             MaterialDesc::Diffuse {
-                albedo: triple(t.required("albedo", what)?, &t.path("albedo"))?,
-                bounce: match t.get("bounce") {
-                    None => BounceDesc::default(),
-                    Some(n) => keyword(
-                        n,
-                        &t.path("bounce"),
-                        &[
-                            ("cube", BounceDesc::Cube),
-                            ("sphere-volume", BounceDesc::SphereVolume),
-                            ("lambertian", BounceDesc::Lambertian),
-                            ("hemisphere", BounceDesc::Hemisphere),
-                        ],
-                    )?,
-                },
-                attenuation: match t.get("attenuation") {
-                    None => AttenuationDesc::default(),
-                    Some(n) => keyword(
-                        n,
-                        &t.path("attenuation"),
-                        &[
-                            ("scale", AttenuationDesc::Scale),
-                            ("absorb", AttenuationDesc::Absorb),
-                        ],
-                    )?,
-                },
+                albedo: t.require("albedo", what, triple)?,
+                bounce: t
+                    .optional("bounce", |n, p| keyword(n, p, BOUNCES))?
+                    .unwrap_or_default(),
+                attenuation: t
+                    .optional("attenuation", |n, p| keyword(n, p, ATTENUATIONS))?
+                    .unwrap_or_default(),
             }
         }
         MaterialKind::Metal => {
@@ -576,11 +570,8 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
                 ],
             )?;
             MaterialDesc::Metal {
-                albedo: triple(t.required("albedo", what)?, &t.path("albedo"))?,
-                fuzz: match t.get("fuzz") {
-                    None => 0.0,
-                    Some(n) => float(n, &t.path("fuzz"))?,
-                },
+                albedo: t.require("albedo", what, triple)?,
+                fuzz: t.optional("fuzz", float)?.unwrap_or(0.0),
             }
         }
         MaterialKind::Dielectric => {
@@ -598,11 +589,8 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
                 ],
             )?;
             MaterialDesc::Dielectric {
-                ior: float(t.required("ior", what)?, &t.path("ior"))?,
-                refract_only: match t.get("refract_only") {
-                    None => false,
-                    Some(n) => boolean(n, &t.path("refract_only"))?,
-                },
+                ior: t.require("ior", what, float)?,
+                refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
             }
         }
     })
@@ -626,9 +614,9 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             let what = "a sphere";
             let t = Table::new(node, path, what, fields, &[])?;
             ObjectDesc::Sphere {
-                center: triple(t.required("center", what)?, &t.path("center"))?,
-                radius: float(t.required("radius", what)?, &t.path("radius"))?,
-                material: string(t.required("material", what)?, &t.path("material"))?.to_string(),
+                center: t.require("center", what, triple)?,
+                radius: t.require("radius", what, float)?,
+                material: t.require("material", what, string)?.to_string(),
             }
         }
     })
