@@ -27,12 +27,20 @@ pub(crate) fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
     Ok(())
 }
 
-pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
-    outln!(
-        "lumen bench: cover-like sphere fields at 400x225, {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
+/// What a benchmark ran on: worker threads, cores and the code version.
+fn machine() -> String {
+    format!(
+        "{} worker threads on {} cores ({} code)",
         rayon::current_num_threads(),
         std::thread::available_parallelism().map_or(1, |n| n.get()),
         lumen::isa::Isa::detect().name()
+    )
+}
+
+pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<()> {
+    outln!(
+        "lumen bench: cover-like sphere fields at 400x225, {}, {spp} spp, depth 50, median of {runs} runs",
+        machine()
     )?;
     outln!(
         "{:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>12}",
@@ -64,10 +72,8 @@ pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<(
 
 pub(crate) fn bench_command(spp: u32, runs: u32) -> Result<()> {
     outln!(
-        "lumen bench: {} worker threads on {} cores ({} code), {spp} spp, depth 50, median of {runs} runs",
-        rayon::current_num_threads(),
-        std::thread::available_parallelism().map_or(1, |n| n.get()),
-        lumen::isa::Isa::detect().name()
+        "lumen bench: {}, {spp} spp, depth 50, median of {runs} runs",
+        machine()
     )?;
     outln!(
         "{:<24} {:>10} {:>14} {:>16}",
