@@ -102,6 +102,12 @@ impl Camera {
                 return Err(CameraError::NotFinite(name));
             }
         }
+        // First, as the default focus distance (to `lookat`) is then 0 too:
+        // the message names what is really wrong.
+        let view = s.lookfrom - s.lookat;
+        if view == Vec3::ZERO {
+            return Err(CameraError::NoViewDirection(s.lookfrom));
+        }
         if !(s.vfov > 0.0 && s.vfov < 180.0) {
             return Err(CameraError::FieldOfView(s.vfov));
         }
@@ -113,10 +119,6 @@ impl Camera {
         }
         if width == 0 || height == 0 {
             return Err(CameraError::EmptyImage(width, height));
-        }
-        let view = s.lookfrom - s.lookat;
-        if view == Vec3::ZERO {
-            return Err(CameraError::NoViewDirection(s.lookfrom));
         }
         if !view.length_squared().is_finite() {
             return Err(CameraError::Overflow);

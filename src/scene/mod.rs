@@ -233,11 +233,6 @@ impl Scene {
         finite("camera.defocus_angle", &[cam.defocus_angle])?;
         let lookfrom = vec3(cam.lookfrom);
         let lookat = vec3(cam.lookat);
-        // Without a view direction the default focus distance is 0; say what
-        // is really wrong rather than complain about the focus.
-        if lookfrom == lookat {
-            return Err(CameraError::NoViewDirection(lookfrom).into());
-        }
         let focus_dist = match cam.focus_dist {
             Some(d) => {
                 finite("camera.focus_dist", &[d])?;
