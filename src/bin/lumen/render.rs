@@ -118,13 +118,17 @@ pub(crate) fn render_command(
             String::new()
         }
     );
+    // Saves the image, and the checkpoint unless the render is complete, as
+    // one step that a second interrupt lets finish (see `signals`).
     let save = |session: &Session| -> Result<()> {
         let _saving = saving();
         output::write_image(out, session.film(), s.gamma)?;
-        session
-            .checkpoint()
-            .write(&ckpt_path)
-            .context("cannot save the checkpoint")?;
+        if !session.is_complete() {
+            session
+                .checkpoint()
+                .write(&ckpt_path)
+                .context("cannot save the checkpoint")?;
+        }
         quit_if_asked();
         Ok(())
     };
@@ -163,9 +167,7 @@ pub(crate) fn render_command(
     let (held, total) = (session.spp_done(), session.spp_total());
     let code = match run.reason {
         StopReason::Complete => {
-            let _saving = saving();
-            output::write_image(out, session.film(), s.gamma)?;
-            quit_if_asked();
+            save(&session)?;
             match std::fs::remove_file(&ckpt_path) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                     eprintln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
