@@ -220,8 +220,25 @@ impl Bvh {
                     continue;
                 }
                 if mask != 0 {
-                    // Push the hit children farthest first; go on with the nearest.
                     let t_near = t_near.to_array();
+                    let first = mask.trailing_zeros() as usize & 3;
+                    let rest = mask & (mask - 1);
+                    if rest & (rest - 1) == 0 {
+                        // Two children (most of the rest): push the farther,
+                        // go on with the nearer (the first lane on a tie).
+                        let second = rest.trailing_zeros() as usize & 3;
+                        let (near, far) = if t_near[second] < t_near[first] {
+                            (second, first)
+                        } else {
+                            (first, second)
+                        };
+                        stack[top].write((node.children[far], t_near[far]));
+                        top += 1;
+                        current = node.children[near];
+                        continue;
+                    }
+                    // Three or four: push the hit children farthest first; go
+                    // on with the nearest.
                     let mut hits = [(0u32, 0.0f32); 4];
                     let mut n = 0;
                     while mask != 0 {
@@ -332,7 +349,6 @@ impl SphereRay {
         let fy = self.oy - p.cy[half];
         let fz = self.oz - p.cz[half];
         let half_b = fx * self.dx + fy * self.dy + fz * self.dz;
-        let c = fx * fx + fy * fy + fz * fz - radius2;
         let lx = fx - half_b * self.dx;
         let ly = fy - half_b * self.dy;
         let lz = fz - half_b * self.dz;
@@ -342,16 +358,12 @@ impl SphereRay {
             return None;
         }
         let sqrt_d = sqrt4(discriminant);
-        let q = -half_b - sqrt_d.copysign(half_b);
-        let (r1, r2) = (c / q, q);
-        let ordered = r1.cmple(r2);
-        let near = Vec4::select(ordered, r1, r2);
-        let far = Vec4::select(ordered, r2, r1);
+        let near = -half_b - sqrt_d;
+        let far = -half_b + sqrt_d;
         let closest4 = Vec4::splat(closest);
         let near_ok = self.t_min.cmplt(near) & near.cmplt(closest4);
         let far_ok = self.t_min.cmplt(far) & far.cmplt(closest4);
-        let valid = real & q.cmpne(Vec4::ZERO);
-        let hit = valid & (near_ok | far_ok);
+        let hit = real & (near_ok | far_ok);
         if !hit.any() {
             return None;
         }
@@ -399,7 +411,6 @@ impl SphereRay {
             )
         };
         let half_b = dot(fx, fy, fz, dx, dy, dz);
-        let c = _mm256_sub_ps(dot(fx, fy, fz, fx, fy, fz), radius2);
         let lx = _mm256_sub_ps(fx, _mm256_mul_ps(half_b, dx));
         let ly = _mm256_sub_ps(fy, _mm256_mul_ps(half_b, dy));
         let lz = _mm256_sub_ps(fz, _mm256_mul_ps(half_b, dz));
@@ -409,12 +420,9 @@ impl SphereRay {
             return None;
         }
         let sqrt_d = _mm256_sqrt_ps(discriminant);
-        let signed_sqrt = _mm256_or_ps(_mm256_and_ps(half_b, sign), _mm256_andnot_ps(sign, sqrt_d));
-        let q = _mm256_sub_ps(_mm256_xor_ps(half_b, sign), signed_sqrt);
-        let (r1, r2) = (_mm256_div_ps(c, q), q);
-        let ordered = _mm256_cmp_ps::<_CMP_LE_OQ>(r1, r2);
-        let near = _mm256_blendv_ps(r2, r1, ordered);
-        let far = _mm256_blendv_ps(r1, r2, ordered);
+        let minus_b = _mm256_xor_ps(half_b, sign);
+        let near = _mm256_sub_ps(minus_b, sqrt_d);
+        let far = _mm256_add_ps(minus_b, sqrt_d);
         let closest8 = _mm256_set1_ps(closest);
         let near_ok = _mm256_and_ps(
             _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, near),
@@ -424,9 +432,7 @@ impl SphereRay {
             _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, far),
             _mm256_cmp_ps::<_CMP_LT_OQ>(far, closest8),
         );
-        // Not-equal is true for NaN, as `Vec4::cmpne` (and `q == 0.0` false).
-        let valid = _mm256_and_ps(real, _mm256_cmp_ps::<_CMP_NEQ_UQ>(q, zero));
-        let hit = _mm256_and_ps(valid, _mm256_or_ps(near_ok, far_ok));
+        let hit = _mm256_and_ps(real, _mm256_or_ps(near_ok, far_ok));
         if _mm256_movemask_ps(hit) == 0 {
             return None;
         }

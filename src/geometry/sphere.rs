@@ -26,15 +26,17 @@ impl Sphere {
     /// The nearest root of the ray–sphere quadratic inside `interval`, if any.
     ///
     /// The ray's direction must have unit length (every ray the camera and the
-    /// materials make has), so that a = B·B = 1 drops out of the formulas: one
-    /// division per sphere instead of three.
+    /// materials make has), so that a = B·B = 1 drops out of the formulas and
+    /// the roots are t = −h ∓ √d, with no division at all.
     ///
-    /// In `f32` the textbook discriminant b² − ac loses every significant digit
+    /// In `f32` the textbook discriminant h² − c loses every significant digit
     /// when a small ray grazes a large sphere (the radius-1000 ground of the
     /// cover scene shows rings). Following Haines et al., *Ray Tracing Gems*
-    /// ch. 7, the discriminant is computed as a·(R² − |l|²), where l is the part
-    /// of A − C perpendicular to the ray, and the two roots come from the
-    /// cancellation-free pair t = c/q, t = q/a.
+    /// ch. 7, the discriminant is computed as R² − |l|², where l is the part of
+    /// A − C perpendicular to the ray. The roots themselves need no such care:
+    /// −h ∓ √d cancels only when that root is close to 0 compared with h, that
+    /// is for the surface a ray is leaving, which the interval's lower end
+    /// (the renderer's epsilon) excludes anyway.
     #[inline]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
         debug_assert!(
@@ -44,21 +46,13 @@ impl Sphere {
         );
         let f = ray.origin - self.center;
         let half_b = f.dot(ray.direction);
-        let c = f.length_squared() - self.radius * self.radius;
         let l = f - half_b * ray.direction;
         let discriminant = self.radius * self.radius - l.length_squared();
         if discriminant < 0.0 {
             return None;
         }
         let sqrt_d = discriminant.sqrt();
-        let q = -half_b - sqrt_d.copysign(half_b);
-        // q is zero only for a ray that starts on the sphere tangent to it:
-        // it touches at t = 0, which no interval of the renderer includes.
-        if q == 0.0 {
-            return None;
-        }
-        let (r1, r2) = (c / q, q);
-        let (near, far) = if r1 <= r2 { (r1, r2) } else { (r2, r1) };
+        let (near, far) = (-half_b - sqrt_d, -half_b + sqrt_d);
         if interval.surrounds(near) {
             Some(near)
         } else if interval.surrounds(far) {
