@@ -35,9 +35,19 @@ impl Rng {
 
     /// The generator for one camera sample: independent of every other sample
     /// of the image, and of the order in which samples are taken.
+    ///
+    /// `pixel` and `sample` must be below 2³² (images are far smaller), so
+    /// that `pixel · 2³² + sample` names the sample uniquely; the bijective
+    /// [`mix64`] of that name, keyed by the mixed seed, starts its sequence.
+    /// Two finalisers per sample, not five: seeding is a noticeable part of a
+    /// camera sample's cost. (`mix64(seed)` is the same for every sample and
+    /// is hoisted out of the render loop.)
     #[inline]
     pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Self {
-        Self::new(mix64(seed ^ mix64(pixel ^ mix64(sample))))
+        debug_assert!(pixel < 1 << 32 && sample < 1 << 32);
+        Self {
+            state: mix64(mix64(seed) ^ (pixel << 32 | sample)),
+        }
     }
 
     /// The next 32 uniformly distributed bits.
