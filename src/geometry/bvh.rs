@@ -21,23 +21,23 @@ use glam::Vec4;
 use std::mem::MaybeUninit;
 
 /// Children of a node referring to a leaf have this bit set.
-const LEAF_BIT: u32 = 1 << 31;
+pub(super) const LEAF_BIT: u32 = 1 << 31;
 /// An unused child slot (its box is empty, so it is never entered).
-const NO_CHILD: u32 = u32::MAX;
+pub(super) const NO_CHILD: u32 = u32::MAX;
 /// Entries of the traversal stack: a node pushes at most three children and
 /// the tree is at most `MAX_SAH_DEPTH + 32` levels deep (see `bvh_build`).
-const STACK_SIZE: usize = 256;
+pub(super) const STACK_SIZE: usize = 256;
 
 /// Four children's boxes, structure of arrays, and their references.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node {
+pub(super) struct Node {
     /// `planes[axis][0]`: the four lower bounds along `axis`; `[1]`: the upper.
-    planes: [[Vec4; 2]; 3],
+    pub(super) planes: [[Vec4; 2]; 3],
     /// Node index, `LEAF_BIT | packet index`, or `NO_CHILD`.
-    children: [u32; 4],
+    pub(super) children: [u32; 4],
     /// Bit `lane` is set when `children[lane]` is used.
-    used: u32,
+    pub(super) used: u32,
 }
 
 impl Node {
@@ -63,13 +63,14 @@ impl Node {
 /// which no ray hits.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-struct Packet {
-    cx: [Vec4; 2],
-    cy: [Vec4; 2],
-    cz: [Vec4; 2],
-    radius2: [Vec4; 2],
-    /// Index of each sphere in the input; `NO_CHILD` in unused lanes.
-    index: [u32; 8],
+pub(super) struct Packet {
+    pub(super) cx: [Vec4; 2],
+    pub(super) cy: [Vec4; 2],
+    pub(super) cz: [Vec4; 2],
+    pub(super) radius2: [Vec4; 2],
+    /// Index of each sphere in the input; `NO_CHILD` in unused lanes (which
+    /// come after the used ones).
+    pub(super) index: [u32; 8],
 }
 
 /// The nearest sphere a ray hits.
@@ -146,9 +147,15 @@ impl Bvh {
         self.traverse(ray, interval)
     }
 
+    /// Whether the tree is empty (there are no spheres).
+    #[inline(always)]
+    pub(super) fn nodes_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
     /// Node `i`, which the traversal reached through a child reference.
     #[inline(always)]
-    fn node(&self, i: u32) -> &Node {
+    pub(super) fn node(&self, i: u32) -> &Node {
         debug_assert!((i as usize) < self.nodes.len());
         // SAFETY: the traversal starts at node 0 of a non-empty tree and only
         // follows references of used child slots, each of which `Collapse`
@@ -162,7 +169,7 @@ impl Bvh {
 
     /// Packet `i`, reached through a leaf reference of a used child slot.
     #[inline(always)]
-    fn packet(&self, i: u32) -> &Packet {
+    pub(super) fn packet(&self, i: u32) -> &Packet {
         debug_assert!((i as usize) < self.packets.len());
         // SAFETY: as for `node`: `Collapse::emit_packet` returns the index of
         // the packet it has just pushed.
@@ -186,8 +193,11 @@ impl Bvh {
         let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
         let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
         let sphere_ray = SphereRay::new(ray, interval, self.avx2);
+        // The best hit so far, compared as the pair (distance, sphere index)
+        // so that the result does not depend on the order of the visit. No
+        // sphere ties the start (interval.max, 0): index 0 is the lowest.
         let mut closest = interval.max;
-        let mut best = NO_CHILD;
+        let mut best = 0;
 
         // Uninitialised: zeroing 2 KiB on every call cost ~10% of the render.
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK_SIZE];
@@ -196,7 +206,7 @@ impl Bvh {
         loop {
             if current & LEAF_BIT != 0 {
                 let packet = self.packet(current & !LEAF_BIT);
-                if let Some((t, index)) = sphere_ray.hit_packet(packet, closest) {
+                if let Some((t, index)) = sphere_ray.hit_packet(packet, closest, best) {
                     closest = t;
                     best = index;
                 }
@@ -265,7 +275,8 @@ impl Bvh {
             // Pop the next entry that may still hold a nearer hit.
             loop {
                 if top == 0 {
-                    return (best != NO_CHILD).then_some(Hit {
+                    // Every accepted hit is nearer than interval.max.
+                    return (closest < interval.max).then_some(Hit {
                         t: closest,
                         index: best,
                     });
@@ -312,38 +323,37 @@ impl SphereRay {
         }
     }
 
-    /// The nearest hit among the packet's spheres closer than `closest`, the
-    /// lowest lane winning ties; distances are bit-identical to
-    /// [`Sphere::hit`] whichever version runs.
+    /// The packet's hit (t, sphere index) that comes before `(closest, best)`
+    /// in the order of distance then index, if any: the nearest sphere, the
+    /// lowest index among spheres at exactly the same distance. Distances are
+    /// bit-identical to [`Sphere::hit`] whichever version runs.
     #[inline(always)]
-    fn hit_packet(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
+    fn hit_packet(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
             #[allow(unsafe_code)]
-            return unsafe { self.hit_packet_avx2(p, closest) };
+            return unsafe { self.hit_packet_avx2(p, closest, best) };
         }
-        self.hit_packet_halves(p, closest)
+        self.hit_packet_halves(p, closest, best)
     }
 
     /// [`Self::hit_packet`] as two 4-lane tests.
     #[inline(always)]
-    fn hit_packet_halves(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
-        let first = self.hit_half(p, 0, closest);
+    fn hit_packet_halves(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
+        let first = self.hit_half(p, 0, closest, best);
         if p.index[4] == NO_CHILD {
             return first;
         }
-        // A tie in the second half is not nearer (`< closest`): the first
-        // half's lane is kept, as the 8-lane test keeps the lowest lane.
-        let closest = first.map_or(closest, |h| h.0);
-        self.hit_half(p, 1, closest).or(first)
+        let (closest, best) = first.unwrap_or((closest, best));
+        self.hit_half(p, 1, closest, best).or(first)
     }
 
-    /// The nearest hit among lanes `4·half .. 4·half + 4` closer than
-    /// `closest`: [`Sphere::hit`] on four spheres at once, operation for
-    /// operation, so both give bit-identical distances.
+    /// [`Self::hit_packet`] for lanes `4·half .. 4·half + 4`: [`Sphere::hit`]
+    /// on four spheres at once, operation for operation, so both give
+    /// bit-identical distances.
     #[inline(always)]
-    fn hit_half(&self, p: &Packet, half: usize, closest: f32) -> Option<(f32, u32)> {
+    fn hit_half(&self, p: &Packet, half: usize, closest: f32, best: u32) -> Option<(f32, u32)> {
         let radius2 = p.radius2[half];
         let fx = self.ox - p.cx[half];
         let fy = self.oy - p.cy[half];
@@ -360,18 +370,18 @@ impl SphereRay {
         let sqrt_d = sqrt4(discriminant);
         let near = -half_b - sqrt_d;
         let far = -half_b + sqrt_d;
-        let closest4 = Vec4::splat(closest);
-        let near_ok = self.t_min.cmplt(near) & near.cmplt(closest4);
-        let far_ok = self.t_min.cmplt(far) & far.cmplt(closest4);
-        let hit = real & (near_ok | far_ok);
+        // The first root beyond t_min, if it is not beyond `closest`.
+        let near_ok = self.t_min.cmplt(near);
+        let t = Vec4::select(near_ok, near, far);
+        let hit = real & (near_ok | self.t_min.cmplt(far)) & t.cmple(Vec4::splat(closest));
         if !hit.any() {
             return None;
         }
-        let t = Vec4::select(hit, Vec4::select(near_ok, near, far), Vec4::INFINITY);
+        let t = Vec4::select(hit, t, Vec4::INFINITY);
         let t_best = t.min_element();
-        // The lowest lane among equals, as a sequential loop would keep.
-        let lane = t.cmpeq(Vec4::splat(t_best)).bitmask().trailing_zeros() as usize & 3;
-        Some((t_best, p.index[4 * half + lane]))
+        let equal = t.cmpeq(Vec4::splat(t_best)).bitmask();
+        let lanes = &p.index[4 * half..4 * half + 4];
+        finish(t_best, equal, lanes, closest, best)
     }
 
     /// [`Self::hit_half`] on all eight lanes at once with AVX, the same
@@ -380,7 +390,7 @@ impl SphereRay {
     #[target_feature(enable = "avx2")]
     #[inline]
     #[allow(unsafe_code)]
-    unsafe fn hit_packet_avx2(&self, p: &Packet, closest: f32) -> Option<(f32, u32)> {
+    unsafe fn hit_packet_avx2(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
         use std::arch::x86_64::*;
         // Loop-invariant after inlining: hoisted out of the traversal loop.
         macro_rules! wide {
@@ -423,24 +433,20 @@ impl SphereRay {
         let minus_b = _mm256_xor_ps(half_b, sign);
         let near = _mm256_sub_ps(minus_b, sqrt_d);
         let far = _mm256_add_ps(minus_b, sqrt_d);
-        let closest8 = _mm256_set1_ps(closest);
-        let near_ok = _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, near),
-            _mm256_cmp_ps::<_CMP_LT_OQ>(near, closest8),
+        // The first root beyond t_min, if it is not beyond `closest`.
+        let near_ok = _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, near);
+        let t = _mm256_blendv_ps(far, near, near_ok);
+        let hit = _mm256_and_ps(
+            _mm256_and_ps(
+                real,
+                _mm256_or_ps(near_ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, far)),
+            ),
+            _mm256_cmp_ps::<_CMP_LE_OQ>(t, _mm256_set1_ps(closest)),
         );
-        let far_ok = _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, far),
-            _mm256_cmp_ps::<_CMP_LT_OQ>(far, closest8),
-        );
-        let hit = _mm256_and_ps(real, _mm256_or_ps(near_ok, far_ok));
         if _mm256_movemask_ps(hit) == 0 {
             return None;
         }
-        let t = _mm256_blendv_ps(
-            _mm256_set1_ps(f32::INFINITY),
-            _mm256_blendv_ps(far, near, near_ok),
-            hit,
-        );
+        let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, hit);
         // The minimum does not depend on the order of comparisons: every lane
         // is a number or +∞.
         let m = _mm_min_ps(_mm256_castps256_ps128(t), _mm256_extractf128_ps::<1>(t));
@@ -448,9 +454,34 @@ impl SphereRay {
         let m = _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m));
         let t_best = _mm_cvtss_f32(m);
         let equal = _mm256_cmp_ps::<_CMP_EQ_OQ>(t, _mm256_set1_ps(t_best));
-        let lane = (_mm256_movemask_ps(equal) as u32).trailing_zeros() as usize & 7;
-        Some((t_best, p.index[lane]))
+        finish(
+            t_best,
+            _mm256_movemask_ps(equal) as u32,
+            &p.index,
+            closest,
+            best,
+        )
     }
+}
+
+/// The end of a packet test: `t_best` is the nearest distance found, not
+/// beyond `closest`, and bit `lane` of `equal` is set for the lanes at that
+/// distance, whose sphere indices are `index[lane]`. Returns the hit if
+/// (t_best, lowest of those indices) comes before (closest, best).
+#[inline(always)]
+fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Option<(f32, u32)> {
+    let first = equal.trailing_zeros() as usize;
+    let mut lowest = index[first];
+    if equal & (equal - 1) != 0 {
+        // Several spheres at exactly the same distance (coincident surfaces):
+        // the lowest index wins, wherever the spheres sit in the tree.
+        let mut rest = equal & (equal - 1);
+        while rest != 0 {
+            lowest = lowest.min(index[rest.trailing_zeros() as usize]);
+            rest &= rest - 1;
+        }
+    }
+    (t_best < closest || lowest < best).then_some((t_best, lowest))
 }
 
 /// Lane-wise square root (glam's `Vec4` has none).
@@ -589,12 +620,8 @@ mod tests {
             let ray = Ray::new(origin, crate::sampling::unit_vector(rng));
             let expected = brute_force(spheres, &ray, interval);
             let got = bvh.hit(&ray, interval).map(|h| (h.t, h.index));
-            assert_eq!(got.map(|g| g.0), expected.map(|e| e.0));
-            if let (Some((t, i)), Some((_, j))) = (got, expected) {
-                // Coincident spheres tie; either may be reported.
-                let same = spheres[i as usize] == spheres[j as usize];
-                assert!(i == j || same, "t = {t}: sphere {i} instead of {j}");
-            }
+            // Exactly the same: among coincident spheres, the lowest index.
+            assert_eq!(got, expected);
         }
     }
 
@@ -650,10 +677,10 @@ mod tests {
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
             let ray = SphereRay::new(&Ray::new(origin, d), interval, true);
             for p in &bvh.packets {
-                let halves = ray.hit_packet_halves(p, interval.max);
+                let halves = ray.hit_packet_halves(p, interval.max, 0);
                 // SAFETY: AVX2 was detected above.
                 #[allow(unsafe_code)]
-                let wide = unsafe { ray.hit_packet_avx2(p, interval.max) };
+                let wide = unsafe { ray.hit_packet_avx2(p, interval.max, 0) };
                 let bits = |h: Option<(f32, u32)>| h.map(|(t, i)| (t.to_bits(), i));
                 assert_eq!(bits(halves), bits(wide));
                 hits += usize::from(wide.is_some());
