@@ -157,6 +157,14 @@ impl Camera {
         })
     }
 
+    /// The ray from the centre of the lens through the centre of pixel
+    /// `(x, y)`: the axis of the pixel's camera rays.
+    #[inline]
+    pub fn central_ray(&self, x: u32, y: u32) -> Ray {
+        let target = self.pixel00 + x as f32 * self.pixel_du + y as f32 * self.pixel_dv;
+        Ray::new(self.center, (target - self.center).normalize())
+    }
+
     /// The ray through pixel `(x, y)` at sub-pixel offset `(dx, dy)` ∈ [-0.5, 0.5)²
     /// from the pixel centre, leaving the lens at a random point.
     #[inline]

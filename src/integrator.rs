@@ -1,9 +1,20 @@
-//! The path of one ray, from the camera to the sky, in one function.
+//! The path of one ray, from the camera to the sky, in one function
+//! ([`trace_path`]), and the same for a group of camera rays of one pixel
+//! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
+use crate::geometry::bvh_bundle::LANES;
+use crate::geometry::HitRecord;
 use crate::math::{Color, Interval};
 use crate::ray::Ray;
 use crate::rng::Rng;
 use crate::scene::{Scene, Shading};
+
+/// Paths traced side by side by [`trace_paths`].
+pub const PATHS: usize = 32;
+
+/// The fewest rays worth tracing as a bundle: below this, one at a time is
+/// faster (a bundle costs about as much as three or four single rays).
+const MIN_BUNDLE: usize = 4;
 
 /// Traces one camera ray and returns the colour it carries back.
 ///
@@ -16,44 +27,155 @@ pub fn radiance(scene: &Scene, ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color
     }
 }
 
+/// The interval of hits counted: hits closer than epsilon are the surface the
+/// ray leaves from, seen again through rounding error, and counting them is
+/// what causes shadow acne.
+#[inline(always)]
+pub fn hit_range(scene: &Scene) -> Interval {
+    Interval::new(scene.settings.epsilon, f32::INFINITY)
+}
+
+/// What becomes of a path at the end of one segment.
+enum Step {
+    /// It goes on along this ray.
+    Continue(Ray),
+    /// It ends, carrying this colour back.
+    Done(Color),
+}
+
+/// The end of one segment of a path: `ray` met `hit` (or nothing, and the
+/// background lights it). The surface's material absorbs the path or
+/// scatters it, multiplying `throughput` by its attenuation.
+#[inline(always)]
+fn step(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<HitRecord>,
+    throughput: &mut Color,
+    rng: &mut Rng,
+) -> Step {
+    let Some(hit) = hit else {
+        return Step::Done(*throughput * scene.background.color(ray.direction));
+    };
+    let material = &scene.materials[hit.material as usize];
+    let Some(scatter) = material.scatter(ray.direction, &hit, rng) else {
+        return Step::Done(Color::ZERO);
+    };
+    *throughput *= scatter.attenuation;
+    if *throughput == Color::ZERO {
+        return Step::Done(Color::ZERO);
+    }
+    Step::Continue(Ray::new(hit.point, scatter.direction))
+}
+
 /// Path tracing: the ray bounces from surface to surface, each bounce
 /// multiplying its colour by the surface's attenuation, until it escapes to
 /// the background (which lights it), is absorbed (black), or reaches
 /// `max_depth` segments (black: it never found light in time).
-///
-/// Always inlined, with the BVH traversal, into the render loop, so that the
-/// loop's instruction-set versions (`render::Isa`) cover the whole path.
 #[inline(always)]
-fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color {
-    let settings = &scene.settings;
-    // Hits closer than epsilon are the surface the ray leaves from, seen again
-    // through rounding error: counting them is what causes shadow acne.
-    let range = Interval::new(settings.epsilon, f32::INFINITY);
+pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color {
+    let range = hit_range(scene);
     let mut throughput = Color::ONE;
-    for _ in 0..settings.max_depth {
+    for _ in 0..scene.settings.max_depth {
         *rays += 1;
-        let Some(hit) = scene.hit(&ray, range) else {
-            return throughput * scene.background.color(ray.direction);
-        };
-        let material = &scene.materials[hit.material as usize];
-        let Some(scatter) = material.scatter(ray.direction, &hit, rng) else {
-            return Color::ZERO;
-        };
-        throughput *= scatter.attenuation;
-        if throughput == Color::ZERO {
-            return Color::ZERO;
+        let hit = scene.hit(&ray, range);
+        match step(scene, &ray, hit, &mut throughput, rng) {
+            Step::Continue(next) => ray = next,
+            Step::Done(colour) => return colour,
         }
-        ray = Ray::new(hit.point, scatter.direction);
     }
     Color::ZERO
+}
+
+/// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
+/// each with its own generator: `colours[i]` gets exactly what
+/// `trace_path(scene, rays[i], &mut rngs[i], ..)` returns.
+///
+/// The paths advance together, one segment each per round, so that the rays
+/// of a round can be traced as bundles (see
+/// [`RayBundle`](crate::geometry::RayBundle)): a single ray's traversal
+/// waits on one test after another, while a bundle keeps the processor busy
+/// with eight. `reference` (the pixel's central ray) orders the visit of the
+/// first round's bundles; later rounds use a ray of the bundle.
+#[inline(always)]
+pub fn trace_paths(
+    scene: &Scene,
+    rays: &mut [Ray],
+    rngs: &mut [Rng],
+    reference: &Ray,
+    colours: &mut [Color],
+    traced: &mut u64,
+) {
+    let n = rays.len();
+    assert!(n <= PATHS && rngs.len() == n && colours.len() == n);
+    colours.fill(Color::ZERO);
+    let range = hit_range(scene);
+    let mut throughput = [Color::ONE; PATHS];
+    let mut hits = [None; PATHS];
+    // The paths still going, in order.
+    let mut live = [0u8; PATHS];
+    for (i, l) in live.iter_mut().enumerate().take(n) {
+        *l = i as u8;
+    }
+    let mut n_live = n;
+    for round in 0..scene.settings.max_depth {
+        *traced += n_live as u64;
+        let reference = (round == 0).then_some(reference);
+        find_hits(scene, rays, &live[..n_live], reference, range, &mut hits);
+        let mut still = 0;
+        for k in 0..n_live {
+            let i = live[k] as usize;
+            match step(scene, &rays[i], hits[i], &mut throughput[i], &mut rngs[i]) {
+                Step::Continue(next) => {
+                    rays[i] = next;
+                    live[still] = i as u8;
+                    still += 1;
+                }
+                Step::Done(colour) => colours[i] = colour,
+            }
+        }
+        n_live = still;
+        if n_live == 0 {
+            break;
+        }
+    }
+}
+
+/// Sets `hits[i]` to the hit of `rays[i]` for every path `i` of `live`:
+/// eight at a time as bundles, the few left over one by one.
+#[inline(always)]
+fn find_hits(
+    scene: &Scene,
+    rays: &[Ray],
+    live: &[u8],
+    reference: Option<&Ray>,
+    range: Interval,
+    hits: &mut [Option<HitRecord>; PATHS],
+) {
+    for group in live.chunks(LANES) {
+        if group.len() < MIN_BUNDLE {
+            for &i in group {
+                hits[i as usize] = scene.hit(&rays[i as usize], range);
+            }
+            continue;
+        }
+        let mut bundle = [rays[group[0] as usize]; LANES];
+        for (slot, &i) in bundle.iter_mut().zip(group) {
+            *slot = rays[i as usize];
+        }
+        let reference = reference.unwrap_or(&bundle[0]);
+        let found = scene.hit_bundle(&bundle[..group.len()], reference, range);
+        for (&i, hit) in group.iter().zip(found) {
+            hits[i as usize] = hit;
+        }
+    }
 }
 
 /// The debugging views of the notes' first chapters: what the camera ray hits
 /// first, shown as a flat colour or as its normal.
 fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &mut u64) -> Color {
     *rays += 1;
-    let range = Interval::new(scene.settings.epsilon, f32::INFINITY);
-    let Some(hit) = scene.hit(&ray, range) else {
+    let Some(hit) = scene.hit(&ray, hit_range(scene)) else {
         return scene.background.color(ray.direction);
     };
     let sphere = &scene.spheres[hit.object as usize];
@@ -63,5 +185,70 @@ fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &mut u64) -> 
         Shading::NormalsUnit => outward,
         Shading::NormalsRaw => outward * sphere.radius,
         Shading::NormalsBrightened | Shading::Path => 0.5 * (outward + Color::ONE),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    /// Side by side, every path must come out exactly as it does alone: the
+    /// same colour bits and the same number of segments, whatever the group
+    /// size and depth limit, on scenes with every material.
+    #[test]
+    fn paths_side_by_side_equal_paths_one_at_a_time() {
+        let names = ["cover", "glass-hollow", "metal-fuzz-0.5", "bounce-cube"];
+        for name in names {
+            let mut desc = builtin::find(name).expect("built-in").desc();
+            desc.render.width = 24;
+            for max_depth in [1, 2, 3, 50] {
+                desc.render.max_depth = max_depth;
+                let scene = Scene::from_desc(&desc).expect("compiles");
+                let height = scene.settings.height;
+                for (pixel, n) in [(0u32, 1usize), (5, 3), (100, 8), (200, 13), (300, PATHS)] {
+                    let (x, y) = (pixel % 24, (pixel / 24).min(height - 1));
+                    let mut rays = Vec::new();
+                    let mut rngs = Vec::new();
+                    for sample in 0..n as u64 {
+                        let mut rng = Rng::for_sample(7, u64::from(pixel), sample);
+                        let (dx, dy) = (rng.next_f32() - 0.5, rng.next_f32() - 0.5);
+                        rays.push(scene.camera.ray(x, y, dx, dy, &mut rng));
+                        rngs.push(rng);
+                    }
+                    let mut alone_rays = 0;
+                    let alone: Vec<Color> = rays
+                        .iter()
+                        .zip(rngs.clone())
+                        .map(|(&ray, mut rng)| trace_path(&scene, ray, &mut rng, &mut alone_rays))
+                        .collect();
+                    let mut together = vec![Color::ZERO; n];
+                    let mut together_rays = 0;
+                    let reference = scene.camera.central_ray(x, y);
+                    trace_paths(
+                        &scene,
+                        &mut rays,
+                        &mut rngs,
+                        &reference,
+                        &mut together,
+                        &mut together_rays,
+                    );
+                    let bits = |c: &[Color]| {
+                        c.iter()
+                            .map(|c| c.to_array().map(f32::to_bits))
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(
+                        bits(&together),
+                        bits(&alone),
+                        "{name}, depth {max_depth}, {n} paths"
+                    );
+                    assert_eq!(
+                        together_rays, alone_rays,
+                        "{name}, depth {max_depth}: segments"
+                    );
+                }
+            }
+        }
     }
 }

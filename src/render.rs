@@ -1,11 +1,12 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::film::Film;
-use crate::integrator::radiance;
+use crate::integrator::{radiance, trace_paths, PATHS};
 pub use crate::isa::Isa;
 use crate::math::Color;
+use crate::ray::Ray;
 use crate::rng::Rng;
-use crate::scene::{Sampling, Scene};
+use crate::scene::{Sampling, Scene, Shading};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Duration;
@@ -215,6 +216,9 @@ fn render_row_generic(
     let s = &scene.settings;
     let mut stats = RenderStats::default();
     let width = sums.len().min(counts.len());
+    // Path tracing runs a pixel's samples side by side (`trace_paths`); the
+    // debugging views trace one ray at a time.
+    let side_by_side = s.shading == Shading::Path;
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
         // Only stratified sampling permutes its cells.
@@ -223,18 +227,57 @@ fn render_row_generic(
         } else {
             0
         };
-        for index in samples.clone() {
-            let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
-            let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, key, &mut rng);
-            let ray = scene.camera.ray(x as u32, y, dx, dy, &mut rng);
-            let c = radiance(scene, ray, &mut rng, &mut stats.rays);
+        let camera_sample = |index| camera_sample(scene, x as u32, y, pixel, key, index);
+        let mut add = |c: Color| {
             stats.samples += 1;
             if !accumulate(sum, count, c) {
                 stats.dropped += 1;
             }
+        };
+        if !side_by_side {
+            for index in samples.clone() {
+                let (ray, mut rng) = camera_sample(index);
+                add(radiance(scene, ray, &mut rng, &mut stats.rays));
+            }
+            continue;
+        }
+        let reference = scene.camera.central_ray(x as u32, y);
+        let mut start = samples.start;
+        while start < samples.end {
+            let n = (samples.end - start).min(PATHS as u32) as usize;
+            let mut rays = [reference; PATHS];
+            let mut rngs = [const { Rng::placeholder() }; PATHS];
+            for (i, (ray, rng)) in rays.iter_mut().zip(&mut rngs).take(n).enumerate() {
+                (*ray, *rng) = camera_sample(start + i as u32);
+            }
+            let mut colours = [Color::ZERO; PATHS];
+            trace_paths(
+                scene,
+                &mut rays[..n],
+                &mut rngs[..n],
+                &reference,
+                &mut colours[..n],
+                &mut stats.rays,
+            );
+            // In sample order, as one at a time would add them.
+            for &c in &colours[..n] {
+                add(c);
+            }
+            start += n as u32;
         }
     }
     stats
+}
+
+/// The camera ray of sample `index` of pixel `(x, y)` (number `pixel`, with
+/// stratum key `key`), and the generator that goes on to serve its path.
+#[inline(always)]
+fn camera_sample(scene: &Scene, x: u32, y: u32, pixel: u64, key: u64, index: u32) -> (Ray, Rng) {
+    let s = &scene.settings;
+    let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
+    let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, key, &mut rng);
+    let ray = scene.camera.ray(x, y, dx, dy, &mut rng);
+    (ray, rng)
 }
 
 /// Adds one sample's colour to a pixel's sum and count, unless it is NaN or

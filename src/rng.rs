@@ -50,6 +50,11 @@ impl Rng {
         }
     }
 
+    /// A generator to be overwritten before use (filling arrays).
+    pub const fn placeholder() -> Self {
+        Self { state: 0 }
+    }
+
     /// The next 32 uniformly distributed bits.
     #[inline]
     pub fn next_u32(&mut self) -> u32 {

@@ -16,10 +16,10 @@
 //! finds bit for bit the same distances as tracing its rays one at a time.
 //!
 //! Children are visited in the order of a *reference* ray given by the
-//! caller (the pixel's central ray), not of the bundle's own rays. Each
-//! lane's result therefore depends only on that lane's ray and the
-//! reference, not on which other rays share the bundle: an image does not
-//! depend on how samples are grouped into bundles (by passes, say).
+//! caller (the pixel's central ray, say), near to the bundle's rays. The order
+//! only affects speed: each lane's result, like [`Bvh::hit`]'s, is the first
+//! hit in the order of distance then sphere index, whatever the order of the
+//! visit, so it does not depend on the other rays of its bundle either.
 
 use super::bvh::{Bvh, Hit, LEAF_BIT, NO_CHILD, STACK_SIZE};
 use crate::math::Interval;
@@ -120,15 +120,18 @@ impl Bvh {
         reference: &Ray,
         interval: Interval,
     ) -> [Option<Hit>; LANES] {
+        // Per lane, the best hit so far as in `Bvh::hit`: (distance, index),
+        // starting from (interval.max, 0). Unused lanes start at −∞, so that
+        // they never enter a box or accept a sphere.
         let mut closest = [f32::NEG_INFINITY; LANES];
         closest[..rays.len].fill(interval.max);
-        let mut best = [NO_CHILD; LANES];
+        let mut best = [0; LANES];
         if !self.nodes_empty() {
-            self.traverse_bundle(rays, reference, interval.min, &mut closest, &mut best);
+            (closest, best) = self.traverse_bundle(rays, reference, interval.min, closest, best);
         }
         let mut hits = [None; LANES];
-        for lane in 0..LANES {
-            if best[lane] != NO_CHILD {
+        for lane in 0..rays.len {
+            if closest[lane] < interval.max {
                 hits[lane] = Some(Hit {
                     t: closest[lane],
                     index: best[lane],
@@ -144,9 +147,11 @@ impl Bvh {
         rays: &RayBundle,
         reference: &Ray,
         t_min: f32,
-        closest: &mut Lanes,
-        best: &mut [u32; LANES],
-    ) {
+        mut closest: Lanes,
+        mut best: [u32; LANES],
+    ) -> (Lanes, [u32; LANES]) {
+        // The best hits are passed by value, not by reference: in memory, the
+        // compiler updates them with masked stores, and the next read stalls.
         // The reference ray's slab test, only to order children.
         let ref_inv = reference.direction.recip();
         let ref_near = [
@@ -175,7 +180,7 @@ impl Bvh {
         let mut current = 0u32;
         loop {
             if current & LEAF_BIT != 0 {
-                self.bundle_leaf(current & !LEAF_BIT, rays, t_min, closest, best);
+                (closest, best) = self.bundle_leaf(current & !LEAF_BIT, rays, t_min, closest, best);
             } else {
                 let node = self.node(current);
                 // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
@@ -246,7 +251,7 @@ impl Bvh {
             // Pop the next entry that may still hold a nearer hit for a lane.
             loop {
                 if top == 0 {
-                    return;
+                    return (closest, best);
                 }
                 top -= 1;
                 // SAFETY: entries below `top` were all written by the pushes above.
@@ -265,17 +270,18 @@ impl Bvh {
     }
 
     /// Tests every ray of the bundle against the spheres of packet `index`,
-    /// sphere by sphere in lane order, with the operations of the single-ray
-    /// packet test (so the same distances, and the lowest lane winning ties).
+    /// sphere by sphere, with the operations of the single-ray packet test
+    /// (so the same distances), keeping per lane the first in the order of
+    /// distance then sphere index, as `Bvh::hit` does.
     #[inline(always)]
     fn bundle_leaf(
         &self,
         index: u32,
         rays: &RayBundle,
         t_min: f32,
-        closest: &mut Lanes,
-        best: &mut [u32; LANES],
-    ) {
+        mut closest: Lanes,
+        mut best: [u32; LANES],
+    ) -> (Lanes, [u32; LANES]) {
         let p = self.packet(index);
         // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
         let eight = |v: &[Vec4; 2]| -> [f32; 8] {
@@ -291,10 +297,7 @@ impl Bvh {
             let (cx, cy, cz, radius2) = (pcx[s], pcy[s], pcz[s], pr2[s]);
             let [ox, oy, oz] = &rays.origin;
             let [dx, dy, dz] = &rays.direction;
-            // Whole new arrays rather than updates in place: the compiler
-            // turns a conditional update into a masked store, which stalls
-            // the next sphere's load of `closest`.
-            let (mut new_closest, mut new_best) = (*closest, *best);
+            let (mut new_closest, mut new_best) = (closest, best);
             for l in 0..LANES {
                 let fx = ox[l] - cx;
                 let fy = oy[l] - cy;
@@ -308,15 +311,20 @@ impl Bvh {
                 let sqrt_d = discriminant.sqrt();
                 let near = -half_b - sqrt_d;
                 let far = -half_b + sqrt_d;
-                let near_ok = t_min < near && near < closest[l];
-                let far_ok = t_min < far && far < closest[l];
-                let hit = real && (near_ok || far_ok);
+                // The first root beyond t_min, if it is nearer than the best.
+                let near_ok = t_min < near;
                 let t = if near_ok { near } else { far };
+                let valid = real & (near_ok | (t_min < far));
+                let hit = valid & (t < closest[l]);
+                // Exactly as near as the best (coincident surfaces): the lower
+                // sphere index wins.
+                let tie = valid & (t == closest[l]) & (sphere < best[l]);
                 new_closest[l] = if hit { t } else { closest[l] };
-                new_best[l] = if hit { sphere } else { best[l] };
+                new_best[l] = if hit | tie { sphere } else { best[l] };
             }
-            (*closest, *best) = (new_closest, new_best);
+            (closest, best) = (new_closest, new_best);
         }
+        (closest, best)
     }
 }
 
@@ -376,9 +384,15 @@ mod tests {
                 assert_eq!(bits(got[lane]), bits(expected), "case {case}, lane {lane}");
                 hits += usize::from(expected.is_some());
             }
-            assert!(got[n..].iter().all(Option::is_none), "unused lanes report nothing");
+            assert!(
+                got[n..].iter().all(Option::is_none),
+                "unused lanes report nothing"
+            );
         }
-        assert!(hits > 5000, "only {hits} hits: the test exercises too little");
+        assert!(
+            hits > 5000,
+            "only {hits} hits: the test exercises too little"
+        );
     }
 
     #[test]

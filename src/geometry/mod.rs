@@ -3,9 +3,11 @@
 
 pub mod bvh;
 pub mod bvh_build;
+pub mod bvh_bundle;
 pub mod hit;
 pub mod sphere;
 
 pub use bvh::Bvh;
+pub use bvh_bundle::RayBundle;
 pub use hit::HitRecord;
 pub use sphere::Sphere;

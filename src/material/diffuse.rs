@@ -76,7 +76,7 @@ impl Diffuse {
 }
 
 /// A unit bounce direction around unit `normal` following `model`.
-#[inline]
+#[inline(always)]
 pub fn bounce_direction(model: BounceModel, normal: Vec3, rng: &mut Rng) -> Vec3 {
     let d = match model {
         BounceModel::Cube => normal + sampling::on_cube_surface(rng),

@@ -11,7 +11,8 @@ pub mod source;
 pub use desc::SceneDesc;
 
 use crate::camera::{Camera, CameraError, CameraSettings};
-use crate::geometry::{Bvh, HitRecord, Sphere};
+use crate::geometry::bvh_bundle::LANES;
+use crate::geometry::{Bvh, HitRecord, RayBundle, Sphere};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
 use crate::math::{lerp, Color, Interval, Vec3};
 use crate::ray::Ray;
@@ -333,18 +334,45 @@ impl Scene {
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let hit = self.bvh.hit(ray, interval)?;
+        Some(self.record(ray, hit))
+    }
+
+    /// The nearest hit of each ray of `rays` within `interval`, as
+    /// [`Scene::hit`] would find it for each ray alone; `reference` is a ray
+    /// close to all of them (see [`RayBundle`]). Entries beyond `rays.len()`
+    /// are `None`.
+    #[inline(always)]
+    pub fn hit_bundle(
+        &self,
+        rays: &[Ray],
+        reference: &Ray,
+        interval: Interval,
+    ) -> [Option<HitRecord>; LANES] {
+        let hits = self
+            .bvh
+            .hit_bundle(&RayBundle::new(rays), reference, interval);
+        let mut records = [None; LANES];
+        for (lane, ray) in rays.iter().enumerate() {
+            records[lane] = hits[lane].map(|hit| self.record(ray, hit));
+        }
+        records
+    }
+
+    /// The full record of a hit the BVH found.
+    #[inline(always)]
+    fn record(&self, ray: &Ray, hit: crate::geometry::bvh::Hit) -> HitRecord {
         let sphere = &self.spheres[hit.index as usize];
         let point = ray.at(hit.t);
         let outward = sphere.outward_normal(point);
         let (normal, front_face) = crate::geometry::hit::face_normal(ray, outward);
-        Some(HitRecord {
+        HitRecord {
             point,
             normal,
             t: hit.t,
             front_face,
             material: self.sphere_materials[hit.index as usize],
             object: hit.index,
-        })
+        }
     }
 
     /// Number of nodes in the acceleration structure.
