@@ -14,7 +14,7 @@ use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::{Bvh, HitRecord, RayBundle, Sphere};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
-use crate::math::{lerp, Color, Interval, Vec3};
+use crate::math::{lerp, Color, Interval, Point3, Vec3};
 use crate::ray::Ray;
 use desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, MaterialDesc, ObjectDesc, SamplingDesc,
@@ -179,6 +179,18 @@ pub struct Scene {
     /// Material index of each sphere.
     pub sphere_materials: Vec<u32>,
     bvh: Bvh,
+    /// What shading needs of each sphere, in one place.
+    surfaces: Vec<Surface>,
+}
+
+/// The part of a sphere and its material that the record of a hit needs,
+/// together in 32 bytes: one cache line per hit instead of two, and a
+/// multiplication by the inverse radius instead of a division.
+#[derive(Clone, Copy, Debug)]
+struct Surface {
+    center: Point3,
+    inverse_radius: f32,
+    material: u32,
 }
 
 fn vec3(t: [f64; 3]) -> Vec3 {
@@ -318,6 +330,15 @@ impl Scene {
             }
         }
         let bvh = Bvh::new(&spheres);
+        let surfaces = spheres
+            .iter()
+            .zip(&sphere_materials)
+            .map(|(s, &material)| Surface {
+                center: s.center,
+                inverse_radius: 1.0 / s.radius,
+                material,
+            })
+            .collect();
         Ok(Scene {
             settings,
             camera,
@@ -326,6 +347,7 @@ impl Scene {
             spheres,
             sphere_materials,
             bvh,
+            surfaces,
         })
     }
 
@@ -361,16 +383,16 @@ impl Scene {
     /// The full record of a hit the BVH found.
     #[inline(always)]
     fn record(&self, ray: &Ray, hit: crate::geometry::bvh::Hit) -> HitRecord {
-        let sphere = &self.spheres[hit.index as usize];
+        let surface = &self.surfaces[hit.index as usize];
         let point = ray.at(hit.t);
-        let outward = sphere.outward_normal(point);
+        let outward = (point - surface.center) * surface.inverse_radius;
         let (normal, front_face) = crate::geometry::hit::face_normal(ray, outward);
         HitRecord {
             point,
             normal,
             t: hit.t,
             front_face,
-            material: self.sphere_materials[hit.index as usize],
+            material: surface.material,
             object: hit.index,
         }
     }
