@@ -27,6 +27,7 @@ fn hit_facing_up() -> HitRecord {
         front_face: true,
         material: 0,
         object: 0,
+        error: 0.0,
     }
 }
 
@@ -285,4 +286,34 @@ fn grey_sphere_in_a_white_furnace_returns_its_albedo() {
             }
         }
     }
+}
+
+/// A ray leaving a convex sphere can never meet it again. The cover's
+/// ground (radius 1000) alone, lit by the sky: with depth 2 every sample
+/// traces its camera ray and, where the ground is hit, one bounce; any
+/// segment more at depth 50 is a bounce that found the ground it left,
+/// through rounding. Before bounce rays were moved off the surface by the
+/// hit point's error bound, 2.5% of bounces did; now none may.
+#[test]
+fn bounces_do_not_hit_the_huge_ground_sphere_they_leave() {
+    let mut desc = common::builtin_desc("cover", 160, 16, 3);
+    desc.objects.truncate(1);
+    let rays = |depth: u32| {
+        let mut d = desc.clone();
+        d.render.max_depth = depth;
+        let scene = lumen::scene::Scene::from_desc(&d).expect("compiles");
+        pixel_stats(&scene).stats.rays
+    };
+    let (two, fifty) = (rays(2), rays(50));
+    let samples = 160 * 90 * 16;
+    let bounces = two - samples;
+    assert!(
+        bounces > samples / 2,
+        "the ground is not in view: {bounces} bounces"
+    );
+    assert!(
+        fifty - two <= bounces / 100_000,
+        "{} of {bounces} bounces hit the ground again",
+        fifty - two
+    );
 }

@@ -19,6 +19,27 @@ pub struct HitRecord {
     pub material: u32,
     /// Index of the hit object in the scene.
     pub object: u32,
+    /// A bound on how far `point` may lie from the true surface: `f32`
+    /// rounding of the hit point and of its offset from the sphere's centre.
+    pub error: f32,
+}
+
+impl HitRecord {
+    /// Where a ray leaving the surface along `direction` starts: the hit
+    /// point moved off the surface, to the side `direction` goes, by the
+    /// rounding bound `error`. Started at the rounded point itself, a ray
+    /// could find the surface it leaves again a little way off: on the
+    /// radius-1000 ground of the cover the rounding (≈ 3·10⁻⁵) made 2.5% of
+    /// bounces hit the ground again, beyond any small epsilon.
+    #[inline(always)]
+    pub fn spawn_origin(&self, direction: Vec3) -> Point3 {
+        let offset = if direction.dot(self.normal) >= 0.0 {
+            self.error
+        } else {
+            -self.error
+        };
+        self.point + offset * self.normal
+    }
 }
 
 /// Orients an outward normal against the ray and records which side was hit.

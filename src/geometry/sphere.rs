@@ -33,10 +33,14 @@ impl Sphere {
     /// when a small ray grazes a large sphere (the radius-1000 ground of the
     /// cover scene shows rings). Following Haines et al., *Ray Tracing Gems*
     /// ch. 7, the discriminant is computed as R² − |l|², where l is the part of
-    /// A − C perpendicular to the ray. The roots themselves need no such care:
-    /// −h ∓ √d cancels only when that root is close to 0 compared with h, that
-    /// is for the surface a ray is leaving, which the interval's lower end
-    /// (the renderer's epsilon) excludes anyway.
+    /// A − C perpendicular to the ray. The roots −h ∓ √d cancel only when a
+    /// root is close to 0 compared with h, that is for the surface a ray is
+    /// leaving. On a large sphere that error (≈ 2⁻²⁴R/cos θ) can exceed any
+    /// small epsilon, so the renderer starts rays leaving a surface a
+    /// rounding bound off it ([`HitRecord::spawn_origin`]), where the root is
+    /// clearly negative.
+    ///
+    /// [`HitRecord::spawn_origin`]: crate::geometry::HitRecord::spawn_origin
     #[inline]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
         debug_assert!(

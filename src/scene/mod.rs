@@ -183,6 +183,15 @@ pub struct Scene {
     surfaces: Vec<Surface>,
 }
 
+/// A bound on the distance between a hit point computed in `f32` and the
+/// sphere's surface: the point and its offset from the centre are each
+/// rounded to about 2⁻²⁴ of their size (the point's coordinates, the
+/// radius); 2⁻²⁰ leaves a wide margin over their sum.
+#[inline(always)]
+fn point_error(point: Point3, radius: f32) -> f32 {
+    (point.abs().max_element() + radius) * (1.0 / (1u32 << 20) as f32)
+}
+
 /// The part of a sphere and its material that the record of a hit needs,
 /// together in 32 bytes: one cache line per hit instead of two, and a
 /// multiplication by the inverse radius instead of a division.
@@ -190,6 +199,7 @@ pub struct Scene {
 struct Surface {
     center: Point3,
     inverse_radius: f32,
+    radius: f32,
     material: u32,
 }
 
@@ -336,6 +346,7 @@ impl Scene {
             .map(|(s, &material)| Surface {
                 center: s.center,
                 inverse_radius: 1.0 / s.radius,
+                radius: s.radius,
                 material,
             })
             .collect();
@@ -394,6 +405,7 @@ impl Scene {
             front_face,
             material: surface.material,
             object: hit.index,
+            error: point_error(point, surface.radius),
         }
     }
 
