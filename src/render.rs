@@ -312,15 +312,16 @@ mod tests {
     fn every_instruction_set_version_renders_the_same_bits() {
         let mut desc = builtin::cover();
         desc.render.width = 48;
-        desc.render.samples_per_pixel = 2;
+        // Enough samples for bundles of every size in every round.
+        desc.render.samples_per_pixel = 37;
         let scene = Scene::from_desc(&desc).expect("the cover compiles");
         let width = scene.settings.width as usize;
         let isa = Isa::detect();
         for y in 0..scene.settings.height {
             let mut base = (vec![[0.0f64; 3]; width], vec![0u32; width]);
             let mut best = base.clone();
-            let a = render_row(Isa::Baseline, &scene, y, 0..2, &mut base.0, &mut base.1);
-            let b = render_row(isa, &scene, y, 0..2, &mut best.0, &mut best.1);
+            let a = render_row(Isa::Baseline, &scene, y, 0..37, &mut base.0, &mut base.1);
+            let b = render_row(isa, &scene, y, 0..37, &mut best.0, &mut best.1);
             assert_eq!(a, b, "row {y}: counts differ between baseline and {isa:?}");
             let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(

@@ -41,8 +41,10 @@ pub fn unit_vector(rng: &mut Rng) -> Vec3 {
 fn sin_cos_turns(u: f32) -> (f32, f32) {
     // The nearest quarter turn q, and the rest as an angle in [−π/4, π/4].
     let x = 4.0 * u;
-    let q = x.round();
-    let a = (x - q) * FRAC_PI_2;
+    // Rounded by truncation (x ≥ 0): `round` is a library call on the
+    // baseline x86-64 instruction set.
+    let q = (x + 0.5) as u32;
+    let a = (x - q as f32) * FRAC_PI_2;
     let a2 = a * a;
     // Taylor series to the a⁹ and a⁸ terms: the first term left out is below
     // (π/4)¹⁰/10! ≈ 2.5·10⁻⁸.
@@ -51,7 +53,6 @@ fn sin_cos_turns(u: f32) -> (f32, f32) {
     let cos = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 / 40_320.0)));
     // Turn by q quarter turns, without branches (q is random): an odd q
     // swaps sine and cosine, q = 2 or 3 negates both.
-    let q = q as u32;
     let (sin, cos) = if q & 1 == 1 { (cos, -sin) } else { (sin, cos) };
     let negate = (q & 2) << 30;
     (

@@ -194,8 +194,9 @@ impl Bvh {
         let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
         let sphere_ray = SphereRay::new(ray, interval, self.avx2);
         // The best hit so far, compared as the pair (distance, sphere index)
-        // so that the result does not depend on the order of the visit. No
-        // sphere ties the start (interval.max, 0): index 0 is the lowest.
+        // so that, with boxes kept within `SLACK`, the result does not depend
+        // on the order of the visit. No sphere ties the start
+        // (interval.max, 0): index 0 is the lowest.
         let mut closest = interval.max;
         let mut best = 0;
 
@@ -221,8 +222,8 @@ impl Bvh {
                 let tz1 = (p[2][1 - near[2]] - o4[2]) * inv4[2];
                 // The bound given last wins when a lane is NaN (0·∞ for a ray
                 // lying in a box's plane), so a NaN never culls a box it may hit.
-                let t_near = tx0.max(ty0).max(tz0).max(sphere_ray.t_min);
-                let t_far = tx1.min(ty1).min(tz1).min(Vec4::splat(closest));
+                let t_near = max4(max4(max4(tx0, ty0), tz0), sphere_ray.t_min);
+                let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(closest)) * SLACK4;
                 let mut mask = t_near.cmple(t_far).bitmask() & node.used;
                 if mask != 0 && mask & (mask - 1) == 0 {
                     // One child hit (the most common case): go on with it.
@@ -285,7 +286,7 @@ impl Bvh {
                 // SAFETY: entries below `top` were all written by the pushes above.
                 #[allow(unsafe_code)]
                 let (child, t_near) = unsafe { stack[top].assume_init() };
-                if t_near <= closest {
+                if t_near <= closest * SLACK {
                     current = child;
                     break;
                 }
@@ -482,6 +483,44 @@ fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Op
         }
     }
     (t_best < closest || lowest < best).then_some((t_best, lowest))
+}
+
+/// Box tests keep a box whose entry is up to this factor beyond the far end
+/// of the interval (the box's exit or the best hit so far). The box and
+/// sphere tests round differently, and a sphere touching its box's face can
+/// compute a hit a few ulp before the box's computed entry: without the
+/// margin, such a box could be culled when the best hit so far has the same
+/// distance, and which of two tied spheres is found would depend on the order
+/// of the visit. 2⁻¹² is far above those few ulp and costs no measurable
+/// extra visits.
+pub(super) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
+const SLACK4: Vec4 = Vec4::splat(SLACK);
+
+/// `maxps` semantics on every architecture: `a` if `a > b`, else `b` (so `b`
+/// when either is NaN). NEON's and the scalar fallback's `max` differ on NaN.
+#[inline(always)]
+fn max4(a: Vec4, b: Vec4) -> Vec4 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        a.max(b)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        Vec4::select(a.cmpgt(b), a, b)
+    }
+}
+
+/// `minps` semantics on every architecture, as [`max4`].
+#[inline(always)]
+fn min4(a: Vec4, b: Vec4) -> Vec4 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        a.min(b)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        Vec4::select(a.cmplt(b), a, b)
+    }
 }
 
 /// Lane-wise square root (glam's `Vec4` has none).

@@ -1,27 +1,33 @@
-//! Bundles of up to eight nearly parallel rays traced through the BVH
-//! together: the camera rays of one pixel.
+//! Bundles of up to eight rays traced through the BVH together: the camera
+//! rays of one pixel, or the bounces of a round of its paths.
 //!
 //! Single-ray traversal ([`Bvh::hit`]) is bound by latency: each box and
 //! sphere test waits for the one before. The camera rays of one pixel start
 //! within the lens and pass within one pixel of each other, so they visit
-//! nearly the same nodes. A bundle visits each node once for all its rays,
-//! testing the eight rays against one box (or one sphere) as eight
-//! independent lanes: the work per ray is about the same, but it is spread
-//! over SIMD lanes and independent chains instead of one long chain.
+//! nearly the same nodes; the bounces of one pixel's paths start close
+//! together, and many of them leave the scene at once. A bundle visits each
+//! node once for all its rays, testing the eight rays against one box (or
+//! one sphere) as eight independent lanes: the work per ray is about the
+//! same, but it is spread over SIMD lanes and independent chains instead of
+//! one long chain.
 //!
 //! The lanes are plain `[f32; 8]` arrays processed by simple loops, which the
 //! compiler turns into 8-wide (AVX2) or 2×4-wide (SSE2, NEON) vector code in
 //! each instruction-set version of the render loop. Every arithmetic
 //! operation is the one [`Bvh::hit`] performs, in the same order, so a bundle
-//! finds bit for bit the same distances as tracing its rays one at a time.
+//! finds bit for bit the same distances as tracing its rays one at a time,
+//! and a lane tests a leaf's spheres only when its own ray enters the leaf's
+//! box, as it would alone.
 //!
 //! Children are visited in the order of a *reference* ray given by the
 //! caller (the pixel's central ray, say), near to the bundle's rays. The order
 //! only affects speed: each lane's result, like [`Bvh::hit`]'s, is the first
-//! hit in the order of distance then sphere index, whatever the order of the
-//! visit, so it does not depend on the other rays of its bundle either.
+//! hit in the order of distance then sphere index, and boxes are kept with a
+//! margin over the rounding of their tests (`bvh::SLACK`), so the result
+//! does not depend on the order of the visit, nor on the other rays of the
+//! bundle.
 
-use super::bvh::{Bvh, Hit, LEAF_BIT, NO_CHILD, STACK_SIZE};
+use super::bvh::{Bvh, Hit, LEAF_BIT, NO_CHILD, SLACK, STACK_SIZE};
 use crate::math::Interval;
 use crate::ray::Ray;
 use glam::Vec4;
@@ -173,19 +179,28 @@ impl Bvh {
         let flip: [[bool; LANES]; 3] =
             std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0));
 
-        // Entries: a child and, per lane, where its box starts (+∞ for lanes
-        // that miss it). Uninitialised, as in `Bvh::hit`.
+        // Entries: a child and, per lane, where its box starts (NaN for lanes
+        // that miss it, which no comparison accepts). Uninitialised, as in
+        // `Bvh::hit`. `entry` is the same for `current`.
         let mut stack = [MaybeUninit::<(u32, Lanes)>::uninit(); STACK_SIZE];
         let mut top = 0usize;
         let mut current = 0u32;
+        let mut entry = [f32::NAN; LANES];
         loop {
             if current & LEAF_BIT != 0 {
-                (closest, best) = self.bundle_leaf(current & !LEAF_BIT, rays, t_min, closest, best);
+                // Only the lanes that enter the leaf's box test its spheres,
+                // as each ray alone would.
+                let mut enter = [false; LANES];
+                for l in 0..LANES {
+                    enter[l] = entry[l] <= closest[l] * SLACK;
+                }
+                (closest, best) =
+                    self.bundle_leaf(current & !LEAF_BIT, rays, t_min, &enter, closest, best);
             } else {
                 let node = self.node(current);
                 // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
                 let bounds = node.planes.map(|pair| pair.map(|v| v.to_array()));
-                let mut t_near = [[f32::INFINITY; LANES]; 4];
+                let mut t_near = [[f32::NAN; LANES]; 4];
                 let mut hit_mask = 0u32;
                 for child in 0..4 {
                     if node.used & (1 << child) == 0 {
@@ -208,9 +223,9 @@ impl Bvh {
                         let (y0, y1) = slab(1);
                         let (z0, z1) = slab(2);
                         let near = max_ps(max_ps(max_ps(x0, y0), z0), t_min);
-                        let far = min_ps(min_ps(min_ps(x1, y1), z1), closest[l]);
+                        let far = min_ps(min_ps(min_ps(x1, y1), z1), closest[l]) * SLACK;
                         let hit = near <= far;
-                        tn[l] = if hit { near } else { f32::INFINITY };
+                        tn[l] = if hit { near } else { f32::NAN };
                         any |= hit;
                     }
                     hit_mask |= u32::from(any) << child;
@@ -245,6 +260,7 @@ impl Bvh {
                         top += 1;
                     }
                     current = node.children[hits[n - 1].0];
+                    entry = t_near[hits[n - 1].0];
                     continue;
                 }
             }
@@ -259,10 +275,11 @@ impl Bvh {
                 let (child, t_near) = unsafe { stack[top].assume_init() };
                 let mut needed = false;
                 for l in 0..LANES {
-                    needed |= t_near[l] <= closest[l];
+                    needed |= t_near[l] <= closest[l] * SLACK;
                 }
                 if needed {
                     current = child;
+                    entry = t_near;
                     break;
                 }
             }
@@ -279,6 +296,7 @@ impl Bvh {
         index: u32,
         rays: &RayBundle,
         t_min: f32,
+        enter: &[bool; LANES],
         mut closest: Lanes,
         mut best: [u32; LANES],
     ) -> (Lanes, [u32; LANES]) {
@@ -314,7 +332,7 @@ impl Bvh {
                 // The first root beyond t_min, if it is nearer than the best.
                 let near_ok = t_min < near;
                 let t = if near_ok { near } else { far };
-                let valid = real & (near_ok | (t_min < far));
+                let valid = enter[l] & real & (near_ok | (t_min < far));
                 let hit = valid & (t < closest[l]);
                 // Exactly as near as the best (coincident surfaces): the lower
                 // sphere index wins.
@@ -419,6 +437,56 @@ mod tests {
                 assert_eq!(key(all[lane]), key(alone[0]));
             }
         }
+    }
+
+    fn key(h: Option<Hit>) -> Option<(u32, u32)> {
+        h.map(|h| (h.t.to_bits(), h.index))
+    }
+
+    /// A sphere touching its box's face computes a hit a rounding error
+    /// before the box's computed entry: the tie with an identical sphere in
+    /// another leaf must still go to the lower index, whatever the order.
+    #[test]
+    fn ties_at_a_box_face_go_to_the_lowest_index_in_any_order() {
+        let c = Vec3::new(-0.79811573, 0.90824604, 1.9778109);
+        let mut spheres = vec![Sphere::new(c, 1.8841038); 20];
+        spheres.extend((0..20).map(|i| Sphere::new(Vec3::new(i as f32, 8.0, 0.0), 0.5)));
+        let bvh = Bvh::new(&spheres);
+        let interval = Interval::new(0.001, f32::INFINITY);
+        let o = Vec3::new(10.488633, 1.1547536, 0.70374763);
+        let ray = Ray::new(o, Vec3::new(-0.9906112, -0.025959643, 0.13422203));
+        let box_entry = (c.x + 1.8841038 - o.x) * ray.direction.x.recip();
+        let t = spheres[0].hit(&ray, interval).expect("hits");
+        assert!(
+            box_entry > t,
+            "the case lost its point: entry {box_entry}, hit {t}"
+        );
+        assert_eq!(key(bvh.hit(&ray, interval)), Some((t.to_bits(), 0)));
+        for reference in [
+            ray,
+            Ray::new(Vec3::Y * 20.0, -Vec3::Y),
+            Ray::new(-Vec3::X * 10.0, Vec3::X),
+        ] {
+            let got = bvh.hit_bundle(&RayBundle::new(&[ray]), &reference, interval);
+            assert_eq!(key(got[0]), Some((t.to_bits(), 0)));
+        }
+    }
+
+    /// A ray grazing a sphere whose box test misses: alone it hits nothing,
+    /// and it must not hit the sphere because another ray of its bundle
+    /// enters the box.
+    #[test]
+    fn a_lane_missing_a_box_does_not_test_its_spheres() {
+        let sphere = Sphere::new(Vec3::new(0.4491043, -1.872978, -2.6306076), 0.5630208);
+        let bvh = Bvh::new(&[sphere]);
+        let interval = Interval::new(0.001, f32::INFINITY);
+        let o = Vec3::new(3.1213696, 33.058666, -3.1936314);
+        let grazing = Ray::new(o, Vec3::new(-0.07628037, -0.99708647, 8.617153e-8));
+        let through = Ray::new(o, (sphere.center - o).normalize());
+        let alone = bvh.hit(&grazing, interval);
+        let bundle = bvh.hit_bundle(&RayBundle::new(&[through, grazing]), &through, interval);
+        assert!(bundle[0].is_some());
+        assert_eq!(key(bundle[1]), key(alone));
     }
 
     #[test]
