@@ -18,7 +18,7 @@
 //! - [`progressive`] and [`checkpoint`]: rendering in passes that can be
 //!   stopped, saved and resumed, within a time budget.
 //! - [`scene`]: scene descriptions, the built-in scenes, and the compiled scene.
-//! - [`gallery`] and [`bench`]: all the notes' figures at once; throughput.
+//! - [`gallery`] and [`bench`](mod@bench): all the notes' figures at once; throughput.
 //!
 //! ```
 //! use lumen::scene::{builtin, Scene};

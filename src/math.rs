@@ -1,6 +1,6 @@
 //! Basic numeric types shared by every module.
 //!
-//! lumen computes in `f32` with glam's 16-byte aligned [`Vec3A`], which maps a
+//! lumen computes in `f32` with glam's 16-byte aligned [`Vec3A`](glam::Vec3A), which maps a
 //! 3-vector onto one SIMD register. Points, directions and colours all use it.
 
 pub use glam::Vec3A as Vec3;
