@@ -41,17 +41,24 @@ fn films_are_bit_identical_across_thread_counts() {
 
 #[test]
 fn rendering_in_passes_equals_rendering_at_once() {
-    let scene = builtin_scene("glass-refract-reflect", 40, 9, 4);
-    let (whole, stats) = render(&scene, &|_| {});
-    for split in [1, 4, 8] {
-        let mut film = Film::new(scene.settings.width, scene.settings.height);
-        let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
-        passes.add(render_samples(&scene, &mut film, split..9, &|_| {}));
-        assert!(
-            film == whole,
-            "0..{split} then {split}..9 differs from 0..9"
-        );
-        assert_eq!(passes, stats);
+    // Passes group a pixel's samples differently into paths traced side by
+    // side and into bundles of rays (up to 32 and 8): no difference may show.
+    for (name, spp, splits) in [
+        ("glass-refract-reflect", 9, &[1, 4, 8][..]),
+        ("cover", 37, &[1, 3, 20, 33][..]),
+    ] {
+        let scene = builtin_scene(name, 40, spp, 4);
+        let (whole, stats) = render(&scene, &|_| {});
+        for &split in splits {
+            let mut film = Film::new(scene.settings.width, scene.settings.height);
+            let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
+            passes.add(render_samples(&scene, &mut film, split..spp, &|_| {}));
+            assert!(
+                film == whole,
+                "{name}: 0..{split} then {split}..{spp} differs from 0..{spp}"
+            );
+            assert_eq!(passes, stats);
+        }
     }
 }
 
