@@ -65,14 +65,10 @@ fn step(
     if *throughput == Color::ZERO {
         return Step::Done(Color::ZERO);
     }
-    // With epsilon 0 (the notes' demonstration of shadow acne) the ray
-    // starts at the hit point itself, as in the notes.
-    let origin = if scene.settings.epsilon > 0.0 {
-        hit.spawn_origin(scatter.direction)
-    } else {
-        hit.point
-    };
-    Step::Continue(Ray::new(origin, scatter.direction))
+    Step::Continue(Ray::new(
+        hit.spawn_origin(scatter.direction),
+        scatter.direction,
+    ))
 }
 
 /// Path tracing: the ray bounces from surface to surface, each bounce

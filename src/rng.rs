@@ -40,8 +40,8 @@ impl Rng {
     /// that `pixel · 2³² + sample` names the sample uniquely; the bijective
     /// [`mix64`] of that name, keyed by the mixed seed, starts its sequence.
     /// Two finalisers per sample, not five: seeding is a noticeable part of a
-    /// camera sample's cost. (`mix64(seed)` is the same for every sample and
-    /// is hoisted out of the render loop.)
+    /// camera sample's cost. (`mix64(seed)` is the same for every sample, so
+    /// the optimiser can hoist it out of the render loop once this is inlined.)
     #[inline]
     pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Self {
         debug_assert!(pixel < 1 << 32 && sample < 1 << 32);

@@ -224,7 +224,7 @@ impl Bvh {
                 // lying in a box's plane), so a NaN never culls a box it may hit.
                 let t_near = max4(max4(max4(tx0, ty0), tz0), sphere_ray.t_min);
                 let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(closest)) * SLACK4;
-                let mut mask = t_near.cmple(t_far).bitmask() & node.used;
+                let mask = t_near.cmple(t_far).bitmask() & node.used;
                 if mask != 0 && mask & (mask - 1) == 0 {
                     // One child hit (the most common case): go on with it.
                     current = node.children[mask.trailing_zeros() as usize & 3];
@@ -250,26 +250,12 @@ impl Bvh {
                     }
                     // Three or four: push the hit children farthest first; go
                     // on with the nearest.
-                    let mut hits = [(0u32, 0.0f32); 4];
-                    let mut n = 0;
-                    while mask != 0 {
-                        let lane = mask.trailing_zeros() as usize & 3;
-                        mask &= mask - 1;
-                        let entry = (node.children[lane], t_near[lane]);
-                        // Insertion sort, descending distance.
-                        let mut i = n;
-                        while i > 0 && hits[i - 1].1 < entry.1 {
-                            hits[i] = hits[i - 1];
-                            i -= 1;
-                        }
-                        hits[i] = entry;
-                        n += 1;
-                    }
-                    for &h in &hits[..n - 1] {
-                        stack[top].write(h);
+                    let (order, n) = farthest_first(mask, t_near);
+                    for &lane in &order[..n - 1] {
+                        stack[top].write((node.children[lane], t_near[lane]));
                         top += 1;
                     }
-                    current = hits[n - 1].0;
+                    current = node.children[order[n - 1]];
                     continue;
                 }
             }
@@ -483,6 +469,28 @@ fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Op
         }
     }
     (t_best < closest || lowest < best).then_some((t_best, lowest))
+}
+
+/// The lanes set in `mask` (at least one, of four) ordered by `distance`,
+/// farthest first, and how many there are: a traversal pushes all but the
+/// last and goes on with the last, the nearest.
+#[inline(always)]
+pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], usize) {
+    let mut order = [0usize; 4];
+    let mut n = 0;
+    while mask != 0 {
+        let lane = mask.trailing_zeros() as usize & 3;
+        mask &= mask - 1;
+        // Insertion sort, descending distance.
+        let mut i = n;
+        while i > 0 && distance[order[i - 1]] < distance[lane] {
+            order[i] = order[i - 1];
+            i -= 1;
+        }
+        order[i] = lane;
+        n += 1;
+    }
+    (order, n)
 }
 
 /// Box tests keep a box whose entry is up to this factor beyond the far end

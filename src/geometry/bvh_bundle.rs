@@ -27,7 +27,7 @@
 //! does not depend on the order of the visit, nor on the other rays of the
 //! bundle.
 
-use super::bvh::{Bvh, Hit, LEAF_BIT, NO_CHILD, SLACK, STACK_SIZE};
+use super::bvh::{farthest_first, Bvh, Hit, LEAF_BIT, NO_CHILD, SLACK, STACK_SIZE};
 use crate::math::Interval;
 use crate::ray::Ray;
 use glam::Vec4;
@@ -238,29 +238,14 @@ impl Bvh {
                     let rx = (p[0][ref_near[0]] - ref_o[0]) * ref_inv4[0];
                     let ry = (p[1][ref_near[1]] - ref_o[1]) * ref_inv4[1];
                     let rz = (p[2][ref_near[2]] - ref_o[2]) * ref_inv4[2];
-                    let order = rx.max(ry).max(rz).max(Vec4::splat(t_min)).to_array();
-                    let mut hits = [(0usize, 0.0f32); 4];
-                    let mut n = 0;
-                    let mut mask = hit_mask;
-                    while mask != 0 {
-                        let child = mask.trailing_zeros() as usize & 3;
-                        mask &= mask - 1;
-                        let entry = (child, order[child]);
-                        // Insertion sort, descending distance; ties keep lane order.
-                        let mut i = n;
-                        while i > 0 && hits[i - 1].1 < entry.1 {
-                            hits[i] = hits[i - 1];
-                            i -= 1;
-                        }
-                        hits[i] = entry;
-                        n += 1;
-                    }
-                    for &(child, _) in &hits[..n - 1] {
+                    let distance = rx.max(ry).max(rz).max(Vec4::splat(t_min)).to_array();
+                    let (order, n) = farthest_first(hit_mask, distance);
+                    for &child in &order[..n - 1] {
                         stack[top].write((node.children[child], t_near[child]));
                         top += 1;
                     }
-                    current = node.children[hits[n - 1].0];
-                    entry = t_near[hits[n - 1].0];
+                    current = node.children[order[n - 1]];
+                    entry = t_near[order[n - 1]];
                     continue;
                 }
             }

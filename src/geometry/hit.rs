@@ -21,6 +21,8 @@ pub struct HitRecord {
     pub object: u32,
     /// A bound on how far `point` may lie from the true surface: `f32`
     /// rounding of the hit point and of its offset from the sphere's centre.
+    /// 0 when the scene's epsilon is 0, so that rays leave from the point
+    /// itself (the notes' shadow acne).
     pub error: f32,
 }
 

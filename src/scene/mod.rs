@@ -179,17 +179,23 @@ pub struct Scene {
     /// Material index of each sphere.
     pub sphere_materials: Vec<u32>,
     bvh: Bvh,
+    /// See [`error_scale`].
+    error_scale: f32,
     /// What shading needs of each sphere, in one place.
     surfaces: Vec<Surface>,
 }
 
-/// A bound on the distance between a hit point computed in `f32` and the
-/// sphere's surface: the point and its offset from the centre are each
-/// rounded to about 2⁻²⁴ of their size (the point's coordinates, the
-/// radius); 2⁻²⁰ leaves a wide margin over their sum.
-#[inline(always)]
-fn point_error(point: Point3, radius: f32) -> f32 {
-    (point.abs().max_element() + radius) * (1.0 / (1u32 << 20) as f32)
+/// The factor of [`HitRecord::error`]: the hit point and its offset from the
+/// centre are each rounded to about 2⁻²⁴ of their size (the point's
+/// coordinates, the radius); 2⁻²⁰ leaves a wide margin over their sum. With
+/// epsilon 0 (the notes' demonstration of shadow acne) it is 0, and rays
+/// leave from the hit point itself, as in the notes.
+fn error_scale(epsilon: f32) -> f32 {
+    if epsilon > 0.0 {
+        1.0 / (1u32 << 20) as f32
+    } else {
+        0.0
+    }
 }
 
 /// The part of a sphere and its material that the record of a hit needs,
@@ -351,6 +357,7 @@ impl Scene {
             })
             .collect();
         Ok(Scene {
+            error_scale: error_scale(settings.epsilon),
             settings,
             camera,
             background,
@@ -405,7 +412,7 @@ impl Scene {
             front_face,
             material: surface.material,
             object: hit.index,
-            error: point_error(point, surface.radius),
+            error: (point.abs().max_element() + surface.radius) * self.error_scale,
         }
     }
 
