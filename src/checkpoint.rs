@@ -28,6 +28,7 @@ use crate::film::Film;
 use crate::output::{self, OutputError};
 use crate::render::RenderStats;
 use crate::scene::SceneDesc;
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -244,7 +245,7 @@ impl Checkpoint {
     /// Reads a checkpoint from `bytes`; `path` only names it in errors.
     pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, CheckpointError> {
         let path_buf = || path.to_path_buf();
-        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+        if !bytes.starts_with(MAGIC) {
             return Err(CheckpointError::NotACheckpoint { path: path_buf() });
         }
         if bytes.len() < HEADER_LEN {
@@ -379,14 +380,13 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
     };
     let mut out = Vec::new();
     let empty = serde_json::Map::new();
-    let section = |m: &serde_json::Map<String, Value>| match m.get("render") {
-        Some(Value::Object(r)) => r.clone(),
-        _ => empty.clone(),
+    let section = |m| {
+        serde_json::Map::get(m, "render")
+            .and_then(Value::as_object)
+            .unwrap_or(&empty)
     };
     let (a, b) = (section(&theirs), section(&ours));
-    let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
-    keys.sort();
-    keys.dedup();
+    let keys: BTreeSet<&String> = a.keys().chain(b.keys()).collect();
     for key in keys {
         let (x, y) = (a.get(key).unwrap_or(&absent), b.get(key).unwrap_or(&absent));
         if x != y {
@@ -402,9 +402,7 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
             ));
         }
     }
-    let mut sections: Vec<&String> = theirs.keys().chain(ours.keys()).collect();
-    sections.sort();
-    sections.dedup();
+    let sections: BTreeSet<&String> = theirs.keys().chain(ours.keys()).collect();
     let differing: Vec<&str> = sections
         .into_iter()
         .filter(|k| *k != "render" && theirs.get(*k) != ours.get(*k))

@@ -85,13 +85,7 @@ impl Film {
     /// The mean linear colour of pixel `(x, y)`; black if it has no samples.
     pub fn pixel(&self, x: u32, y: u32) -> Color {
         let i = y as usize * self.width as usize + x as usize;
-        let n = self.counts[i];
-        if n == 0 {
-            return Color::ZERO;
-        }
-        let s = self.sums[i];
-        let n = f64::from(n);
-        Color::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32)
+        mean(&self.sums[i], self.counts[i])
     }
 
     /// All pixels' mean linear colours, row-major, top row first.
@@ -113,8 +107,22 @@ impl Film {
 
     /// The mean linear colour of every pixel, row-major, top row first.
     pub fn pixels(&self) -> impl Iterator<Item = Color> + '_ {
-        (0..self.height).flat_map(move |y| (0..self.width).map(move |x| self.pixel(x, y)))
+        self.sums.iter().zip(&self.counts).map(|(s, &n)| mean(s, n))
     }
+}
+
+/// The mean of `n` samples summing to `sum`; black if there are none.
+#[inline]
+fn mean(sum: &[f64; 3], n: u32) -> Color {
+    if n == 0 {
+        return Color::ZERO;
+    }
+    let n = f64::from(n);
+    Color::new(
+        (sum[0] / n) as f32,
+        (sum[1] / n) as f32,
+        (sum[2] / n) as f32,
+    )
 }
 
 /// Applies the display gamma (v^(1/γ)) and tone-maps by clamping to [0, 1].

@@ -5,7 +5,6 @@
 
 use crate::film::Film;
 use std::fs;
-use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -68,7 +67,7 @@ fn io_error(path: &Path, e: impl std::fmt::Display) -> OutputError {
 }
 
 /// Checks, before any work is done, that `path` can later be written: its
-/// format is known, its directory exists and accepts new files.
+/// directory exists and accepts new files.
 pub fn check_writable(path: &Path) -> Result<(), OutputError> {
     if path.is_dir() {
         return Err(io_error(path, "is a directory, not a file"));
@@ -86,7 +85,8 @@ pub fn check_writable(path: &Path) -> Result<(), OutputError> {
         .map_err(|e| io_error(path, format!("cannot write in {}: {e}", dir.display())))
 }
 
-fn parent_dir(path: &Path) -> &Path {
+/// The directory `path` is in: its parent, or `.` for a bare file name.
+pub fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -140,11 +140,17 @@ pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputErr
         ImageFormat::Ppm => write_bytes_atomic(path, &encode_ppm(film, gamma)),
         ImageFormat::Pfm => write_bytes_atomic(path, &encode_pfm(film)),
         ImageFormat::Png => {
-            let img = image::RgbImage::from_raw(w, h, film.to_rgb8(gamma))
-                .ok_or_else(|| io_error(path, "image buffer has the wrong size"))?;
+            let rgb = film.to_rgb8(gamma);
             write_atomic(path, |tmp| {
-                img.save_with_format(tmp, image::ImageFormat::Png)
-                    .map_err(|e| e.to_string())
+                image::save_buffer_with_format(
+                    tmp,
+                    &rgb,
+                    w,
+                    h,
+                    image::ExtendedColorType::Rgb8,
+                    image::ImageFormat::Png,
+                )
+                .map_err(|e| e.to_string())
             })
         }
         ImageFormat::Exr => write_atomic(path, |tmp| {
@@ -159,17 +165,15 @@ pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputErr
 
 /// Plain-text P3 PPM: a header, then one "r g b" line a pixel, top row first.
 pub fn encode_ppm(film: &Film, gamma: f32) -> Vec<u8> {
+    use std::fmt::Write as _;
+    const IN_MEMORY: &str = "writing to a String cannot fail";
     let bytes = film.to_rgb8(gamma);
-    let mut out = BufWriter::new(Vec::with_capacity(bytes.len() * 4 + 32));
-    let write = |out: &mut BufWriter<Vec<u8>>| -> io::Result<()> {
-        writeln!(out, "P3\n{} {}\n255", film.width(), film.height())?;
-        for p in bytes.chunks_exact(3) {
-            writeln!(out, "{} {} {}", p[0], p[1], p[2])?;
-        }
-        Ok(())
-    };
-    write(&mut out).expect("writing to memory cannot fail");
-    out.into_inner().expect("flushing to memory cannot fail")
+    let mut out = String::with_capacity(bytes.len() * 4 + 32);
+    writeln!(out, "P3\n{} {}\n255", film.width(), film.height()).expect(IN_MEMORY);
+    for p in bytes.chunks_exact(3) {
+        writeln!(out, "{} {} {}", p[0], p[1], p[2]).expect(IN_MEMORY);
+    }
+    out.into_bytes()
 }
 
 /// Portable float map: linear RGB, little-endian, bottom row first.

@@ -182,16 +182,21 @@ impl Session {
         // Checked before compiling, so a mismatch is reported as such even
         // when the checkpoint's scene would not compile any more.
         checkpoint.check_matches(desc, path)?;
-        Self::new(desc)?.restore(checkpoint, path)
+        Self::new(desc)?.adopt(checkpoint, path)
     }
 
     /// Continues this new session from `checkpoint` (read from `path`, which
     /// names it in errors). Refused unless the checkpoint was made for the
     /// same description, overrides included.
-    pub fn restore(mut self, checkpoint: Checkpoint, path: &Path) -> Result<Self, SessionError> {
+    pub fn restore(self, checkpoint: Checkpoint, path: &Path) -> Result<Self, SessionError> {
         checkpoint.check_description(&self.description, path)?;
-        let session = &mut self;
-        let s = &session.scene.settings;
+        self.adopt(checkpoint, path)
+    }
+
+    /// Takes the samples of `checkpoint`, whose description is known to be
+    /// this session's, after checking that its film fits the render.
+    fn adopt(mut self, checkpoint: Checkpoint, path: &Path) -> Result<Self, SessionError> {
+        let s = &self.scene.settings;
         let malformed = |message: String| CheckpointError::Malformed {
             path: path.to_path_buf(),
             message,
@@ -213,9 +218,9 @@ impl Session {
             ))
             .into());
         }
-        session.film = checkpoint.film;
-        session.stats = checkpoint.stats;
-        session.spp_done = checkpoint.spp_done;
+        self.film = checkpoint.film;
+        self.stats = checkpoint.stats;
+        self.spp_done = checkpoint.spp_done;
         Ok(self)
     }
 

@@ -12,9 +12,8 @@ pub(crate) fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
     let start = Instant::now();
     let mut total = RenderStats::default();
     let bar = progress_bar(BUILTINS.len() as u64);
-    lumen::gallery::make_gallery(dir, &args.overrides(), &mut |name, stats| {
+    lumen::gallery::make_gallery(dir, &args.overrides(), &mut |_name, stats| {
         bar.inc(1);
-        bar.set_message(name.to_string());
         total.add(stats);
     })?;
     bar.finish_and_clear();

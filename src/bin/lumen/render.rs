@@ -16,10 +16,7 @@ use std::time::Instant;
 /// Where a path points once its directory is resolved (the file itself may
 /// not exist yet): `./out.png`, `out.png` and `$PWD/out.png` are one place.
 fn resolved(path: &Path) -> PathBuf {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let dir = output::parent_dir(path);
     let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
     match path.file_name() {
         Some(name) => dir.join(name),
@@ -184,21 +181,16 @@ pub(crate) fn render_command(
         }
         reason => {
             save(&session)?;
-            let why = if reason == StopReason::Interrupted {
-                "interrupted"
-            } else {
-                "time limit reached"
+            let (why, code) = match reason {
+                StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
+                _ => ("time limit reached", ExitCode::SUCCESS),
             };
             eprintln!(
                 "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
                 out.display(),
                 ckpt_path.display()
             );
-            if reason == StopReason::Interrupted {
-                ExitCode::from(EXIT_INTERRUPTED)
-            } else {
-                ExitCode::SUCCESS
-            }
+            code
         }
     };
     eprintln!("{}", summary(&run.stats, &session.stats(), elapsed));

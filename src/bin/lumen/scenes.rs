@@ -32,7 +32,7 @@ impl SceneSource {
             SceneSource::Builtin(_) => {
                 Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?
             }
-            SceneSource::File(f) => f.compile(overrides)?,
+            SceneSource::File(f) => Scene::from_desc(&desc).map_err(|e| f.locate(&e, overrides))?,
         };
         Ok((desc, scene))
     }
