@@ -9,7 +9,6 @@ use super::desc::{
     SamplingDesc, SceneDesc, ShadingDesc, Triple,
 };
 use crate::rng::Rng;
-use std::collections::BTreeMap;
 
 /// A named built-in scene.
 #[derive(Clone, Copy, Debug)]
@@ -96,12 +95,8 @@ impl Builder {
     fn new(render: RenderDesc) -> Self {
         Builder {
             desc: SceneDesc {
-                caption: String::new(),
                 render,
-                camera: CameraDesc::default(),
-                background: BackgroundDesc::default(),
-                materials: BTreeMap::new(),
-                objects: Vec::new(),
+                ..SceneDesc::default()
             },
         }
     }

@@ -285,66 +285,67 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
         ],
         &[],
     )?;
-    let mut desc = SceneDesc {
-        caption: String::new(),
-        render: RenderDesc::default(),
-        camera: CameraDesc::default(),
-        background: BackgroundDesc::default(),
-        materials: BTreeMap::new(),
-        objects: Vec::new(),
+    Ok(SceneDesc {
+        caption: t
+            .optional("caption", string)?
+            .unwrap_or_default()
+            .to_string(),
+        render: t.optional("render", |n, _| render(n))?.unwrap_or_default(),
+        camera: t.optional("camera", |n, _| camera(n))?.unwrap_or_default(),
+        background: t
+            .optional("background", |n, _| background(n))?
+            .unwrap_or_default(),
+        materials: t
+            .optional("materials", |n, _| materials(n))?
+            .unwrap_or_default(),
+        objects: t
+            .optional("objects", |n, _| objects(n))?
+            .unwrap_or_default(),
+    })
+}
+
+fn materials(n: &Node) -> Result<BTreeMap<String, MaterialDesc>> {
+    let Value::Table(entries) = &n.value else {
+        return Err(error(
+            "materials",
+            &n.span,
+            format!(
+                "expected a table of named materials, got {}",
+                n.value.describe()
+            ),
+        ));
     };
-    if let Some(n) = t.get("caption") {
-        desc.caption = string(n, "caption")?.to_string();
-    }
-    if let Some(n) = t.get("render") {
-        desc.render = render(n)?;
-    }
-    if let Some(n) = t.get("camera") {
-        desc.camera = camera(n)?;
-    }
-    if let Some(n) = t.get("background") {
-        desc.background = background(n)?;
-    }
-    if let Some(n) = t.get("materials") {
-        let Value::Table(entries) = &n.value else {
+    let mut materials = BTreeMap::new();
+    for e in entries {
+        let path = child("materials", &e.key);
+        if materials.contains_key(&e.key) {
             return Err(error(
-                "materials",
-                &n.span,
-                format!(
-                    "expected a table of named materials, got {}",
-                    n.value.describe()
-                ),
+                &path,
+                &e.key_span,
+                format!("material `{}` is defined twice", e.key),
             ));
-        };
-        for e in entries {
-            let path = child("materials", &e.key);
-            if desc.materials.contains_key(&e.key) {
-                return Err(error(
-                    &path,
-                    &e.key_span,
-                    format!("material `{}` is defined twice", e.key),
-                ));
-            }
-            desc.materials
-                .insert(e.key.clone(), material(&e.node, &path)?);
         }
+        materials.insert(e.key.clone(), material(&e.node, &path)?);
     }
-    if let Some(n) = t.get("objects") {
-        let Value::Array(items) = &n.value else {
-            return Err(error(
-                "objects",
-                &n.span,
-                format!(
-                    "expected an array of objects ([[objects]] tables), got {}",
-                    n.value.describe()
-                ),
-            ));
-        };
-        for (i, item) in items.iter().enumerate() {
-            desc.objects.push(object(item, &format!("objects[{i}]"))?);
-        }
-    }
-    Ok(desc)
+    Ok(materials)
+}
+
+fn objects(n: &Node) -> Result<Vec<ObjectDesc>> {
+    let Value::Array(items) = &n.value else {
+        return Err(error(
+            "objects",
+            &n.span,
+            format!(
+                "expected an array of objects ([[objects]] tables), got {}",
+                n.value.describe()
+            ),
+        ));
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| object(item, &format!("objects[{i}]")))
+        .collect()
 }
 
 const SAMPLINGS: &[(&str, SamplingDesc)] = &[
@@ -432,60 +433,74 @@ fn camera(node: &Node) -> Result<CameraDesc> {
     })
 }
 
+/// One kind of a table tagged by `type`: its name, what it is called in
+/// messages, its fields, and the fields of its sibling kinds with their owners.
+struct Kind<K> {
+    name: &'static str,
+    kind: K,
+    what: &'static str,
+    fields: &'static [&'static str],
+    elsewhere: &'static [(&'static str, &'static str)],
+}
+
+/// `node` as a table whose `type` names one of `kinds`. The type is checked
+/// first, against the union of all kinds' fields, so that a wrong type is
+/// reported as such and not as a field that does not belong.
+fn tagged<'a, K: Copy>(
+    node: &'a Node,
+    path: &'a str,
+    what: &str,
+    kinds: &[Kind<K>],
+) -> Result<(K, &'static str, Table<'a>)> {
+    let mut all: Vec<&str> = Vec::new();
+    for f in kinds.iter().flat_map(|k| k.fields) {
+        if !all.contains(f) {
+            all.push(f);
+        }
+    }
+    let any = Table::new(node, path, what, &all, &[])?;
+    let names: Vec<(&str, usize)> = kinds.iter().enumerate().map(|(i, k)| (k.name, i)).collect();
+    let k = &kinds[keyword(any.required("type", what)?, &any.path("type"), &names)?];
+    let t = Table::new(node, path, k.what, k.fields, k.elsewhere)?;
+    Ok((k.kind, k.what, t))
+}
+
 #[derive(Clone, Copy)]
 enum BackgroundKind {
     Gradient,
     Solid,
 }
 
-fn background(node: &Node) -> Result<BackgroundDesc> {
-    let path = "background";
-    let any = Table::new(
-        node,
-        path,
-        "a background",
-        &["type", "bottom", "top", "color"],
-        &[],
-    )?;
-    let kind = keyword(
-        any.required("type", "a background")?,
-        &any.path("type"),
-        &[
-            ("gradient", BackgroundKind::Gradient),
-            ("solid", BackgroundKind::Solid),
+const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
+    Kind {
+        name: "gradient",
+        kind: BackgroundKind::Gradient,
+        what: "a gradient background",
+        fields: &["type", "bottom", "top"],
+        elsewhere: &[("color", "a solid background")],
+    },
+    Kind {
+        name: "solid",
+        kind: BackgroundKind::Solid,
+        what: "a solid background",
+        fields: &["type", "color"],
+        elsewhere: &[
+            ("bottom", "a gradient background"),
+            ("top", "a gradient background"),
         ],
-    )?;
+    },
+];
+
+fn background(node: &Node) -> Result<BackgroundDesc> {
+    let (kind, what, t) = tagged(node, "background", "a background", BACKGROUNDS)?;
     Ok(match kind {
-        BackgroundKind::Gradient => {
-            let what = "a gradient background";
-            let t = Table::new(
-                node,
-                path,
-                what,
-                &["type", "bottom", "top"],
-                &[("color", "a solid background")],
-            )?;
-            BackgroundDesc::Gradient {
-                bottom: t.require("bottom", what, triple)?,
-                top: t.require("top", what, triple)?,
-            }
-        }
-        BackgroundKind::Solid => {
-            let what = "a solid background";
-            let t = Table::new(
-                node,
-                path,
-                what,
-                &["type", "color"],
-                &[
-                    ("bottom", "a gradient background"),
-                    ("top", "a gradient background"),
-                ],
-            )?;
-            BackgroundDesc::Solid {
-                color: t.require("color", what, triple)?,
-            }
-        }
+        BackgroundKind::Gradient => BackgroundDesc::Gradient {
+            bottom: t.require("bottom", what, triple)?,
+            top: t.require("top", what, triple)?,
+        },
+        BackgroundKind::Solid => BackgroundDesc::Solid {
+            color: t.require("color", what, triple)?,
+        },
     })
 }
 
@@ -508,91 +523,64 @@ enum MaterialKind {
     Dielectric,
 }
 
-const DIFFUSE_FIELDS: &[&str] = &["type", "albedo", "bounce", "attenuation"];
-const METAL_FIELDS: &[&str] = &["type", "albedo", "fuzz"];
-const DIELECTRIC_FIELDS: &[&str] = &["type", "ior", "refract_only"];
+const MATERIALS: &[Kind<MaterialKind>] = &[
+    Kind {
+        name: "diffuse",
+        kind: MaterialKind::Diffuse,
+        what: "a diffuse material",
+        fields: &["type", "albedo", "bounce", "attenuation"],
+        elsewhere: &[
+            ("fuzz", "metal materials"),
+            ("ior", "dielectric materials"),
+            ("refract_only", "dielectric materials"),
+        ],
+    },
+    Kind {
+        name: "metal",
+        kind: MaterialKind::Metal,
+        what: "a metal material",
+        fields: &["type", "albedo", "fuzz"],
+        elsewhere: &[
+            ("bounce", "diffuse materials"),
+            ("attenuation", "diffuse materials"),
+            ("ior", "dielectric materials"),
+            ("refract_only", "dielectric materials"),
+        ],
+    },
+    Kind {
+        name: "dielectric",
+        kind: MaterialKind::Dielectric,
+        what: "a dielectric material",
+        fields: &["type", "ior", "refract_only"],
+        elsewhere: &[
+            ("albedo", "diffuse and metal materials"),
+            ("fuzz", "metal materials"),
+            ("bounce", "diffuse materials"),
+            ("attenuation", "diffuse materials"),
+        ],
+    },
+];
 
 fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
-    // Check the type first, against the union of all fields, so that a wrong
-    // type is reported as such and not as a field that does not belong.
-    let mut all: Vec<&str> = Vec::new();
-    for f in [DIFFUSE_FIELDS, METAL_FIELDS, DIELECTRIC_FIELDS].concat() {
-        if !all.contains(&f) {
-            all.push(f);
-        }
-    }
-    let any = Table::new(node, path, "a material", &all, &[])?;
-    let kind = keyword(
-        any.required("type", "a material")?,
-        &any.path("type"),
-        &[
-            ("diffuse", MaterialKind::Diffuse),
-            ("metal", MaterialKind::Metal),
-            ("dielectric", MaterialKind::Dielectric),
-        ],
-    )?;
+    let (kind, what, t) = tagged(node, path, "a material", MATERIALS)?;
     Ok(match kind {
-        MaterialKind::Diffuse => {
-            let what = "a diffuse material";
-            let t = Table::new(
-                node,
-                path,
-                what,
-                DIFFUSE_FIELDS,
-                &[
-                    ("fuzz", "metal materials"),
-                    ("ior", "dielectric materials"),
-                    ("refract_only", "dielectric materials"),
-                ],
-            )?;
-            MaterialDesc::Diffuse {
-                albedo: t.require("albedo", what, triple)?,
-                bounce: t
-                    .optional("bounce", |n, p| keyword(n, p, BOUNCES))?
-                    .unwrap_or_default(),
-                attenuation: t
-                    .optional("attenuation", |n, p| keyword(n, p, ATTENUATIONS))?
-                    .unwrap_or_default(),
-            }
-        }
-        MaterialKind::Metal => {
-            let what = "a metal material";
-            let t = Table::new(
-                node,
-                path,
-                what,
-                METAL_FIELDS,
-                &[
-                    ("bounce", "diffuse materials"),
-                    ("attenuation", "diffuse materials"),
-                    ("ior", "dielectric materials"),
-                    ("refract_only", "dielectric materials"),
-                ],
-            )?;
-            MaterialDesc::Metal {
-                albedo: t.require("albedo", what, triple)?,
-                fuzz: t.optional("fuzz", float)?.unwrap_or(0.0),
-            }
-        }
-        MaterialKind::Dielectric => {
-            let what = "a dielectric material";
-            let t = Table::new(
-                node,
-                path,
-                what,
-                DIELECTRIC_FIELDS,
-                &[
-                    ("albedo", "diffuse and metal materials"),
-                    ("fuzz", "metal materials"),
-                    ("bounce", "diffuse materials"),
-                    ("attenuation", "diffuse materials"),
-                ],
-            )?;
-            MaterialDesc::Dielectric {
-                ior: t.require("ior", what, float)?,
-                refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
-            }
-        }
+        MaterialKind::Diffuse => MaterialDesc::Diffuse {
+            albedo: t.require("albedo", what, triple)?,
+            bounce: t
+                .optional("bounce", |n, p| keyword(n, p, BOUNCES))?
+                .unwrap_or_default(),
+            attenuation: t
+                .optional("attenuation", |n, p| keyword(n, p, ATTENUATIONS))?
+                .unwrap_or_default(),
+        },
+        MaterialKind::Metal => MaterialDesc::Metal {
+            albedo: t.require("albedo", what, triple)?,
+            fuzz: t.optional("fuzz", float)?.unwrap_or(0.0),
+        },
+        MaterialKind::Dielectric => MaterialDesc::Dielectric {
+            ior: t.require("ior", what, float)?,
+            refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
+        },
     })
 }
 
@@ -601,23 +589,21 @@ enum ObjectKind {
     Sphere,
 }
 
+const OBJECTS: &[Kind<ObjectKind>] = &[Kind {
+    name: "sphere",
+    kind: ObjectKind::Sphere,
+    what: "a sphere",
+    fields: &["type", "center", "radius", "material"],
+    elsewhere: &[],
+}];
+
 fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
-    let fields = &["type", "center", "radius", "material"];
-    let any = Table::new(node, path, "an object", fields, &[])?;
-    let kind = keyword(
-        any.required("type", "an object")?,
-        &any.path("type"),
-        &[("sphere", ObjectKind::Sphere)],
-    )?;
+    let (kind, what, t) = tagged(node, path, "an object", OBJECTS)?;
     Ok(match kind {
-        ObjectKind::Sphere => {
-            let what = "a sphere";
-            let t = Table::new(node, path, what, fields, &[])?;
-            ObjectDesc::Sphere {
-                center: t.require("center", what, triple)?,
-                radius: t.require("radius", what, float)?,
-                material: t.require("material", what, string)?.to_string(),
-            }
-        }
+        ObjectKind::Sphere => ObjectDesc::Sphere {
+            center: t.require("center", what, triple)?,
+            radius: t.require("radius", what, float)?,
+            material: t.require("material", what, string)?.to_string(),
+        },
     })
 }

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 pub type Triple = [f64; 3];
 
 /// A whole scene: settings, camera, background, named materials and objects.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneDesc {
     /// A one-line description, shown by `lumen scenes`.

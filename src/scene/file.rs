@@ -116,6 +116,14 @@ impl Diagnostic {
             excerpt: None,
         }
     }
+
+    /// Located at `span` of `text`: its line, column and underlined excerpt.
+    fn at(mut self, text: &str, span: Range<usize>) -> Self {
+        let lc = source::line_col(text, span.start);
+        self.line_col = Some(lc);
+        self.excerpt = Some(excerpt(text, lc, Some(span)));
+        self
+    }
 }
 
 /// A scene description could not be written out.
@@ -212,15 +220,10 @@ impl SceneFile {
             err
         })?;
         let desc = decode::scene(&root).map_err(|e| {
-            let lc = source::line_col(&text, e.span.start);
-            Diagnostic {
-                file: name.clone(),
-                line_col: Some(lc),
-                field: Some(e.path),
-                message: e.message,
-                hint: e.hint,
-                excerpt: Some(excerpt(&text, lc, Some(e.span))),
-            }
+            let mut err = Diagnostic::plain(&name, e.message).at(&text, e.span);
+            err.field = Some(e.path);
+            err.hint = e.hint;
+            err
         })?;
         Ok(SceneFile {
             name,
@@ -249,9 +252,7 @@ impl SceneFile {
             err.message
                 .push_str(" (with the settings given on the command line)");
         } else if let Some(span) = find(&self.root, &field) {
-            let lc = source::line_col(&self.source, span.start);
-            err.line_col = Some(lc);
-            err.excerpt = Some(excerpt(&self.source, lc, Some(span)));
+            err = err.at(&self.source, span);
         }
         err.field = Some(field);
         err.into()

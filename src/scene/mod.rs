@@ -268,10 +268,7 @@ impl Scene {
                 d as f32
             }
             None => {
-                let d: f64 = (0..3)
-                    .map(|i| (cam.lookfrom[i] - cam.lookat[i]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
+                let d = glam::DVec3::from(cam.lookfrom).distance(cam.lookat.into());
                 if !(d as f32).is_finite() {
                     return Err(SceneError::Camera(CameraError::Overflow));
                 }

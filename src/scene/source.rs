@@ -126,7 +126,16 @@ fn toml_item(item: &toml_edit::Item, fallback: Range<usize>) -> Node {
 /// `[materials.glass]`) and dotted keys have none, so they borrow the span of
 /// their key, passed in as `fallback`.
 fn toml_table(table: &toml_edit::Table, fallback: Range<usize>) -> Node {
-    let entries = table
+    Node {
+        value: Value::Table(toml_entries(table, &fallback)),
+        span: table.span().unwrap_or(fallback),
+    }
+}
+
+/// The entries of a table or inline table; a key without a span of its own
+/// borrows its value's, else `fallback`.
+fn toml_entries(table: &dyn toml_edit::TableLike, fallback: &Range<usize>) -> Vec<Entry> {
+    table
         .iter()
         .map(|(key, item)| {
             let key_span = table
@@ -140,11 +149,7 @@ fn toml_table(table: &toml_edit::Table, fallback: Range<usize>) -> Node {
                 node: toml_item(item, key_span),
             }
         })
-        .collect();
-    Node {
-        span: table.span().unwrap_or(fallback),
-        value: Value::Table(entries),
-    }
+        .collect()
 }
 
 fn toml_value(value: &toml_edit::Value, fallback: Range<usize>) -> Node {
@@ -157,22 +162,7 @@ fn toml_value(value: &toml_edit::Value, fallback: Range<usize>) -> Node {
         V::Boolean(b) => Value::Bool(*b.value()),
         V::Datetime(_) => Value::Other("a date-time"),
         V::Array(a) => Value::Array(a.iter().map(|v| toml_value(v, span.clone())).collect()),
-        V::InlineTable(t) => Value::Table(
-            t.iter()
-                .map(|(key, v)| {
-                    let key_span = t
-                        .key(key)
-                        .and_then(|k| k.span())
-                        .or_else(|| v.span())
-                        .unwrap_or_else(|| span.clone());
-                    Entry {
-                        key: key.to_string(),
-                        key_span: key_span.clone(),
-                        node: toml_value(v, key_span),
-                    }
-                })
-                .collect(),
-        ),
+        V::InlineTable(t) => Value::Table(toml_entries(t, &span)),
     };
     Node { span, value }
 }
@@ -274,6 +264,26 @@ impl Scanner<'_> {
         (self.peek()? == byte).then(|| self.pos += 1)
     }
 
+    /// Skips whitespace, then `byte` if it comes next.
+    fn eat(&mut self, byte: u8) -> bool {
+        self.skip_ws();
+        let next = self.peek() == Some(byte);
+        self.pos += usize::from(next);
+        next
+    }
+
+    /// After an item of a list closed by `close`: past a comma, `false`;
+    /// past `close`, `true`; anything else, `None`.
+    fn comma_or(&mut self, close: u8) -> Option<bool> {
+        self.skip_ws();
+        let next = self.peek()?;
+        if next != b',' && next != close {
+            return None;
+        }
+        self.pos += 1;
+        Some(next == close)
+    }
+
     fn value(&mut self) -> Option<Node> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
@@ -291,10 +301,7 @@ impl Scanner<'_> {
             b'{' => {
                 self.pos += 1;
                 let mut entries = Vec::new();
-                self.skip_ws();
-                if self.peek()? == b'}' {
-                    self.pos += 1;
-                } else {
+                if !self.eat(b'}') {
                     loop {
                         self.skip_ws();
                         let key_start = self.pos;
@@ -307,14 +314,8 @@ impl Scanner<'_> {
                             key_span,
                             node,
                         });
-                        self.skip_ws();
-                        match self.peek()? {
-                            b',' => self.pos += 1,
-                            b'}' => {
-                                self.pos += 1;
-                                break;
-                            }
-                            _ => return None,
+                        if self.comma_or(b'}')? {
+                            break;
                         }
                     }
                 }
@@ -323,20 +324,11 @@ impl Scanner<'_> {
             b'[' => {
                 self.pos += 1;
                 let mut items = Vec::new();
-                self.skip_ws();
-                if self.peek()? == b']' {
-                    self.pos += 1;
-                } else {
+                if !self.eat(b']') {
                     loop {
                         items.push(self.value()?);
-                        self.skip_ws();
-                        match self.peek()? {
-                            b',' => self.pos += 1,
-                            b']' => {
-                                self.pos += 1;
-                                break;
-                            }
-                            _ => return None,
+                        if self.comma_or(b']')? {
+                            break;
                         }
                     }
                 }
