@@ -194,11 +194,7 @@ pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
             message,
         });
     }
-    let mut scanner = Scanner {
-        text,
-        pos: 0,
-        depth: 0,
-    };
+    let mut scanner = Scanner { text, pos: 0 };
     scanner.skip_ws();
     let node = scanner.value();
     node.ok_or_else(|| SyntaxError {
@@ -237,11 +233,11 @@ fn too_deep(text: &str) -> Option<usize> {
 }
 
 /// Walks valid JSON recording byte spans. Returns `None` rather than panic on
-/// anything unexpected.
+/// anything unexpected. Its recursion is bounded by [`too_deep`], checked
+/// first: one level per array or object.
 struct Scanner<'a> {
     text: &'a str,
     pos: usize,
-    depth: usize,
 }
 
 /// Deepest nesting of JSON arrays and objects accepted: far more than any
@@ -285,16 +281,6 @@ impl Scanner<'_> {
     }
 
     fn value(&mut self) -> Option<Node> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
-            return None;
-        }
-        let node = self.value_inner();
-        self.depth -= 1;
-        node
-    }
-
-    fn value_inner(&mut self) -> Option<Node> {
         self.skip_ws();
         let start = self.pos;
         let value = match self.peek()? {
@@ -462,6 +448,27 @@ mod tests {
         let e = parse_json("{\n \"a\": }").unwrap_err();
         assert_eq!(e.line_col.map(|p| p.0), Some(2));
         assert!(!e.message.contains("at line"), "{}", e.message);
+    }
+
+    #[test]
+    fn json_nesting_is_limited_to_max_depth_arrays_and_objects() {
+        let nest = |depth: usize, inner: &str| {
+            format!("{}{inner}{}", "[".repeat(depth), "]".repeat(depth))
+        };
+        for inner in ["", "1", "\"x\"", "{}", "true"] {
+            let depth = MAX_DEPTH - usize::from(inner == "{}");
+            assert!(
+                parse_json(&nest(depth, inner)).is_ok(),
+                "{depth} around {inner:?}"
+            );
+            let e = parse_json(&nest(depth + 1, inner)).unwrap_err();
+            assert!(
+                e.message.contains("nested more than 64 deep"),
+                "{}",
+                e.message
+            );
+            assert_eq!(e.offset, Some(MAX_DEPTH), "the first bracket too deep");
+        }
     }
 
     #[test]
