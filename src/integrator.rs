@@ -162,12 +162,8 @@ fn find_hits(
             }
             continue;
         }
-        let mut bundle = [rays[group[0] as usize]; LANES];
-        for (slot, &i) in bundle.iter_mut().zip(group) {
-            *slot = rays[i as usize];
-        }
-        let reference = reference.unwrap_or(&bundle[0]);
-        let found = scene.hit_bundle(&bundle[..group.len()], reference, range);
+        let reference = reference.unwrap_or(&rays[group[0] as usize]);
+        let found = scene.hit_bundle(rays, group, reference, range);
         for (&i, hit) in group.iter().zip(found) {
             hits[i as usize] = hit;
         }

@@ -55,19 +55,36 @@ impl RayBundle {
     /// When `rays` is empty or longer than [`LANES`].
     #[inline]
     pub fn new(rays: &[Ray]) -> Self {
+        const ALL: [u8; LANES] = [0, 1, 2, 3, 4, 5, 6, 7];
         assert!(
-            (1..=LANES).contains(&rays.len()),
+            rays.len() <= LANES,
             "a bundle holds 1 to {LANES} rays, not {}",
             rays.len()
+        );
+        Self::gather(rays, &ALL[..rays.len()])
+    }
+
+    /// The bundle of `rays[lanes[0]]`, `rays[lanes[1]]`, …: gathered straight
+    /// into structure of arrays, without copying the rays out first.
+    ///
+    /// # Panics
+    /// When `lanes` is empty or longer than [`LANES`], or names a ray
+    /// `rays` does not have.
+    #[inline]
+    pub fn gather(rays: &[Ray], lanes: &[u8]) -> Self {
+        assert!(
+            (1..=LANES).contains(&lanes.len()),
+            "a bundle holds 1 to {LANES} rays, not {}",
+            lanes.len()
         );
         let mut b = RayBundle {
             origin: [[0.0; LANES]; 3],
             direction: [[0.0; LANES]; 3],
             inverse: [[0.0; LANES]; 3],
-            len: rays.len(),
+            len: lanes.len(),
         };
         for lane in 0..LANES {
-            let ray = rays.get(lane).unwrap_or(&rays[0]);
+            let ray = &rays[usize::from(*lanes.get(lane).unwrap_or(&lanes[0]))];
             debug_assert!((ray.direction.length_squared() - 1.0).abs() < 1e-4);
             let inverse = ray.direction.recip();
             for axis in 0..3 {

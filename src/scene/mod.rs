@@ -374,23 +374,24 @@ impl Scene {
         Some(self.record(ray, hit))
     }
 
-    /// The nearest hit of each ray of `rays` within `interval`, as
-    /// [`Scene::hit`] would find it for each ray alone; `reference` is a ray
-    /// close to all of them (see [`RayBundle`]). Entries beyond `rays.len()`
-    /// are `None`.
+    /// The nearest hit within `interval` of each ray `rays[lanes[k]]` (1 to
+    /// [`LANES`] of them), as [`Scene::hit`] would find it for each ray
+    /// alone, in the order of `lanes`; `reference` is a ray close to all of
+    /// them (see [`RayBundle`]). Entries beyond `lanes.len()` are `None`.
     #[inline(always)]
     pub fn hit_bundle(
         &self,
         rays: &[Ray],
+        lanes: &[u8],
         reference: &Ray,
         interval: Interval,
     ) -> [Option<HitRecord>; LANES] {
         let hits = self
             .bvh
-            .hit_bundle(&RayBundle::new(rays), reference, interval);
+            .hit_bundle(&RayBundle::gather(rays, lanes), reference, interval);
         let mut records = [None; LANES];
-        for (lane, ray) in rays.iter().enumerate() {
-            records[lane] = hits[lane].map(|hit| self.record(ray, hit));
+        for (k, &i) in lanes.iter().enumerate() {
+            records[k] = hits[k].map(|hit| self.record(&rays[usize::from(i)], hit));
         }
         records
     }
