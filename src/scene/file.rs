@@ -237,9 +237,16 @@ impl SceneFile {
     /// Applies `overrides` and validates and compiles the scene. An error is
     /// located in the file unless the faulty value came from the overrides.
     pub fn compile(&self, overrides: &Overrides) -> Result<Scene, SceneFileError> {
+        Ok(self.resolve(overrides)?.1)
+    }
+
+    /// [`SceneFile::compile`], also returning the description as overridden
+    /// (what a checkpoint records).
+    pub fn resolve(&self, overrides: &Overrides) -> Result<(SceneDesc, Scene), SceneFileError> {
         let mut desc = self.desc.clone();
         overrides.apply(&mut desc);
-        Scene::from_desc(&desc).map_err(|e| self.locate(&e, overrides))
+        let scene = Scene::from_desc(&desc).map_err(|e| self.locate(&e, overrides))?;
+        Ok((desc, scene))
     }
 
     /// `error`, found when compiling this file's scene, with the file's name,

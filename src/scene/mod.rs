@@ -176,8 +176,6 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The spheres, in description order.
     pub spheres: Vec<Sphere>,
-    /// Material index of each sphere.
-    pub sphere_materials: Vec<u32>,
     bvh: Bvh,
     /// See [`error_scale`].
     error_scale: f32,
@@ -214,12 +212,14 @@ fn vec3(t: [f64; 3]) -> Vec3 {
 }
 
 /// Accepts numbers that stay finite once converted to the renderer's `f32`.
-fn finite(field: &str, values: &[f64]) -> Result<(), SceneError> {
+/// `field` is only formatted when a number is refused (scene files may hold
+/// millions of spheres).
+fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
     // `!(a <= b)` also catches NaN.
     match values.iter().find(|v| !(v.abs() <= f64::from(f32::MAX))) {
         None => Ok(()),
         Some(v) => Err(invalid(
-            field,
+            field.to_string(),
             format!(
                 "must be a finite number of magnitude at most {:e}, got {v}",
                 f32::MAX
@@ -303,7 +303,7 @@ impl Scene {
         }
 
         let mut spheres = Vec::with_capacity(desc.objects.len());
-        let mut sphere_materials = Vec::with_capacity(desc.objects.len());
+        let mut surfaces = Vec::with_capacity(desc.objects.len());
         for (i, object) in desc.objects.iter().enumerate() {
             match object {
                 ObjectDesc::Sphere {
@@ -311,8 +311,8 @@ impl Scene {
                     radius,
                     material,
                 } => {
-                    finite(&format!("objects[{i}].center"), center)?;
-                    finite(&format!("objects[{i}].radius"), &[*radius])?;
+                    finite(format_args!("objects[{i}].center"), center)?;
+                    finite(format_args!("objects[{i}].radius"), &[*radius])?;
                     if !(*radius as f32 > 0.0) {
                         return Err(invalid(
                             format!("objects[{i}].radius"),
@@ -337,22 +337,18 @@ impl Scene {
                             known: desc.materials.keys().cloned().collect(),
                         });
                     };
-                    spheres.push(Sphere::new(vec3(*center), *radius as f32));
-                    sphere_materials.push(m);
+                    let sphere = Sphere::new(vec3(*center), *radius as f32);
+                    surfaces.push(Surface {
+                        center: sphere.center,
+                        inverse_radius: 1.0 / sphere.radius,
+                        radius: sphere.radius,
+                        material: m,
+                    });
+                    spheres.push(sphere);
                 }
             }
         }
         let bvh = Bvh::new(&spheres);
-        let surfaces = spheres
-            .iter()
-            .zip(&sphere_materials)
-            .map(|(s, &material)| Surface {
-                center: s.center,
-                inverse_radius: 1.0 / s.radius,
-                radius: s.radius,
-                material,
-            })
-            .collect();
         Ok(Scene {
             error_scale: error_scale(settings.epsilon),
             settings,
@@ -360,7 +356,6 @@ impl Scene {
             background,
             materials,
             spheres,
-            sphere_materials,
             bvh,
             surfaces,
         })
@@ -528,7 +523,7 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
             },
         }),
         MaterialDesc::Metal { albedo: a, fuzz } => {
-            finite(&format!("{field}.fuzz"), &[*fuzz])?;
+            finite(format_args!("{field}.fuzz"), &[*fuzz])?;
             if !(0.0..=1.0).contains(fuzz) {
                 return Err(invalid(
                     format!("{field}.fuzz"),
@@ -541,7 +536,7 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
             })
         }
         MaterialDesc::Dielectric { ior, refract_only } => {
-            finite(&format!("{field}.ior"), &[*ior])?;
+            finite(format_args!("{field}.ior"), &[*ior])?;
             if !(*ior as f32 > 0.0) {
                 return Err(invalid(
                     format!("{field}.ior"),

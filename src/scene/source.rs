@@ -169,11 +169,11 @@ fn toml_value(value: &toml_edit::Value, fallback: Range<usize>) -> Node {
 
 /// Parses JSON text into a [`Node`] tree.
 pub fn parse_json(text: &str) -> Result<Node, SyntaxError> {
-    // serde_json validates the syntax (and bounds the nesting depth) first,
-    // so the scanner below only ever sees well-formed JSON.
-    // (Skipping with `IgnoredAny` accepts numbers too large for f64, which
-    // the decoder then refuses with the field's path, but does not bound the
-    // nesting depth: that is checked first.)
+    // The nesting depth is bounded first (`too_deep`: serde_json skipping
+    // with `IgnoredAny` does not bound it, and the scanner below recurses
+    // once per level), then serde_json validates the syntax, so the scanner
+    // only ever sees well-formed JSON. (`IgnoredAny` accepts numbers too
+    // large for f64, which the decoder then refuses with the field's path.)
     if let Some(offset) = too_deep(text) {
         return Err(SyntaxError {
             offset: Some(offset),
@@ -255,11 +255,6 @@ impl Scanner<'_> {
         }
     }
 
-    fn expect(&mut self, byte: u8) -> Option<()> {
-        self.skip_ws();
-        (self.peek()? == byte).then(|| self.pos += 1)
-    }
-
     /// Skips whitespace, then `byte` if it comes next.
     fn eat(&mut self, byte: u8) -> bool {
         self.skip_ws();
@@ -293,7 +288,7 @@ impl Scanner<'_> {
                         let key_start = self.pos;
                         let key = self.string()?;
                         let key_span = key_start..self.pos;
-                        self.expect(b':')?;
+                        self.eat(b':').then_some(())?;
                         let node = self.value()?;
                         entries.push(Entry {
                             key,

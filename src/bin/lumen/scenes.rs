@@ -26,15 +26,15 @@ impl SceneSource {
     /// compiled from it; a mistake in a file is reported with its line and
     /// column before any work starts.
     pub(crate) fn resolve(&self, name: &str, overrides: &Overrides) -> Result<(SceneDesc, Scene)> {
-        let mut desc = self.desc().clone();
-        overrides.apply(&mut desc);
-        let scene = match self {
-            SceneSource::Builtin(_) => {
-                Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?
+        match self {
+            SceneSource::Builtin(d) => {
+                let mut desc = d.clone();
+                overrides.apply(&mut desc);
+                let scene = Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
+                Ok((desc, scene))
             }
-            SceneSource::File(f) => Scene::from_desc(&desc).map_err(|e| f.locate(&e, overrides))?,
-        };
-        Ok((desc, scene))
+            SceneSource::File(f) => Ok(f.resolve(overrides)?),
+        }
     }
 }
 
