@@ -1,22 +1,15 @@
 //! The command line never destroys a user's files and never panics on a
 //! closed or full standard output.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+mod lumen_process;
 
-fn lumen(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lumen"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
+use lumen_process::{lumen, temp_dir};
+use std::path::Path;
+use std::process::{Output, Stdio};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lumen-safety-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// Runs lumen to the end in `dir`.
+fn lumen_in(dir: &Path, args: &[&str]) -> Output {
+    lumen().current_dir(dir).args(args).output().unwrap()
 }
 
 fn refused_with(out: &Output, words: &[&str]) {
@@ -30,7 +23,7 @@ fn refused_with(out: &Output, words: &[&str]) {
 
 #[test]
 fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() {
-    let dir = scratch("ckpt");
+    let dir = temp_dir("safety-ckpt");
     fn with<'a>(extra: &[&'a str]) -> Vec<&'a str> {
         [extra, &["--width", "8", "--spp", "2"][..]].concat()
     }
@@ -38,7 +31,7 @@ fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() 
     // The output image, however it is spelled.
     let spelled = dir.join("out.png");
     for ckpt in ["out.png", "./out.png", spelled.to_str().unwrap()] {
-        let out = lumen(
+        let out = lumen_in(
             &dir,
             &with(&["render", "gradient", "-o", "out.png", "--checkpoint", ckpt]),
         );
@@ -48,12 +41,12 @@ fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() 
 
     // The scene file being rendered.
     assert!(
-        lumen(&dir, &["scenes", "export", "gradient", "-o", "g.toml"])
+        lumen_in(&dir, &["scenes", "export", "gradient", "-o", "g.toml"])
             .status
             .success()
     );
     let scene = std::fs::read(dir.join("g.toml")).unwrap();
-    let out = lumen(
+    let out = lumen_in(
         &dir,
         &with(&[
             "render",
@@ -69,7 +62,7 @@ fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() 
 
     // Any other existing file that is not a checkpoint.
     std::fs::write(dir.join("notes.txt"), "keep me").unwrap();
-    let out = lumen(
+    let out = lumen_in(
         &dir,
         &with(&[
             "render",
@@ -87,8 +80,8 @@ fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() 
     );
     assert!(!dir.join("y.png").exists());
 
-    // A real checkpoint there is fine (it is replaced).
-    let ok = lumen(&dir, &with(&["render", "gradient", "-o", "z.png"]));
+    // With nothing at the default checkpoint path, the same render goes ahead.
+    let ok = lumen_in(&dir, &with(&["render", "gradient", "-o", "z.png"]));
     assert!(
         ok.status.success(),
         "{}",
@@ -100,7 +93,7 @@ fn a_checkpoint_path_naming_the_output_the_scene_or_a_foreign_file_is_refused() 
 #[test]
 fn a_closed_pipe_ends_output_quietly_and_a_full_device_is_an_error() {
     // Read one line, then close the pipe while lumen still writes.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lumen"))
+    let mut child = lumen()
         .args(["scenes", "export", "cover"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -120,11 +113,7 @@ fn a_closed_pipe_ends_output_quietly_and_a_full_device_is_an_error() {
             .write(true)
             .open("/dev/full")
             .unwrap();
-        let out = Command::new(env!("CARGO_BIN_EXE_lumen"))
-            .arg("scenes")
-            .stdout(full)
-            .output()
-            .unwrap();
+        let out = lumen().arg("scenes").stdout(full).output().unwrap();
         refused_with(&out, &["cannot write to standard output"]);
     }
 }

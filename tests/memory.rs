@@ -7,32 +7,28 @@
 //! This file holds one test only: `RUSAGE_CHILDREN` reports the largest child
 //! this test process has waited for.
 
-use std::process::Command;
+mod lumen_process;
 
 #[test]
 fn full_size_cover_render_stays_under_64_mb() {
-    let dir = std::env::temp_dir().join(format!("lumen-memory-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = lumen_process::temp_dir("memory");
     let out = dir.join("cover.png");
-    let status = Command::new(env!("CARGO_BIN_EXE_lumen"))
-        .args(["render", "cover", "--spp", "2", "--depth", "8", "-o"])
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (status, stderr) = lumen_process::run(
+        &["render", "cover", "--spp", "2", "--depth", "8"],
+        &out,
+        &[],
+    );
+    assert!(status.success(), "{stderr}");
     let img = image::open(&out).unwrap();
     assert_eq!((img.width(), img.height()), (1200, 675));
 
-    let mut usage = std::mem::MaybeUninit::<libc::rusage>::zeroed();
-    // SAFETY: getrusage fills the struct it is given; zeroed is a valid rusage.
-    #[allow(unsafe_code)]
-    let usage = unsafe {
-        assert_eq!(
-            libc::getrusage(libc::RUSAGE_CHILDREN, usage.as_mut_ptr()),
-            0
-        );
-        usage.assume_init()
-    };
+    // SAFETY: an all-zero rusage is valid (integers only), and getrusage
+    // fills the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    assert_eq!(
+        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
+        0
+    );
     // ru_maxrss is in kilobytes on Linux.
     let peak_mb = usage.ru_maxrss as f64 / 1024.0;
     std::fs::remove_dir_all(&dir).unwrap();

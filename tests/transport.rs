@@ -302,7 +302,7 @@ fn bounces_do_not_hit_the_huge_ground_sphere_they_leave() {
         let mut d = desc.clone();
         d.render.max_depth = depth;
         let scene = lumen::scene::Scene::from_desc(&d).expect("compiles");
-        pixel_stats(&scene).stats.rays
+        lumen::render::render(&scene, &|_| {}).1.rays
     };
     let (two, fifty) = (rays(2), rays(50));
     let samples = 160 * 90 * 16;
