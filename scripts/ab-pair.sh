@@ -10,23 +10,43 @@ a=$1
 b=$2
 rounds=${3:-8}
 out=$(mktemp -d)
+pa=
+pb=
 trap 'rm -rf "$out"' EXIT
-ratios=""
+trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"; exit 130' INT TERM
+
+# Runs binary $1 on core $2, its output to $3, in the background.
+bench() {
+    taskset -c "$2" "$1" bench --threads 1 --runs 3 --spp 64 >"$3" 2>&1 &
+}
+
+# The cover's M rays/s in output file $1, or the output and exit 1.
+cover() {
+    r=$(awk '/^cover/ {print $3}' "$1")
+    if [ -z "$r" ]; then
+        cat "$1" >&2
+        exit 1
+    fi
+    echo "$r"
+}
+
 i=0
 while [ "$i" -lt "$rounds" ]; do
     core_a=$((i % 2))
-    core_b=$((1 - core_a))
-    taskset -c "$core_a" "$a" bench --threads 1 --runs 3 --spp 64 >"$out/a" 2>&1 &
-    taskset -c "$core_b" "$b" bench --threads 1 --runs 3 --spp 64 >"$out/b" 2>&1 &
-    wait
-    ra=$(awk '/^cover/ {print $3}' "$out/a")
-    rb=$(awk '/^cover/ {print $3}' "$out/b")
+    bench "$a" "$core_a" "$out/a"
+    pa=$!
+    bench "$b" $((1 - core_a)) "$out/b"
+    pb=$!
+    wait "$pa" || { cat "$out/a" >&2; exit 1; }
+    wait "$pb" || { cat "$out/b" >&2; exit 1; }
+    ra=$(cover "$out/a")
+    rb=$(cover "$out/b")
     ratio=$(awk -v a="$ra" -v b="$rb" 'BEGIN {printf "%.3f", b / a}')
     echo "round $((i + 1)): A $ra  B $rb M rays/s  B/A $ratio"
-    ratios="$ratios $ratio"
+    echo "$ratio" >>"$out/ratios"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | sort -n | awk '
+sort -n "$out/ratios" | awk '
     { v[NR] = $1 }
     END { m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2;
           printf "B/A median %.3f (range %s to %s, %d rounds)\n", m, v[1], v[NR], NR }'
