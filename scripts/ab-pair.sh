@@ -12,7 +12,7 @@ rounds=${3:-8}
 out=$(mktemp -d)
 pa=
 pb=
-trap 'rm -rf "$out"' EXIT
+trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"' EXIT
 trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"; exit 130' INT TERM
 
 # Runs binary $1 on core $2, its output to $3, in the background.

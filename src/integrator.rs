@@ -111,15 +111,13 @@ pub fn trace_paths(
 ) {
     let n = rays.len();
     assert!(n <= PATHS && rngs.len() == n && colours.len() == n);
+    // Paths still going after `max_depth` segments stay black.
     colours.fill(Color::ZERO);
     let range = hit_range(scene);
     let mut throughput = [Color::ONE; PATHS];
     let mut hits = [None; PATHS];
     // The paths still going, in order.
-    let mut live = [0u8; PATHS];
-    for (i, l) in live.iter_mut().enumerate().take(n) {
-        *l = i as u8;
-    }
+    let mut live: [u8; PATHS] = std::array::from_fn(|i| i as u8);
     let mut n_live = n;
     for round in 0..scene.settings.max_depth {
         *traced += n_live as u64;
@@ -172,7 +170,7 @@ fn find_hits(
 
 /// The debugging views of the notes' first chapters: what the camera ray hits
 /// first, shown as a flat colour or as its normal.
-fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &mut u64) -> Color {
+pub(crate) fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &mut u64) -> Color {
     *rays += 1;
     let Some(hit) = scene.hit(&ray, hit_range(scene)) else {
         return scene.background.color(ray.direction);

@@ -1,9 +1,9 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::film::Film;
-use crate::integrator::{radiance, trace_paths, PATHS};
-pub use crate::isa::Isa;
-use crate::math::Color;
+use crate::integrator::{first_hit_view, trace_paths, PATHS};
+use crate::isa::Isa;
+use crate::math::{Color, Vec3};
 use crate::ray::Ray;
 use crate::rng::Rng;
 use crate::scene::{Sampling, Scene, Shading};
@@ -219,14 +219,14 @@ fn render_row_generic(
     // Path tracing runs a pixel's samples side by side (`trace_paths`); the
     // debugging views trace one ray at a time.
     let side_by_side = s.shading == Shading::Path;
+    // A pixel's camera rays, their generators and colours, filled for each
+    // group of samples.
+    let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PATHS];
+    let mut rngs = [const { Rng::placeholder() }; PATHS];
+    let mut colours = [Color::ZERO; PATHS];
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
-        // Only stratified sampling permutes its cells.
-        let key = if s.sampling == Sampling::Stratified {
-            pixel_key(s.seed, pixel)
-        } else {
-            0
-        };
+        let key = pixel_key(s.seed, pixel);
         let camera_sample = |index| camera_sample(scene, x as u32, y, pixel, key, index);
         let mut add = |c: Color| {
             stats.samples += 1;
@@ -236,8 +236,8 @@ fn render_row_generic(
         };
         if !side_by_side {
             for index in samples.clone() {
-                let (ray, mut rng) = camera_sample(index);
-                add(radiance(scene, ray, &mut rng, &mut stats.rays));
+                let (ray, _) = camera_sample(index);
+                add(first_hit_view(scene, ray, s.shading, &mut stats.rays));
             }
             continue;
         }
@@ -245,12 +245,9 @@ fn render_row_generic(
         let mut start = samples.start;
         while start < samples.end {
             let n = (samples.end - start).min(PATHS as u32) as usize;
-            let mut rays = [reference; PATHS];
-            let mut rngs = [const { Rng::placeholder() }; PATHS];
             for (i, (ray, rng)) in rays.iter_mut().zip(&mut rngs).take(n).enumerate() {
                 (*ray, *rng) = camera_sample(start + i as u32);
             }
-            let mut colours = [Color::ZERO; PATHS];
             trace_paths(
                 scene,
                 &mut rays[..n],

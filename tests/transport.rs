@@ -302,10 +302,10 @@ fn bounces_do_not_hit_the_huge_ground_sphere_they_leave() {
         let mut d = desc.clone();
         d.render.max_depth = depth;
         let scene = lumen::scene::Scene::from_desc(&d).expect("compiles");
-        lumen::render::render(&scene, &|_| {}).1.rays
+        let stats = lumen::render::render(&scene, &|_| {}).1;
+        (stats.rays, stats.samples)
     };
-    let (two, fifty) = (rays(2), rays(50));
-    let samples = 160 * 90 * 16;
+    let ((two, samples), (fifty, _)) = (rays(2), rays(50));
     let bounces = two - samples;
     assert!(
         bounces > samples / 2,
