@@ -7,8 +7,10 @@
 //!
 //! - [`ray`]: p(t) = A + tB; [`math`]: vectors, colours, intervals.
 //! - [`camera`]: from a pixel to a ray, with field of view and defocus blur.
-//! - [`geometry`]: spheres, hit records, and the [`geometry::Bvh`] that finds
-//!   the nearest hit.
+//! - [`geometry`]: spheres, triangles and quads, hit records, and the
+//!   [`geometry::Bvh`] that finds the nearest hit (or any hit).
+//! - [`lanes`]: arithmetic written once for one lane or eight, so that each
+//!   intersection kernel exists once.
 //! - [`material`]: diffuse (four bounce models, two attenuation forms),
 //!   metal, dielectric.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
@@ -45,6 +47,7 @@ pub mod gallery;
 pub mod geometry;
 pub mod integrator;
 pub mod isa;
+pub mod lanes;
 pub mod material;
 pub mod math;
 pub mod output;

@@ -29,3 +29,41 @@ impl Ray {
         self.origin + t * self.direction
     }
 }
+
+/// Rays in lanes, for the intersection kernels: one ray repeated in every
+/// lane (tested against several shapes at once), or one ray per lane (a
+/// bundle tested against one shape). See [`crate::lanes`].
+#[derive(Clone, Copy, Debug)]
+pub struct RayLanes<R> {
+    /// Origin A.
+    pub origin: [R; 3],
+    /// Direction B (unit length).
+    pub direction: [R; 3],
+    /// Hits at or before this distance are not counted.
+    pub t_min: R,
+}
+
+impl RayLanes<f32> {
+    /// One ray as one lane.
+    #[inline(always)]
+    pub fn from_ray(ray: &Ray, t_min: f32) -> Self {
+        RayLanes {
+            origin: ray.origin.to_array(),
+            direction: ray.direction.to_array(),
+            t_min,
+        }
+    }
+}
+
+impl RayLanes<crate::lanes::F8> {
+    /// One ray repeated in all eight lanes.
+    #[inline(always)]
+    pub fn splat(ray: &Ray, t_min: f32) -> Self {
+        use crate::lanes::{Real, F8};
+        RayLanes {
+            origin: ray.origin.to_array().map(F8::splat),
+            direction: ray.direction.to_array().map(F8::splat),
+            t_min: F8::splat(t_min),
+        }
+    }
+}

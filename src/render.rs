@@ -227,7 +227,6 @@ fn render_row_generic(
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
         let key = pixel_key(s.seed, pixel);
-        let camera_sample = |index| camera_sample(scene, x as u32, y, pixel, key, index);
         let mut add = |c: Color| {
             stats.samples += 1;
             if !accumulate(sum, count, c) {
@@ -236,7 +235,7 @@ fn render_row_generic(
         };
         if !side_by_side {
             for index in samples.clone() {
-                let (ray, _) = camera_sample(index);
+                let (ray, _) = camera_sample(scene, x as u32, y, pixel, key, index);
                 add(first_hit_view(scene, ray, s.shading, &mut stats.rays));
             }
             continue;
@@ -246,7 +245,7 @@ fn render_row_generic(
         while start < samples.end {
             let n = (samples.end - start).min(PATHS as u32) as usize;
             for (i, (ray, rng)) in rays.iter_mut().zip(&mut rngs).take(n).enumerate() {
-                (*ray, *rng) = camera_sample(start + i as u32);
+                (*ray, *rng) = camera_sample(scene, x as u32, y, pixel, key, start + i as u32);
             }
             trace_paths(
                 scene,

@@ -1,28 +1,42 @@
-//! A 4-wide bounding volume hierarchy over spheres, traversed with SIMD.
+//! A 4-wide bounding volume hierarchy over primitives of every kind,
+//! traversed by one function for every query.
 //!
 //! The binary SAH tree of [`super::bvh_build`] is collapsed into nodes of four
 //! children: a node stores the boxes of its four children as structure of
 //! arrays (the lower x planes of all four in one 4-lane vector, and so on), so
 //! one ray is tested against four boxes with a handful of vector operations.
-//! Leaves are packets of up to eight spheres, also stored as structure of
-//! arrays and tested together: as one 8-lane vector when the processor has
-//! AVX2 (checked at run time), as two 4-lane halves otherwise. Traversal visits the hit children nearest first and skips
-//! any entry of its stack whose box starts beyond the closest hit found so far.
+//! Leaves are packets of up to eight primitives of one kind (the leaf's tag),
+//! stored as structure of arrays and tested together by that kind's kernel on
+//! eight lanes (see [`crate::lanes`]).
 //!
-//! The vectors are glam's [`Vec4`], which uses SSE2 on x86-64 and NEON on
+//! [`Bvh::traverse`] walks the tree for any [`Rays`]: one ray looking for
+//! its nearest hit ([`Bvh::hit`]) or for any hit ([`Bvh::occluded`]), or a
+//! bundle of rays ([`Bvh::hit_bundle`]). It visits the hit children nearest
+//! first and skips any entry of its stack whose box starts beyond the
+//! closest hit found so far.
+//!
+//! The box tests use glam's [`Vec4`], which uses SSE2 on x86-64 and NEON on
 //! aarch64 (both always present there) and plain scalar code elsewhere.
 
 use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, MAX_LEAF};
-use crate::geometry::Sphere;
-use crate::isa::Isa;
+use crate::geometry::primitive::{Kind, Primitive};
+use crate::geometry::quad::{self, QuadLanes};
+use crate::geometry::sphere::{self, SphereLanes};
+use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
+use crate::lanes::{max4, min4, Mask, Real, Wide, F8};
 use crate::math::Interval;
-use crate::ray::Ray;
+use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
 use std::mem::MaybeUninit;
 
 /// Children of a node referring to a leaf have this bit set.
 pub(super) const LEAF_BIT: u32 = 1 << 31;
-/// An unused child slot (its box is empty, so it is never entered).
+/// A leaf reference holds its kind in these bits…
+const KIND_SHIFT: u32 = 29;
+/// …and the index of its packet (of that kind) in these.
+const INDEX_MASK: u32 = (1 << KIND_SHIFT) - 1;
+/// An unused child slot (its box is empty, so it is never entered), and an
+/// unused lane of a packet.
 pub(super) const NO_CHILD: u32 = u32::MAX;
 /// Entries of the traversal stack: a node pushes at most three children and
 /// the tree is at most `MAX_SAH_DEPTH + 32` levels deep (see `bvh_build`).
@@ -34,7 +48,7 @@ pub(super) const STACK_SIZE: usize = 256;
 pub(super) struct Node {
     /// `planes[axis][0]`: the four lower bounds along `axis`; `[1]`: the upper.
     pub(super) planes: [[Vec4; 2]; 3],
-    /// Node index, `LEAF_BIT | packet index`, or `NO_CHILD`.
+    /// Node index, `LEAF_BIT | kind | packet index`, or `NO_CHILD`.
     pub(super) children: [u32; 4],
     /// Bit `lane` is set when `children[lane]` is used.
     pub(super) used: u32,
@@ -57,50 +71,135 @@ impl Node {
     }
 }
 
-/// Up to eight spheres, structure of arrays: lanes 0–3 in the first `Vec4`
-/// of each field, lanes 4–7 in the second, so the eight lanes of a field are
-/// also one contiguous 8-float vector. Unused lanes have a radius² of −∞,
-/// which no ray hits.
+/// Eight lanes of one field of a packet, as stored.
+pub(super) type Lane8 = [f32; 8];
+
+/// Up to eight spheres, structure of arrays. Unused lanes have a radius² of
+/// −∞, which no ray hits.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-pub(super) struct Packet {
-    pub(super) cx: [Vec4; 2],
-    pub(super) cy: [Vec4; 2],
-    pub(super) cz: [Vec4; 2],
-    pub(super) radius2: [Vec4; 2],
-    /// Index of each sphere in the input; `NO_CHILD` in unused lanes (which
-    /// come after the used ones).
+pub(super) struct SpherePacket {
+    pub(super) center: [Lane8; 3],
+    pub(super) radius2: Lane8,
+    /// Index of each primitive in the input; `NO_CHILD` in unused lanes
+    /// (which come after the used ones).
     pub(super) index: [u32; 8],
 }
 
-/// The nearest sphere a ray hits.
+/// Up to eight triangles, structure of arrays (vertex, axis). Unused lanes
+/// are NaN, which no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub(super) struct TrianglePacket {
+    pub(super) vertices: [[Lane8; 3]; 3],
+    pub(super) index: [u32; 8],
+}
+
+/// Up to eight quads, structure of arrays (see [`QuadLanes`]). Unused lanes
+/// are NaN, which no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub(super) struct QuadPacket {
+    pub(super) corner: [Lane8; 3],
+    pub(super) u: [Lane8; 3],
+    pub(super) v: [Lane8; 3],
+    pub(super) normal: [Lane8; 3],
+    pub(super) w: [Lane8; 3],
+    pub(super) d: Lane8,
+    pub(super) index: [u32; 8],
+}
+
+impl SpherePacket {
+    /// The packet's spheres, one per lane.
+    #[inline(always)]
+    pub(super) fn lanes<R: Wide>(&self) -> SphereLanes<R> {
+        SphereLanes {
+            center: self.center.map(R::from_array),
+            radius2: R::from_array(self.radius2),
+        }
+    }
+
+    /// Sphere `s` of the packet in every lane.
+    #[inline(always)]
+    pub(super) fn splat<R: Real>(&self, s: usize) -> SphereLanes<R> {
+        SphereLanes {
+            center: self.center.map(|c| R::splat(c[s])),
+            radius2: R::splat(self.radius2[s]),
+        }
+    }
+}
+
+impl TrianglePacket {
+    /// The packet's triangles, one per lane, in the axes `axes`.
+    #[inline(always)]
+    pub(super) fn lanes<R: Wide>(&self, axes: [usize; 3]) -> TriangleLanes<R> {
+        TriangleLanes {
+            vertices: self.vertices.map(|v| axes.map(|k| R::from_array(v[k]))),
+        }
+    }
+}
+
+impl QuadPacket {
+    /// The packet's quads, one per lane.
+    #[inline(always)]
+    pub(super) fn lanes<R: Wide>(&self) -> QuadLanes<R> {
+        QuadLanes {
+            corner: self.corner.map(R::from_array),
+            u: self.u.map(R::from_array),
+            v: self.v.map(R::from_array),
+            normal: self.normal.map(R::from_array),
+            w: self.w.map(R::from_array),
+            d: R::from_array(self.d),
+        }
+    }
+
+    /// Quad `s` of the packet in every lane.
+    #[inline(always)]
+    pub(super) fn splat<R: Real>(&self, s: usize) -> QuadLanes<R> {
+        let f = |c: [Lane8; 3]| c.map(|l| R::splat(l[s]));
+        QuadLanes {
+            corner: f(self.corner),
+            u: f(self.u),
+            v: f(self.v),
+            normal: f(self.normal),
+            w: f(self.w),
+            d: R::splat(self.d[s]),
+        }
+    }
+}
+
+/// The nearest primitive a ray hits.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     /// Ray parameter of the hit.
     pub t: f32,
-    /// Index of the sphere in the order the BVH was built from.
+    /// Index of the primitive in the order the BVH was built from.
     pub index: u32,
 }
 
-/// A 4-wide SAH bounding volume hierarchy over a set of spheres.
+/// A 4-wide SAH bounding volume hierarchy over a set of primitives.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Node 0 is the root; empty when there are no spheres.
+    /// Node 0 is the root; empty when there are no primitives.
     nodes: Vec<Node>,
-    packets: Vec<Packet>,
+    spheres: Vec<SpherePacket>,
+    triangles: Vec<TrianglePacket>,
+    quads: Vec<QuadPacket>,
     /// Whether the processor has AVX2, asked once when the tree is built:
     /// asking for every ray cost ≈ 20 instructions per ray.
     avx2: bool,
 }
 
 impl Bvh {
-    /// Builds the hierarchy over `spheres`.
-    pub fn new(spheres: &[Sphere]) -> Self {
-        let (binary, order) = build_binary(spheres);
+    /// Builds the hierarchy over `primitives`.
+    pub fn new(primitives: &[Primitive]) -> Self {
+        let (binary, order) = build_binary(primitives);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(binary.len() / 3 + 1),
-            packets: Vec::with_capacity(spheres.len().div_ceil(2)),
-            avx2: Isa::detect() == Isa::Avx2,
+            spheres: Vec::new(),
+            triangles: Vec::new(),
+            quads: Vec::new(),
+            avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
         };
         if binary.is_empty() {
             return bvh;
@@ -108,7 +207,7 @@ impl Bvh {
         let collapse = Collapse {
             binary: &binary,
             order: &order,
-            spheres,
+            primitives,
         };
         let roots = if binary[0].is_leaf() {
             vec![0]
@@ -117,7 +216,9 @@ impl Bvh {
         };
         collapse.emit_node(&roots, &mut bvh);
         bvh.nodes.shrink_to_fit();
-        bvh.packets.shrink_to_fit();
+        bvh.spheres.shrink_to_fit();
+        bvh.triangles.shrink_to_fit();
+        bvh.quads.shrink_to_fit();
         bvh
     }
 
@@ -128,29 +229,52 @@ impl Bvh {
 
     /// Bytes of memory held by the hierarchy.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.capacity() * std::mem::size_of::<Node>()
-            + self.packets.capacity() * std::mem::size_of::<Packet>()
+        use std::mem::size_of;
+        self.nodes.capacity() * size_of::<Node>()
+            + self.spheres.capacity() * size_of::<SpherePacket>()
+            + self.triangles.capacity() * size_of::<TrianglePacket>()
+            + self.quads.capacity() * size_of::<QuadPacket>()
     }
 
-    /// The nearest sphere hit by `ray` within `interval`; the ray's direction
-    /// must have unit length (see [`Sphere::hit`]).
+    /// The nearest primitive hit by `ray` within `interval`; the ray's
+    /// direction must have unit length (see [`sphere::intersect`]).
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
-        debug_assert!(
-            (ray.direction.length_squared() - 1.0).abs() < 1e-4,
-            "ray direction {} is not unit length",
-            ray.direction
-        );
-        if self.nodes.is_empty() {
-            return None;
-        }
-        self.traverse(ray, interval)
+        let (t, index) = if self.spheres_only() {
+            self.single::<Nearest, true>(ray, interval)
+        } else {
+            self.single::<Nearest, false>(ray, interval)
+        };
+        (t < interval.max).then_some(Hit { t, index })
     }
 
-    /// Whether the tree is empty (there are no spheres).
+    /// Whether `ray` hits anything within `interval` (the first hit found,
+    /// not the nearest: a shadow ray's question).
     #[inline(always)]
-    pub(super) fn nodes_empty(&self) -> bool {
-        self.nodes.is_empty()
+    pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
+        let (t, _) = if self.spheres_only() {
+            self.single::<AnyHit, true>(ray, interval)
+        } else {
+            self.single::<AnyHit, false>(ray, interval)
+        };
+        t < interval.max
+    }
+
+    /// Traverses for one ray asking `Q`; `SPHERES` when the tree holds
+    /// spheres only, whose traversal loop then carries no other kind's test
+    /// (they would take registers from it). Returns the best (distance,
+    /// index), the distance `interval.max` when nothing counts.
+    #[inline(always)]
+    fn single<Q: Query, const SPHERES: bool>(&self, ray: &Ray, interval: Interval) -> (f32, u32) {
+        let mut query = SingleRay::<Q, SPHERES>::new(self, ray, interval);
+        self.traverse(&mut query);
+        (query.closest, query.best)
+    }
+
+    /// Whether every leaf holds spheres.
+    #[inline(always)]
+    pub(super) fn spheres_only(&self) -> bool {
+        self.triangles.is_empty() && self.quads.is_empty()
     }
 
     /// Node `i`, which the traversal reached through a child reference.
@@ -167,113 +291,113 @@ impl Bvh {
         }
     }
 
-    /// Packet `i`, reached through a leaf reference of a used child slot.
+    /// Sphere packet `i`, reached through a leaf reference of a used child
+    /// slot.
     #[inline(always)]
-    pub(super) fn packet(&self, i: u32) -> &Packet {
-        debug_assert!((i as usize) < self.packets.len());
-        // SAFETY: as for `node`: `Collapse::emit_packet` returns the index of
+    pub(super) fn sphere_packet(&self, i: u32) -> &SpherePacket {
+        debug_assert!((i as usize) < self.spheres.len());
+        // SAFETY: as for `node`: `Collapse::emit_leaf` returns the index of
         // the packet it has just pushed.
         #[allow(unsafe_code)]
         unsafe {
-            self.packets.get_unchecked(i as usize)
+            self.spheres.get_unchecked(i as usize)
         }
     }
 
+    /// Triangle packet `i` (bounds-checked: triangle tests dominate the
+    /// check's cost).
     #[inline(always)]
-    fn traverse(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
-        let d = ray.direction;
-        let o = ray.origin;
-        let inv = d.recip();
-        // Per axis: which of the two planes the ray meets first.
-        let near = [
-            usize::from(inv.x < 0.0),
-            usize::from(inv.y < 0.0),
-            usize::from(inv.z < 0.0),
-        ];
-        let inv4 = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
-        let o4 = [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)];
-        let sphere_ray = SphereRay::new(ray, interval, self.avx2);
-        // The best hit so far, compared as the pair (distance, sphere index)
-        // so that, with boxes kept within `SLACK`, the result does not depend
-        // on the order of the visit. No sphere ties the start
-        // (interval.max, 0): index 0 is the lowest.
-        let mut closest = interval.max;
-        let mut best = 0;
+    pub(super) fn triangle_packet(&self, i: u32) -> &TrianglePacket {
+        &self.triangles[i as usize]
+    }
 
-        // Uninitialised: zeroing 2 KiB on every call cost ~10% of the render.
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK_SIZE];
+    /// Quad packet `i`.
+    #[inline(always)]
+    pub(super) fn quad_packet(&self, i: u32) -> &QuadPacket {
+        &self.quads[i as usize]
+    }
+
+    /// Whether leaves are tested with AVX2 (see [`crate::isa`]).
+    #[inline(always)]
+    pub(super) fn avx2(&self) -> bool {
+        self.avx2
+    }
+
+    /// Whether the tree holds triangles (whose rays need preparing).
+    #[inline(always)]
+    pub(super) fn has_triangles(&self) -> bool {
+        !self.triangles.is_empty()
+    }
+
+    /// Walks the tree for `rays`, nearest children first: the one traversal
+    /// of every query. `rays` tests the boxes, tells which stacked boxes are
+    /// still worth entering, and tests the leaves.
+    #[inline(always)]
+    pub(super) fn traverse<R: Rays>(&self, rays: &mut R) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        // Uninitialised: zeroing the stack on every call cost ~10% of the render.
+        let mut stack = [MaybeUninit::<(u32, R::Entry)>::uninit(); STACK_SIZE];
         let mut top = 0usize;
         let mut current = 0u32;
+        let mut entry = R::Entry::default();
         loop {
             if current & LEAF_BIT != 0 {
-                let packet = self.packet(current & !LEAF_BIT);
-                if let Some((t, index)) = sphere_ray.hit_packet(packet, closest, best) {
-                    closest = t;
-                    best = index;
+                if rays.leaf(self, current, &entry) {
+                    return;
                 }
             } else {
                 let node = self.node(current);
-                let p = &node.planes;
-                let tx0 = (p[0][near[0]] - o4[0]) * inv4[0];
-                let tx1 = (p[0][1 - near[0]] - o4[0]) * inv4[0];
-                let ty0 = (p[1][near[1]] - o4[1]) * inv4[1];
-                let ty1 = (p[1][1 - near[1]] - o4[1]) * inv4[1];
-                let tz0 = (p[2][near[2]] - o4[2]) * inv4[2];
-                let tz1 = (p[2][1 - near[2]] - o4[2]) * inv4[2];
-                // The bound given last wins when a lane is NaN (0·∞ for a ray
-                // lying in a box's plane), so a NaN never culls a box it may hit.
-                let t_near = max4(max4(max4(tx0, ty0), tz0), sphere_ray.t_min);
-                let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(closest)) * SLACK4;
-                let mask = t_near.cmple(t_far).bitmask() & node.used;
-                if mask != 0 && mask & (mask - 1) == 0 {
-                    // One child hit (the most common case): go on with it.
-                    current = node.children[mask.trailing_zeros() as usize & 3];
-                    continue;
-                }
+                let (mask, entries, order) = rays.enter(node);
                 if mask != 0 {
-                    let t_near = t_near.to_array();
                     let first = mask.trailing_zeros() as usize & 3;
                     let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        // One child hit (the most common case): go on with it.
+                        current = node.children[first];
+                        entry = entries[first];
+                        continue;
+                    }
                     if rest & (rest - 1) == 0 {
                         // Two children (most of the rest): push the farther,
                         // go on with the nearer (the first lane on a tie).
                         let second = rest.trailing_zeros() as usize & 3;
-                        let (near, far) = if t_near[second] < t_near[first] {
+                        let (near, far) = if order[second] < order[first] {
                             (second, first)
                         } else {
                             (first, second)
                         };
-                        stack[top].write((node.children[far], t_near[far]));
+                        stack[top].write((node.children[far], entries[far]));
                         top += 1;
                         current = node.children[near];
+                        entry = entries[near];
                         continue;
                     }
                     // Three or four: push the hit children farthest first; go
                     // on with the nearest.
-                    let (order, n) = farthest_first(mask, t_near);
-                    for &lane in &order[..n - 1] {
-                        stack[top].write((node.children[lane], t_near[lane]));
+                    let (lanes, n) = farthest_first(mask, order);
+                    for &lane in &lanes[..n - 1] {
+                        stack[top].write((node.children[lane], entries[lane]));
                         top += 1;
                     }
-                    current = node.children[order[n - 1]];
+                    current = node.children[lanes[n - 1]];
+                    entry = entries[lanes[n - 1]];
                     continue;
                 }
             }
-            // Pop the next entry that may still hold a nearer hit.
+            // Pop the next entry that may still hold a hit that matters.
             loop {
                 if top == 0 {
-                    // Every accepted hit is nearer than interval.max.
-                    return (closest < interval.max).then_some(Hit {
-                        t: closest,
-                        index: best,
-                    });
+                    return;
                 }
                 top -= 1;
                 // SAFETY: entries below `top` were all written by the pushes above.
                 #[allow(unsafe_code)]
-                let (child, t_near) = unsafe { stack[top].assume_init() };
-                if t_near <= closest * SLACK {
+                let (child, e) = unsafe { stack[top].assume_init() };
+                if rays.needed(&e) {
                     current = child;
+                    entry = e;
                     break;
                 }
             }
@@ -281,173 +405,258 @@ impl Bvh {
     }
 }
 
-/// A ray broadcast to four lanes, for sphere packets.
-struct SphereRay {
-    ox: Vec4,
-    oy: Vec4,
-    oz: Vec4,
-    dx: Vec4,
-    dy: Vec4,
-    dz: Vec4,
-    t_min: Vec4,
-    /// Whether the processor has AVX2 (the tree's answer).
-    avx2: bool,
+/// What [`Bvh::traverse`] asks of the rays it walks the tree for.
+pub(super) trait Rays {
+    /// Where the rays enter a box: one distance, or one per ray.
+    type Entry: Copy + Default;
+    /// Tests the four boxes of `node`: the children to visit (bit per
+    /// child), where the rays enter each, and an order to visit them in
+    /// (nearest first; only speed depends on it).
+    fn enter(&self, node: &Node) -> (u32, [Self::Entry; 4], [f32; 4]);
+    /// Whether a box the rays enter at `entry` may still hold a hit that matters.
+    fn needed(&self, entry: &Self::Entry) -> bool;
+    /// Tests the primitives of `leaf` (a leaf reference), which the rays
+    /// enter at `entry`; `true` ends the traversal.
+    fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Self::Entry) -> bool;
 }
 
-impl SphereRay {
+/// The kind and packet index of a leaf reference.
+#[inline(always)]
+pub(super) fn leaf_parts(leaf: u32) -> (Kind, u32) {
+    (
+        Kind::from_index((leaf & !LEAF_BIT) >> KIND_SHIFT),
+        leaf & INDEX_MASK,
+    )
+}
+
+/// What a single ray looks for.
+pub(super) trait Query {
+    /// Any hit ends the search (a shadow ray); otherwise the nearest is wanted.
+    const ANY: bool;
+}
+
+/// The nearest hit.
+pub(super) struct Nearest;
+impl Query for Nearest {
+    const ANY: bool = false;
+}
+
+/// Any hit.
+pub(super) struct AnyHit;
+impl Query for AnyHit {
+    const ANY: bool = true;
+}
+
+/// One ray, with what the box and leaf tests need of it.
+struct SingleRay<Q, const SPHERES: bool> {
+    ray: Ray,
+    near: [usize; 3],
+    inv: [Vec4; 3],
+    origin: [Vec4; 3],
+    t_min: f32,
+    /// The ray prepared for triangles, in its axes: only when the tree
+    /// holds triangles.
+    triangle: TriangleRay<f32>,
+    axes: [usize; 3],
+    /// The best hit so far, compared as the pair (distance, index) so that,
+    /// with boxes kept within `SLACK`, the result does not depend on the
+    /// order of the visit. No primitive ties the start (interval.max, 0):
+    /// index 0 is the lowest.
+    closest: f32,
+    best: u32,
+    query: std::marker::PhantomData<Q>,
+}
+
+impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
     #[inline(always)]
-    fn new(ray: &Ray, interval: Interval, avx2: bool) -> Self {
-        let (o, d) = (ray.origin, ray.direction);
-        SphereRay {
-            ox: Vec4::splat(o.x),
-            oy: Vec4::splat(o.y),
-            oz: Vec4::splat(o.z),
-            dx: Vec4::splat(d.x),
-            dy: Vec4::splat(d.y),
-            dz: Vec4::splat(d.z),
-            t_min: Vec4::splat(interval.min),
-            avx2,
+    fn new(bvh: &Bvh, ray: &Ray, interval: Interval) -> Self {
+        debug_assert!(
+            (ray.direction.length_squared() - 1.0).abs() < 1e-4,
+            "ray direction {} is not unit length",
+            ray.direction
+        );
+        let (o, inv) = (ray.origin, ray.direction.recip());
+        let (axes, triangle) = if bvh.has_triangles() {
+            let axes = TriangleRay::axes_of(ray.direction);
+            (axes, TriangleRay::new(ray, axes, interval.min))
+        } else {
+            let none = TriangleRay {
+                origin: [0.0; 3],
+                shear: [0.0; 3],
+                t_min: 0.0,
+            };
+            ([0, 1, 2], none)
+        };
+        SingleRay {
+            ray: *ray,
+            // Per axis: which of the two planes the ray meets first.
+            near: [
+                usize::from(inv.x < 0.0),
+                usize::from(inv.y < 0.0),
+                usize::from(inv.z < 0.0),
+            ],
+            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            origin: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            t_min: interval.min,
+            triangle,
+            axes,
+            closest: interval.max,
+            best: 0,
+            query: std::marker::PhantomData,
         }
     }
 
-    /// The packet's hit (t, sphere index) that comes before `(closest, best)`
-    /// in the order of distance then index, if any: the nearest sphere, the
-    /// lowest index among spheres at exactly the same distance. Distances are
-    /// bit-identical to [`Sphere::hit`] whichever version runs.
+    /// Takes in a packet's distances `t` (valid where `valid`) for the
+    /// primitives `index`; `true` when the search is over.
     #[inline(always)]
-    fn hit_packet(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
-            #[allow(unsafe_code)]
-            return unsafe { self.hit_packet_avx2(p, closest, best) };
+    fn found<R: Wide>(&mut self, t: R, valid: R::Mask, index: &[u32; 8]) -> bool {
+        let closest = R::splat(self.closest);
+        if Q::ANY {
+            let hit = valid & t.lt(closest);
+            if hit.any() {
+                self.closest = R::select(hit, t, closest).min_lane();
+                return true;
+            }
+            return false;
         }
-        self.hit_packet_halves(p, closest, best)
-    }
-
-    /// [`Self::hit_packet`] as two 4-lane tests.
-    #[inline(always)]
-    fn hit_packet_halves(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
-        let first = self.hit_half(p, 0, closest, best);
-        if p.index[4] == NO_CHILD {
-            return first;
-        }
-        let (closest, best) = first.unwrap_or((closest, best));
-        self.hit_half(p, 1, closest, best).or(first)
-    }
-
-    /// [`Self::hit_packet`] for lanes `4·half .. 4·half + 4`: [`Sphere::hit`]
-    /// on four spheres at once, operation for operation, so both give
-    /// bit-identical distances.
-    #[inline(always)]
-    fn hit_half(&self, p: &Packet, half: usize, closest: f32, best: u32) -> Option<(f32, u32)> {
-        let radius2 = p.radius2[half];
-        let fx = self.ox - p.cx[half];
-        let fy = self.oy - p.cy[half];
-        let fz = self.oz - p.cz[half];
-        let half_b = fx * self.dx + fy * self.dy + fz * self.dz;
-        let lx = fx - half_b * self.dx;
-        let ly = fy - half_b * self.dy;
-        let lz = fz - half_b * self.dz;
-        let discriminant = radius2 - (lx * lx + ly * ly + lz * lz);
-        let real = discriminant.cmpge(Vec4::ZERO);
-        if !real.any() {
-            return None;
-        }
-        let sqrt_d = sqrt4(discriminant);
-        let near = -half_b - sqrt_d;
-        let far = -half_b + sqrt_d;
-        // The first root beyond t_min, if it is not beyond `closest`.
-        let near_ok = self.t_min.cmplt(near);
-        let t = Vec4::select(near_ok, near, far);
-        let hit = real & (near_ok | self.t_min.cmplt(far)) & t.cmple(Vec4::splat(closest));
+        let hit = valid & t.le(closest);
         if !hit.any() {
-            return None;
+            return false;
         }
-        let t = Vec4::select(hit, t, Vec4::INFINITY);
-        let t_best = t.min_element();
-        let equal = t.cmpeq(Vec4::splat(t_best)).bitmask();
-        let lanes = &p.index[4 * half..4 * half + 4];
-        finish(t_best, equal, lanes, closest, best)
+        let t = R::select(hit, t, R::splat(f32::INFINITY));
+        let t_best = t.min_lane();
+        let equal = R::bits(t.eq(R::splat(t_best)));
+        if let Some((t, index)) = finish(t_best, equal, index, self.closest, self.best) {
+            self.closest = t;
+            self.best = index;
+        }
+        false
     }
 
-    /// [`Self::hit_half`] on all eight lanes at once with AVX, the same
-    /// operations in the same order.
-    #[cfg(target_arch = "x86_64")]
+    /// The ray in every lane of `R`.
+    #[inline(always)]
+    fn lanes<R: Real>(&self) -> RayLanes<R> {
+        RayLanes {
+            origin: self.ray.origin.to_array().map(R::splat),
+            direction: self.ray.direction.to_array().map(R::splat),
+            t_min: R::splat(self.t_min),
+        }
+    }
+
+    #[inline(always)]
+    fn spheres<R: Wide>(&mut self, p: &SpherePacket) -> bool {
+        let (t, valid) = sphere::intersect(&self.lanes(), &p.lanes());
+        self.found::<R>(t, valid, &p.index)
+    }
+
+    #[inline(always)]
+    fn triangles<R: Wide>(&mut self, p: &TrianglePacket) -> bool {
+        let ray = splat_triangle_ray::<R>(&self.triangle);
+        let (t, valid) = triangle::intersect(&ray, &p.lanes(self.axes));
+        self.found(t, valid, &p.index)
+    }
+
+    #[inline(always)]
+    fn quads<R: Wide>(&mut self, p: &QuadPacket) -> bool {
+        let (t, valid) = quad::intersect(&self.lanes(), &p.lanes());
+        self.found::<R>(t, valid, &p.index)
+    }
+}
+
+/// The packet tests of [`SingleRay`] on AVX lanes, each compiled for AVX2
+/// and small enough to be inlined into the AVX2 render loop.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod single_avx2 {
+    use super::{QuadPacket, Query, SingleRay, SpherePacket, TrianglePacket};
+    use crate::lanes::W8;
+
     #[target_feature(enable = "avx2")]
     #[inline]
-    #[allow(unsafe_code)]
-    unsafe fn hit_packet_avx2(&self, p: &Packet, closest: f32, best: u32) -> Option<(f32, u32)> {
-        use std::arch::x86_64::*;
-        // Loop-invariant after inlining: hoisted out of the traversal loop.
-        macro_rules! wide {
-            ($v:expr) => {{
-                let m: __m128 = $v.into();
-                _mm256_set_m128(m, m)
-            }};
-        }
-        macro_rules! load {
-            ($f:expr) => {
-                // SAFETY: the field is two adjacent `Vec4`s (`repr(C)`), 32 bytes.
-                _mm256_loadu_ps($f.as_ptr().cast::<f32>())
+    pub(super) unsafe fn spheres<Q: Query, const S: bool>(
+        r: &mut SingleRay<Q, S>,
+        p: &SpherePacket,
+    ) -> bool {
+        r.spheres::<W8>(p)
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn triangles<Q: Query, const S: bool>(
+        r: &mut SingleRay<Q, S>,
+        p: &TrianglePacket,
+    ) -> bool {
+        r.triangles::<W8>(p)
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn quads<Q: Query, const S: bool>(
+        r: &mut SingleRay<Q, S>,
+        p: &QuadPacket,
+    ) -> bool {
+        r.quads::<W8>(p)
+    }
+}
+
+/// A prepared triangle ray repeated in every lane.
+#[inline(always)]
+fn splat_triangle_ray<R: Real>(r: &TriangleRay<f32>) -> TriangleRay<R> {
+    TriangleRay {
+        origin: r.origin.map(R::splat),
+        shear: r.shear.map(R::splat),
+        t_min: R::splat(r.t_min),
+    }
+}
+
+impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
+    type Entry = f32;
+
+    #[inline(always)]
+    fn enter(&self, node: &Node) -> (u32, [f32; 4], [f32; 4]) {
+        let (p, near, o, inv) = (&node.planes, &self.near, &self.origin, &self.inv);
+        let tx0 = (p[0][near[0]] - o[0]) * inv[0];
+        let tx1 = (p[0][1 - near[0]] - o[0]) * inv[0];
+        let ty0 = (p[1][near[1]] - o[1]) * inv[1];
+        let ty1 = (p[1][1 - near[1]] - o[1]) * inv[1];
+        let tz0 = (p[2][near[2]] - o[2]) * inv[2];
+        let tz1 = (p[2][1 - near[2]] - o[2]) * inv[2];
+        // The bound given last wins when a lane is NaN (0·∞ for a ray
+        // lying in a box's plane), so a NaN never culls a box it may hit.
+        let t_near = max4(max4(max4(tx0, ty0), tz0), Vec4::splat(self.t_min));
+        let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(self.closest)) * SLACK4;
+        let mask = t_near.cmple(t_far).bitmask() & node.used;
+        let t_near = t_near.to_array();
+        (mask, t_near, t_near)
+    }
+
+    #[inline(always)]
+    fn needed(&self, t_near: &f32) -> bool {
+        *t_near <= self.closest * SLACK
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, bvh: &Bvh, leaf: u32, _: &f32) -> bool {
+        let (kind, i) = leaf_parts(leaf);
+        let kind = if SPHERES { Kind::Sphere } else { kind };
+        // SAFETY (the AVX2 calls): `avx2` is true only when `Isa::detect`
+        // found AVX2.
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        if bvh.avx2 {
+            return match kind {
+                Kind::Sphere => unsafe { single_avx2::spheres(self, bvh.sphere_packet(i)) },
+                Kind::Triangle => unsafe { single_avx2::triangles(self, bvh.triangle_packet(i)) },
+                Kind::Quad => unsafe { single_avx2::quads(self, bvh.quad_packet(i)) },
+                Kind::Instance => unreachable!("instances are traversed by the scene"),
             };
         }
-        let (ox, oy, oz) = (wide!(self.ox), wide!(self.oy), wide!(self.oz));
-        let (dx, dy, dz) = (wide!(self.dx), wide!(self.dy), wide!(self.dz));
-        let t_min = wide!(self.t_min);
-        let zero = _mm256_setzero_ps();
-        let sign = _mm256_set1_ps(-0.0);
-        let radius2 = load!(p.radius2);
-        let fx = _mm256_sub_ps(ox, load!(p.cx));
-        let fy = _mm256_sub_ps(oy, load!(p.cy));
-        let fz = _mm256_sub_ps(oz, load!(p.cz));
-        let dot = |x: __m256, y: __m256, z: __m256, u: __m256, v: __m256, w: __m256| {
-            _mm256_add_ps(
-                _mm256_add_ps(_mm256_mul_ps(x, u), _mm256_mul_ps(y, v)),
-                _mm256_mul_ps(z, w),
-            )
-        };
-        let half_b = dot(fx, fy, fz, dx, dy, dz);
-        let lx = _mm256_sub_ps(fx, _mm256_mul_ps(half_b, dx));
-        let ly = _mm256_sub_ps(fy, _mm256_mul_ps(half_b, dy));
-        let lz = _mm256_sub_ps(fz, _mm256_mul_ps(half_b, dz));
-        let discriminant = _mm256_sub_ps(radius2, dot(lx, ly, lz, lx, ly, lz));
-        let real = _mm256_cmp_ps::<_CMP_GE_OQ>(discriminant, zero);
-        if _mm256_movemask_ps(real) == 0 {
-            return None;
+        match kind {
+            Kind::Sphere => self.spheres::<F8>(bvh.sphere_packet(i)),
+            Kind::Triangle => self.triangles::<F8>(bvh.triangle_packet(i)),
+            Kind::Quad => self.quads::<F8>(bvh.quad_packet(i)),
+            Kind::Instance => unreachable!("instances are traversed by the scene"),
         }
-        let sqrt_d = _mm256_sqrt_ps(discriminant);
-        let minus_b = _mm256_xor_ps(half_b, sign);
-        let near = _mm256_sub_ps(minus_b, sqrt_d);
-        let far = _mm256_add_ps(minus_b, sqrt_d);
-        // The first root beyond t_min, if it is not beyond `closest`.
-        let near_ok = _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, near);
-        let t = _mm256_blendv_ps(far, near, near_ok);
-        let hit = _mm256_and_ps(
-            _mm256_and_ps(
-                real,
-                _mm256_or_ps(near_ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, far)),
-            ),
-            _mm256_cmp_ps::<_CMP_LE_OQ>(t, _mm256_set1_ps(closest)),
-        );
-        if _mm256_movemask_ps(hit) == 0 {
-            return None;
-        }
-        let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, hit);
-        // The minimum does not depend on the order of comparisons: every lane
-        // is a number or +∞.
-        let m = _mm_min_ps(_mm256_castps256_ps128(t), _mm256_extractf128_ps::<1>(t));
-        let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
-        let m = _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m));
-        let t_best = _mm_cvtss_f32(m);
-        let equal = _mm256_cmp_ps::<_CMP_EQ_OQ>(t, _mm256_set1_ps(t_best));
-        finish(
-            t_best,
-            _mm256_movemask_ps(equal) as u32,
-            &p.index,
-            closest,
-            best,
-        )
     }
 }
 
@@ -504,58 +713,11 @@ pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], 
 pub(super) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
 const SLACK4: Vec4 = Vec4::splat(SLACK);
 
-/// `maxps` semantics on every architecture: `a` if `a > b`, else `b` (so `b`
-/// when either is NaN). NEON's and the scalar fallback's `max` differ on NaN.
-#[inline(always)]
-fn max4(a: Vec4, b: Vec4) -> Vec4 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        a.max(b)
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        Vec4::select(a.cmpgt(b), a, b)
-    }
-}
-
-/// `minps` semantics on every architecture, as [`max4`].
-#[inline(always)]
-fn min4(a: Vec4, b: Vec4) -> Vec4 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        a.min(b)
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        Vec4::select(a.cmplt(b), a, b)
-    }
-}
-
-/// Lane-wise square root (glam's `Vec4` has none).
-#[inline(always)]
-#[allow(unsafe_code)]
-fn sqrt4(v: Vec4) -> Vec4 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: SSE is part of the x86-64 baseline, so the instruction exists.
-        Vec4::from(unsafe { std::arch::x86_64::_mm_sqrt_ps(v.into()) })
-    }
-    #[cfg(target_arch = "aarch64")]
-    {
-        // SAFETY: NEON is part of the aarch64 baseline, so the instruction exists.
-        Vec4::from(unsafe { std::arch::aarch64::vsqrtq_f32(v.into()) })
-    }
-    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
-    {
-        Vec4::new(v.x.sqrt(), v.y.sqrt(), v.z.sqrt(), v.w.sqrt())
-    }
-}
-
-/// Turns the binary tree into 4-wide nodes and sphere packets.
+/// Turns the binary tree into 4-wide nodes and packets.
 struct Collapse<'a> {
     binary: &'a [BinaryNode],
     order: &'a [u32],
-    spheres: &'a [Sphere],
+    primitives: &'a [Primitive],
 }
 
 impl Collapse<'_> {
@@ -602,74 +764,156 @@ impl Collapse<'_> {
 
     fn emit_packet(&self, leaf: &BinaryNode, bvh: &mut Bvh) -> u32 {
         debug_assert!(leaf.count as usize <= MAX_LEAF);
-        let mut p = Packet {
-            cx: [Vec4::ZERO; 2],
-            cy: [Vec4::ZERO; 2],
-            cz: [Vec4::ZERO; 2],
-            radius2: [Vec4::NEG_INFINITY; 2],
-            index: [NO_CHILD; 8],
-        };
         let first = leaf.offset as usize;
-        for lane in 0..leaf.count as usize {
-            let index = self.order[first + lane];
-            let s = &self.spheres[index as usize];
-            let (half, sub) = (lane / 4, lane % 4);
-            p.cx[half][sub] = s.center.x;
-            p.cy[half][sub] = s.center.y;
-            p.cz[half][sub] = s.center.z;
-            p.radius2[half][sub] = s.radius * s.radius;
-            p.index[lane] = index;
+        let members = &self.order[first..first + leaf.count as usize];
+        let mut index = [NO_CHILD; 8];
+        index[..members.len()].copy_from_slice(members);
+        let primitive = |lane: usize| &self.primitives[members[lane] as usize];
+        let kind = primitive(0).kind();
+        // Fills lane `lane` of each field; unused lanes keep their filler.
+        fn fill<const N: usize>(fields: &mut [Lane8; N], lane: usize, values: [f32; N]) {
+            for (field, v) in fields.iter_mut().zip(values) {
+                field[lane] = v;
+            }
         }
-        bvh.packets.push(p);
-        LEAF_BIT | (bvh.packets.len() - 1) as u32
+        let packet = match kind {
+            Kind::Sphere => {
+                let mut p = SpherePacket {
+                    center: [[0.0; 8]; 3],
+                    radius2: [f32::NEG_INFINITY; 8],
+                    index,
+                };
+                for lane in 0..members.len() {
+                    let Primitive::Sphere(s) = primitive(lane) else {
+                        unreachable!("a leaf holds one kind")
+                    };
+                    fill(&mut p.center, lane, s.center.to_array());
+                    p.radius2[lane] = s.radius * s.radius;
+                }
+                bvh.spheres.push(p);
+                bvh.spheres.len() - 1
+            }
+            Kind::Triangle => {
+                let mut p = TrianglePacket {
+                    vertices: [[[f32::NAN; 8]; 3]; 3],
+                    index,
+                };
+                for lane in 0..members.len() {
+                    let Primitive::Triangle(t) = primitive(lane) else {
+                        unreachable!("a leaf holds one kind")
+                    };
+                    for (v, x) in p.vertices.iter_mut().zip(t.vertices) {
+                        fill(v, lane, x.to_array());
+                    }
+                }
+                bvh.triangles.push(p);
+                bvh.triangles.len() - 1
+            }
+            Kind::Quad => {
+                let nan = [[f32::NAN; 8]; 3];
+                let mut p = QuadPacket {
+                    corner: nan,
+                    u: nan,
+                    v: nan,
+                    normal: nan,
+                    w: nan,
+                    d: [f32::NAN; 8],
+                    index,
+                };
+                for lane in 0..members.len() {
+                    let Primitive::Quad(q) = primitive(lane) else {
+                        unreachable!("a leaf holds one kind")
+                    };
+                    fill(&mut p.corner, lane, q.corner.to_array());
+                    fill(&mut p.u, lane, q.u.to_array());
+                    fill(&mut p.v, lane, q.v.to_array());
+                    fill(&mut p.normal, lane, q.normal.to_array());
+                    fill(&mut p.w, lane, q.w.to_array());
+                    p.d[lane] = q.d;
+                }
+                bvh.quads.push(p);
+                bvh.quads.len() - 1
+            }
+            Kind::Instance => unreachable!("instances are placed by the scene"),
+        };
+        debug_assert!(packet <= INDEX_MASK as usize);
+        LEAF_BIT | (kind as u32) << KIND_SHIFT | packet as u32
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{Quad, Sphere, Triangle};
     use crate::math::Vec3;
     use crate::rng::Rng;
 
-    fn brute_force(spheres: &[Sphere], ray: &Ray, interval: Interval) -> Option<(f32, u32)> {
+    fn brute_force(prims: &[Primitive], ray: &Ray, interval: Interval) -> Option<(f32, u32)> {
         let mut best: Option<(f32, u32)> = None;
-        for (i, s) in spheres.iter().enumerate() {
+        for (i, p) in prims.iter().enumerate() {
             let max = best.map_or(interval.max, |b| b.0);
-            if let Some(t) = s.hit(ray, Interval::new(interval.min, max)) {
+            if let Some(t) = p.hit(ray, Interval::new(interval.min, max)) {
                 best = Some((t, i as u32));
             }
         }
         best
     }
 
-    fn random_spheres(rng: &mut Rng, n: usize, extent: f32) -> Vec<Sphere> {
+    fn point(rng: &mut Rng, extent: f32) -> Vec3 {
+        Vec3::new(
+            rng.range_f32(-extent, extent),
+            rng.range_f32(-extent, extent),
+            rng.range_f32(-extent, extent),
+        )
+    }
+
+    fn random_spheres(rng: &mut Rng, n: usize, extent: f32) -> Vec<Primitive> {
+        (0..n)
+            .map(|_| Primitive::Sphere(Sphere::new(point(rng, extent), rng.range_f32(0.1, 2.0))))
+            .collect()
+    }
+
+    /// Spheres, triangles and quads mixed, in random order.
+    fn random_mixed(rng: &mut Rng, n: usize, extent: f32) -> Vec<Primitive> {
         (0..n)
             .map(|_| {
-                let c = Vec3::new(
-                    rng.range_f32(-extent, extent),
-                    rng.range_f32(-extent, extent),
-                    rng.range_f32(-extent, extent),
-                );
-                Sphere::new(c, rng.range_f32(0.1, 2.0))
+                let c = point(rng, extent);
+                match rng.next_u32() % 3 {
+                    0 => Primitive::Sphere(Sphere::new(c, rng.range_f32(0.1, 2.0))),
+                    1 => Primitive::Triangle(Triangle::new(
+                        c,
+                        c + point(rng, 3.0),
+                        c + point(rng, 3.0),
+                    )),
+                    _ => Primitive::Quad(
+                        Quad::new(c, point(rng, 3.0), point(rng, 3.0)).expect("random edges"),
+                    ),
+                }
             })
             .collect()
     }
 
-    fn check_against_brute_force(spheres: &[Sphere], rng: &mut Rng, rays: usize) {
-        let bvh = Bvh::new(spheres);
+    fn check_against_brute_force(prims: &[Primitive], rng: &mut Rng, rays: usize) -> usize {
+        let bvh = Bvh::new(prims);
         let interval = Interval::new(0.001, f32::INFINITY);
-        for _ in 0..rays {
-            let origin = Vec3::new(
-                rng.range_f32(-30.0, 30.0),
-                rng.range_f32(-30.0, 30.0),
-                rng.range_f32(-30.0, 30.0),
-            );
-            let ray = Ray::new(origin, crate::sampling::unit_vector(rng));
-            let expected = brute_force(spheres, &ray, interval);
+        let mut hits = 0;
+        for k in 0..rays {
+            // Half in random directions, half aimed into the scene.
+            let origin = point(rng, 30.0);
+            let direction = if k % 2 == 0 {
+                crate::sampling::unit_vector(rng)
+            } else {
+                (point(rng, 10.0) - origin).normalize()
+            };
+            let ray = Ray::new(origin, direction);
+            let expected = brute_force(prims, &ray, interval);
             let got = bvh.hit(&ray, interval).map(|h| (h.t, h.index));
-            // Exactly the same: among coincident spheres, the lowest index.
+            // Exactly the same: among coincident primitives, the lowest index.
             assert_eq!(got, expected);
+            assert_eq!(bvh.occluded(&ray, interval), expected.is_some());
+            hits += usize::from(expected.is_some());
         }
+        hits
     }
 
     #[test]
@@ -683,79 +927,130 @@ mod tests {
     }
 
     #[test]
+    fn bvh_over_mixed_kinds_agrees_with_brute_force() {
+        let mut rng = Rng::new(17);
+        let mut hits = 0;
+        for n in [1, 2, 3, 9, 30, 300, 2000] {
+            let prims = random_mixed(&mut rng, n, 15.0);
+            hits += check_against_brute_force(&prims, &mut rng, 3000);
+        }
+        assert!(
+            hits > 2500,
+            "only {hits} hits: the test exercises too little"
+        );
+    }
+
+    #[test]
+    fn leaves_hold_one_kind() {
+        let mut rng = Rng::new(8);
+        // Every kind at one place: SAH sees nothing to split.
+        let c = Vec3::new(1.0, 1.0, 1.0);
+        let mut prims = vec![Primitive::Sphere(Sphere::new(c, 1.0)); 3];
+        prims.extend([Primitive::Triangle(Triangle::new(c, c + Vec3::X, c + Vec3::Y)); 3]);
+        prims.extend([Primitive::Quad(Quad::new(c, Vec3::X, Vec3::Z).unwrap()); 2]);
+        let bvh = Bvh::new(&prims);
+        assert_eq!(
+            (bvh.spheres.len(), bvh.triangles.len(), bvh.quads.len()),
+            (1, 1, 1)
+        );
+        check_against_brute_force(&prims, &mut rng, 2000);
+    }
+
+    #[test]
     fn bvh_handles_coincident_and_axis_aligned_cases() {
         let mut rng = Rng::new(5);
         // Many spheres with one centre (no SAH split exists), and a row of
         // spheres on an axis hit by axis-aligned rays (0·∞ in the slab test).
-        let mut spheres = vec![Sphere::new(Vec3::new(1.0, 2.0, 3.0), 1.5); 9];
-        spheres.extend((0..20).map(|i| Sphere::new(Vec3::new(i as f32 * 3.0, 0.0, 0.0), 1.0)));
-        check_against_brute_force(&spheres, &mut rng, 2000);
-        let bvh = Bvh::new(&spheres);
+        let mut prims = vec![Primitive::Sphere(Sphere::new(Vec3::new(1.0, 2.0, 3.0), 1.5)); 9];
+        prims.extend(
+            (0..20)
+                .map(|i| Primitive::Sphere(Sphere::new(Vec3::new(i as f32 * 3.0, 0.0, 0.0), 1.0))),
+        );
+        check_against_brute_force(&prims, &mut rng, 2000);
+        let bvh = Bvh::new(&prims);
         for dir in [Vec3::X, -Vec3::X, Vec3::Y, Vec3::Z] {
             for origin in [Vec3::new(-10.0, 0.0, 0.0), Vec3::new(30.0, 1.0, 0.0)] {
                 let ray = Ray::new(origin, dir);
                 let all = Interval::new(0.001, f32::INFINITY);
-                let expected = brute_force(&spheres, &ray, all).map(|b| b.0);
+                let expected = brute_force(&prims, &ray, all).map(|b| b.0);
                 assert_eq!(bvh.hit(&ray, all).map(|h| h.t), expected);
             }
         }
     }
 
+    /// Each lane of a packet's eight-lane test gives the bits of the
+    /// one-lane test of its primitive, for every kind.
     #[test]
-    #[cfg(target_arch = "x86_64")]
-    fn avx2_and_four_lane_packet_tests_agree_bit_for_bit() {
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            return;
-        }
+    fn packet_lanes_agree_with_single_lane_tests_bit_for_bit() {
         let mut rng = Rng::new(11);
-        // Leaves of 1 to 8 spheres in a small box, with duplicates (ties)
-        // and rays from inside and outside, so every branch is taken.
-        let mut spheres = random_spheres(&mut rng, 300, 3.0);
-        spheres.extend_from_within(..40);
-        let bvh = Bvh::new(&spheres);
+        let mut prims = random_mixed(&mut rng, 600, 3.0);
+        prims.extend_from_within(..60);
+        let bvh = Bvh::new(&prims);
         let mut hits = 0;
-        for _ in 0..20_000 {
-            let origin = Vec3::new(
-                rng.range_f32(-6.0, 6.0),
-                rng.range_f32(-6.0, 6.0),
-                rng.range_f32(-6.0, 6.0),
-            );
+        for _ in 0..4_000 {
             let d = crate::sampling::unit_vector(&mut rng);
+            let ray = Ray::new(point(&mut rng, 6.0), d);
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
-            let ray = SphereRay::new(&Ray::new(origin, d), interval, true);
-            for p in &bvh.packets {
-                let halves = ray.hit_packet_halves(p, interval.max, 0);
-                // SAFETY: AVX2 was detected above.
-                #[allow(unsafe_code)]
-                let wide = unsafe { ray.hit_packet_avx2(p, interval.max, 0) };
-                let bits = |h: Option<(f32, u32)>| h.map(|(t, i)| (t.to_bits(), i));
-                assert_eq!(bits(halves), bits(wide));
-                hits += usize::from(wide.is_some());
+            let lanes = RayLanes::splat(&ray, interval.min);
+            let axes = TriangleRay::axes_of(d);
+            let tri_ray = splat_triangle_ray(&TriangleRay::new(&ray, axes, interval.min));
+            let mut check = |t: F8, valid: crate::lanes::M8, index: &[u32; 8]| {
+                for lane in 0..8 {
+                    if index[lane] == NO_CHILD {
+                        assert!(!valid.lane(lane), "an unused lane hits");
+                        continue;
+                    }
+                    let prim = &prims[index[lane] as usize];
+                    let single = prim.hit(&ray, Interval::new(interval.min, f32::INFINITY));
+                    let packet = valid.lane(lane).then_some(t.lane(lane));
+                    assert_eq!(packet.map(f32::to_bits), single.map(f32::to_bits));
+                    hits += usize::from(single.is_some());
+                }
+            };
+            for p in &bvh.spheres {
+                let (t, valid) = sphere::intersect(&lanes, &p.lanes());
+                check(t, valid, &p.index);
+            }
+            for p in &bvh.triangles {
+                let (t, valid) = triangle::intersect(&tri_ray, &p.lanes(axes));
+                check(t, valid, &p.index);
+            }
+            for p in &bvh.quads {
+                let (t, valid) = quad::intersect(&lanes, &p.lanes());
+                check(t, valid, &p.index);
             }
         }
         assert!(
-            hits > 1000,
-            "only {hits} packet hits: the test exercises too little"
+            hits > 20_000,
+            "only {hits} hits: the test exercises too little"
         );
     }
 
     #[test]
     fn deep_trees_do_not_overflow_the_stack() {
         // Radii growing geometrically make SAH peel one sphere at a time.
-        let spheres: Vec<Sphere> = (0..3000)
-            .map(|i| Sphere::new(Vec3::new(i as f32 * 0.001, 0.0, 0.0), 1.002f32.powi(i)))
+        let prims: Vec<Primitive> = (0..3000)
+            .map(|i| {
+                Primitive::Sphere(Sphere::new(
+                    Vec3::new(i as f32 * 0.001, 0.0, 0.0),
+                    1.002f32.powi(i),
+                ))
+            })
             .collect();
         let mut rng = Rng::new(9);
-        check_against_brute_force(&spheres, &mut rng, 200);
+        check_against_brute_force(&prims, &mut rng, 200);
     }
 
     #[test]
-    fn empty_and_single_sphere_scenes_work() {
+    fn empty_and_single_primitive_scenes_work() {
         let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
         let all = Interval::new(0.0, f32::INFINITY);
         assert!(Bvh::new(&[]).hit(&ray, all).is_none());
-        let one = Bvh::new(&[Sphere::new(Vec3::ZERO, 1.0)]);
+        assert!(!Bvh::new(&[]).occluded(&ray, all));
+        let one = Bvh::new(&[Primitive::Sphere(Sphere::new(Vec3::ZERO, 1.0))]);
         let hit = one.hit(&ray, all).expect("hits the sphere");
         assert_eq!((hit.t, hit.index), (4.0, 0));
+        assert!(one.occluded(&ray, all));
+        assert!(!one.occluded(&ray, Interval::new(0.0, 3.5)));
     }
 }

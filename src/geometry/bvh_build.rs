@@ -5,17 +5,17 @@
 //! `i + 1`, and each interior node stores the index of its right child.
 //! [`super::bvh::Bvh`] then collapses this binary tree into its 4-wide form.
 
-use crate::geometry::Sphere;
+use crate::geometry::primitive::{Kind, Primitive};
 use crate::math::{Point3, Vec3};
 
-/// Leaves hold at most this many spheres: one packet, tested as one 8-lane
-/// vector with AVX2 or as two 4-lane halves otherwise.
+/// Leaves hold at most this many primitives, all of one kind: one packet,
+/// tested as one 8-lane vector with AVX2 or as two 4-lane halves otherwise.
 pub const MAX_LEAF: usize = 8;
 /// Number of centroid bins evaluated per axis when choosing a split.
 const BINS: usize = 12;
-/// Relative cost of visiting a node against testing one packet of spheres.
-/// A packet tests up to eight spheres for the price of one, so the leaf cost
-/// counts packets, not spheres.
+/// Relative cost of visiting a node against testing one packet of
+/// primitives. A packet tests up to eight for the price of one, so the leaf
+/// cost counts packets, not primitives.
 const TRAVERSAL_COST: f32 = 1.0;
 const INTERSECT_COST: f32 = 1.0;
 /// Below this depth every split is a median split, which halves the items:
@@ -24,7 +24,7 @@ const INTERSECT_COST: f32 = 1.0;
 const MAX_SAH_DEPTH: usize = 48;
 
 /// An axis-aligned bounding box.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
     /// Smallest corner.
     pub min: Point3,
@@ -39,7 +39,18 @@ impl Aabb {
         max: Vec3::splat(f32::NEG_INFINITY),
     };
 
-    fn grow(&mut self, other: &Aabb) {
+    /// The box of `(min, max)`.
+    pub fn new((min, max): (Point3, Point3)) -> Aabb {
+        Aabb { min, max }
+    }
+
+    /// The box's centre.
+    pub fn center(&self) -> Point3 {
+        0.5 * (self.min + self.max)
+    }
+
+    /// Grows the box to contain `other`.
+    pub fn grow(&mut self, other: &Aabb) {
         self.min = self.min.min(other.min);
         self.max = self.max.max(other.max);
     }
@@ -61,9 +72,9 @@ impl Aabb {
 pub struct BinaryNode {
     /// Bounds of everything below.
     pub bounds: Aabb,
-    /// Leaf: index of the first sphere. Interior: index of the right child.
+    /// Leaf: index of the first primitive. Interior: index of the right child.
     pub offset: u32,
-    /// Number of spheres in a leaf; 0 for an interior node.
+    /// Number of primitives in a leaf; 0 for an interior node.
     pub count: u32,
 }
 
@@ -77,26 +88,25 @@ impl BinaryNode {
 struct BuildItem {
     bounds: Aabb,
     centroid: Point3,
+    kind: Kind,
     index: u32,
 }
 
-/// The binary SAH tree over `spheres` (empty for no spheres), and the order
-/// of the spheres in its leaves: leaf spheres `offset..offset + count` are
-/// `spheres[order[offset]]`, ….
-pub fn build_binary(spheres: &[Sphere]) -> (Vec<BinaryNode>, Vec<u32>) {
-    let mut items: Vec<BuildItem> = spheres
+/// The binary SAH tree over `primitives` (empty for none), and the order of
+/// the primitives in its leaves: leaf primitives `offset..offset + count`
+/// are `primitives[order[offset]]`, …. Every leaf holds one kind.
+pub fn build_binary(primitives: &[Primitive]) -> (Vec<BinaryNode>, Vec<u32>) {
+    let mut items: Vec<BuildItem> = primitives
         .iter()
         .enumerate()
-        .map(|(i, s)| {
-            let (min, max) = s.bounds();
-            BuildItem {
-                bounds: Aabb { min, max },
-                centroid: s.center,
-                index: i as u32,
-            }
+        .map(|(i, p)| BuildItem {
+            bounds: p.bounds(),
+            centroid: p.centroid(),
+            kind: p.kind(),
+            index: i as u32,
         })
         .collect();
-    let mut nodes = Vec::with_capacity(2 * spheres.len().div_ceil(2));
+    let mut nodes = Vec::with_capacity(2 * primitives.len().div_ceil(2));
     if !items.is_empty() {
         build(&mut items, 0, 0, &mut nodes);
     }
@@ -132,9 +142,13 @@ fn build(
     } else {
         None
     };
+    let first_kind = items[0].kind;
+    let one_kind = items.iter().all(|it| it.kind == first_kind);
     let mid = match split {
         Some((axis, position)) => partition(items, |it| it.centroid[axis] < position),
-        None if items.len() <= MAX_LEAF => return node_index,
+        None if items.len() <= MAX_LEAF && one_kind => return node_index,
+        // A leaf holds one kind: kinds that would share one part company.
+        None if items.len() <= MAX_LEAF => partition(items, |it| it.kind == first_kind),
         None => {
             // SAH prefers one leaf but it would be too large (or all centroids
             // coincide, or the tree is already deep): split at the median of
@@ -165,7 +179,7 @@ fn build(
     node_index
 }
 
-/// Cost of a leaf of `n` spheres, tested a packet at a time.
+/// Cost of a leaf of `n` primitives, tested a packet at a time.
 fn leaf_cost(n: usize) -> f32 {
     INTERSECT_COST * n.div_ceil(MAX_LEAF) as f32
 }

@@ -2,39 +2,43 @@
 //! rays of one pixel, or the bounces of a round of its paths.
 //!
 //! Single-ray traversal ([`Bvh::hit`]) is bound by latency: each box and
-//! sphere test waits for the one before. The camera rays of one pixel start
+//! primitive test waits for the one before. The camera rays of one pixel start
 //! within the lens and pass within one pixel of each other, so they visit
 //! nearly the same nodes; the bounces of one pixel's paths start close
 //! together, and many of them leave the scene at once. A bundle visits each
 //! node once for all its rays, testing the eight rays against one box (or
-//! one sphere) as eight independent lanes: the work per ray is about the
+//! one primitive) as eight independent lanes: the work per ray is about the
 //! same, but it is spread over SIMD lanes and independent chains instead of
 //! one long chain.
 //!
 //! The lanes are plain `[f32; 8]` arrays processed by simple loops, which the
 //! compiler turns into 8-wide (AVX2) or 2×4-wide (SSE2, NEON) vector code in
-//! each instruction-set version of the render loop. Every arithmetic
-//! operation is the one [`Bvh::hit`] performs, in the same order, so a bundle
-//! finds bit for bit the same distances as tracing its rays one at a time,
-//! and a lane tests a leaf's spheres only when its own ray enters the leaf's
-//! box, as it would alone.
+//! each instruction-set version of the render loop. The box test performs
+//! the operations of [`Bvh::hit`]'s, and each primitive is tested by the same
+//! kernel on the same numbers, so a bundle finds bit for bit the same
+//! distances as tracing its rays one at a time; a lane tests a leaf's
+//! primitives only when its own ray enters the leaf's box, as it would alone.
 //!
 //! Children are visited in the order of a *reference* ray given by the
 //! caller (the pixel's central ray, say), near to the bundle's rays. The order
 //! only affects speed: each lane's result, like [`Bvh::hit`]'s, is the first
-//! hit in the order of distance then sphere index, and boxes are kept with a
+//! hit in the order of distance then primitive index, and boxes are kept with a
 //! margin over the rounding of their tests (`bvh::SLACK`), so the result
 //! does not depend on the order of the visit, nor on the other rays of the
 //! bundle.
 
-use super::bvh::{farthest_first, Bvh, Hit, LEAF_BIT, NO_CHILD, SLACK, STACK_SIZE};
+use super::bvh::{leaf_parts, Bvh, Hit, Node, Rays, NO_CHILD, SLACK};
+use crate::geometry::primitive::Kind;
+use crate::geometry::quad;
+use crate::geometry::sphere;
+use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
+use crate::lanes::{Wide, F8};
 use crate::math::Interval;
-use crate::ray::Ray;
+use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
-use std::mem::MaybeUninit;
 
 /// Rays in a bundle.
-pub const LANES: usize = 8;
+pub const LANES: usize = crate::lanes::LANES;
 
 type Lanes = [f32; LANES];
 
@@ -107,6 +111,14 @@ impl RayBundle {
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
+
+    /// The ray of lane `lane`.
+    #[inline(always)]
+    pub fn ray(&self, lane: usize) -> Ray {
+        let o = self.origin.map(|c| c[lane]);
+        let d = self.direction.map(|c| c[lane]);
+        Ray::new(o.into(), d.into())
+    }
 }
 
 /// `maxps` semantics: the second operand when either is NaN, so a NaN bound
@@ -131,9 +143,9 @@ fn min_ps(a: f32, b: f32) -> f32 {
 }
 
 impl Bvh {
-    /// The nearest sphere hit by each ray of `rays` within `interval`, in the
-    /// bundle's order (`None` beyond its length). Each distance is the one
-    /// [`Bvh::hit`] finds for that ray. `reference` orders the visit of
+    /// The nearest primitive hit by each ray of `rays` within `interval`, in
+    /// the bundle's order (`None` beyond its length). Each distance is the
+    /// one [`Bvh::hit`] finds for that ray. `reference` orders the visit of
     /// children (see the module documentation); any ray close to the
     /// bundle's rays makes a good reference.
     #[inline(always)]
@@ -143,15 +155,17 @@ impl Bvh {
         reference: &Ray,
         interval: Interval,
     ) -> [Option<Hit>; LANES] {
-        // Per lane, the best hit so far as in `Bvh::hit`: (distance, index),
-        // starting from (interval.max, 0). Unused lanes start at −∞, so that
-        // they never enter a box or accept a sphere.
-        let mut closest = [f32::NEG_INFINITY; LANES];
-        closest[..rays.len].fill(interval.max);
-        let mut best = [0; LANES];
-        if !self.nodes_empty() {
-            (closest, best) = self.traverse_bundle(rays, reference, interval.min, closest, best);
-        }
+        // As for single rays: a tree of spheres only gets a loop without
+        // the other kinds' tests.
+        let (closest, best) = if self.spheres_only() {
+            let mut query = BundleRays::<true>::new(self, rays, reference, interval);
+            self.traverse(&mut query);
+            (query.closest, query.best)
+        } else {
+            let mut query = BundleRays::<false>::new(self, rays, reference, interval);
+            self.traverse(&mut query);
+            (query.closest, query.best)
+        };
         let mut hits = [None; LANES];
         for lane in 0..rays.len {
             if closest[lane] < interval.max {
@@ -163,203 +177,299 @@ impl Bvh {
         }
         hits
     }
+}
 
+/// A bundle's rays, with what the box and leaf tests need of them.
+struct BundleRays<'a, const SPHERES: bool> {
+    rays: &'a RayBundle,
+    t_min: f32,
+    /// Per lane and axis: whether the upper plane is met first.
+    flip: [[bool; LANES]; 3],
+    /// The reference ray's slab test, only to order children.
+    ref_near: [usize; 3],
+    ref_origin: [Vec4; 3],
+    ref_inv: [Vec4; 3],
+    /// Only prepared when the tree holds triangles: each ray in its own axes
+    /// (see [`TriangleRay`]), lane by lane, and per permuted axis, the lanes
+    /// (as bits) for which it is x, and those for which it is y (else z).
+    triangle: TriangleRay<Lanes>,
+    is_axis: [[u32; 2]; 3],
+    /// Per lane, the best hit so far as in `Bvh::hit`: (distance, index),
+    /// starting from (interval.max, 0). Unused lanes start at −∞, so that
+    /// they never enter a box or accept a primitive.
+    closest: Lanes,
+    best: [u32; LANES],
+}
+
+impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
     #[inline(always)]
-    fn traverse_bundle(
-        &self,
-        rays: &RayBundle,
-        reference: &Ray,
-        t_min: f32,
-        mut closest: Lanes,
-        mut best: [u32; LANES],
-    ) -> (Lanes, [u32; LANES]) {
-        // The best hits are passed by value, not by reference: in memory, the
-        // compiler updates them with masked stores, and the next read stalls.
-        // The reference ray's slab test, only to order children.
+    fn new(bvh: &Bvh, rays: &'a RayBundle, reference: &Ray, interval: Interval) -> Self {
         let ref_inv = reference.direction.recip();
-        let ref_near = [
-            usize::from(ref_inv.x < 0.0),
-            usize::from(ref_inv.y < 0.0),
-            usize::from(ref_inv.z < 0.0),
-        ];
-        let ref_o = [
-            Vec4::splat(reference.origin.x),
-            Vec4::splat(reference.origin.y),
-            Vec4::splat(reference.origin.z),
-        ];
-        let ref_inv4 = [
-            Vec4::splat(ref_inv.x),
-            Vec4::splat(ref_inv.y),
-            Vec4::splat(ref_inv.z),
-        ];
-        // Per lane and axis: whether the upper plane is met first.
-        let flip: [[bool; LANES]; 3] =
-            std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0));
-
-        // Entries: a child and, per lane, where its box starts (NaN for lanes
-        // that miss it, which no comparison accepts). Uninitialised, as in
-        // `Bvh::hit`. `entry` is the same for `current`.
-        let mut stack = [MaybeUninit::<(u32, Lanes)>::uninit(); STACK_SIZE];
-        let mut top = 0usize;
-        let mut current = 0u32;
-        let mut entry = [f32::NAN; LANES];
-        loop {
-            if current & LEAF_BIT != 0 {
-                // Only the lanes that enter the leaf's box test its spheres,
-                // as each ray alone would.
-                let mut enter = [false; LANES];
-                for l in 0..LANES {
-                    enter[l] = entry[l] <= closest[l] * SLACK;
-                }
-                (closest, best) =
-                    self.bundle_leaf(current & !LEAF_BIT, rays, t_min, &enter, closest, best);
-            } else {
-                let node = self.node(current);
-                // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
-                let bounds = node.planes.map(|pair| pair.map(|v| v.to_array()));
-                let mut t_near = [[f32::NAN; LANES]; 4];
-                let mut hit_mask = 0u32;
-                for child in 0..4 {
-                    if node.used & (1 << child) == 0 {
-                        continue;
-                    }
-                    let mut any = false;
-                    let planes: [[f32; 2]; 3] = std::array::from_fn(|axis| {
-                        [bounds[axis][0][child], bounds[axis][1][child]]
-                    });
-                    let tn = &mut t_near[child];
-                    for l in 0..LANES {
-                        let slab = |axis: usize| {
-                            let (lo, hi) = (planes[axis][0], planes[axis][1]);
-                            let (n, f) = if flip[axis][l] { (hi, lo) } else { (lo, hi) };
-                            let o = rays.origin[axis][l];
-                            let inv = rays.inverse[axis][l];
-                            ((n - o) * inv, (f - o) * inv)
-                        };
-                        let (x0, x1) = slab(0);
-                        let (y0, y1) = slab(1);
-                        let (z0, z1) = slab(2);
-                        let near = max_ps(max_ps(max_ps(x0, y0), z0), t_min);
-                        let far = min_ps(min_ps(min_ps(x1, y1), z1), closest[l]) * SLACK;
-                        let hit = near <= far;
-                        tn[l] = if hit { near } else { f32::NAN };
-                        any |= hit;
-                    }
-                    hit_mask |= u32::from(any) << child;
-                }
-                if hit_mask != 0 {
-                    // Order the hit children by where the reference ray
-                    // meets their boxes: push the farther ones, go on with
-                    // the nearest.
-                    let p = &node.planes;
-                    let rx = (p[0][ref_near[0]] - ref_o[0]) * ref_inv4[0];
-                    let ry = (p[1][ref_near[1]] - ref_o[1]) * ref_inv4[1];
-                    let rz = (p[2][ref_near[2]] - ref_o[2]) * ref_inv4[2];
-                    let distance = rx.max(ry).max(rz).max(Vec4::splat(t_min)).to_array();
-                    let (order, n) = farthest_first(hit_mask, distance);
-                    for &child in &order[..n - 1] {
-                        stack[top].write((node.children[child], t_near[child]));
-                        top += 1;
-                    }
-                    current = node.children[order[n - 1]];
-                    entry = t_near[order[n - 1]];
-                    continue;
+        let mut closest = [f32::NEG_INFINITY; LANES];
+        closest[..rays.len].fill(interval.max);
+        let mut triangle = TriangleRay {
+            origin: [[0.0; LANES]; 3],
+            shear: [[0.0; LANES]; 3],
+            t_min: [interval.min; LANES],
+        };
+        let mut is_axis = [[0; 2]; 3];
+        if bvh.has_triangles() {
+            for lane in 0..LANES {
+                let ray = rays.ray(lane);
+                let axes = TriangleRay::axes_of(ray.direction);
+                let r = TriangleRay::new(&ray, axes, interval.min);
+                for k in 0..3 {
+                    triangle.origin[k][lane] = r.origin[k];
+                    triangle.shear[k][lane] = r.shear[k];
+                    is_axis[k][0] |= u32::from(axes[k] == 0) << lane;
+                    is_axis[k][1] |= u32::from(axes[k] == 1) << lane;
                 }
             }
-            // Pop the next entry that may still hold a nearer hit for a lane.
-            loop {
-                if top == 0 {
-                    return (closest, best);
-                }
-                top -= 1;
-                // SAFETY: entries below `top` were all written by the pushes above.
-                #[allow(unsafe_code)]
-                let (child, t_near) = unsafe { stack[top].assume_init() };
-                let mut needed = false;
-                for l in 0..LANES {
-                    needed |= t_near[l] <= closest[l] * SLACK;
-                }
-                if needed {
-                    current = child;
-                    entry = t_near;
-                    break;
-                }
-            }
+        }
+        BundleRays {
+            rays,
+            t_min: interval.min,
+            flip: std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0)),
+            ref_near: [
+                usize::from(ref_inv.x < 0.0),
+                usize::from(ref_inv.y < 0.0),
+                usize::from(ref_inv.z < 0.0),
+            ],
+            ref_origin: reference.origin.to_array().map(Vec4::splat),
+            ref_inv: ref_inv.to_array().map(Vec4::splat),
+            triangle,
+            is_axis,
+            closest,
+            best: [0; LANES],
         }
     }
 
-    /// Tests every ray of the bundle against the spheres of packet `index`,
-    /// sphere by sphere, with the operations of the single-ray packet test
-    /// (so the same distances), keeping per lane the first in the order of
-    /// distance then sphere index, as `Bvh::hit` does.
+    /// Takes in one primitive's distances `t` to the rays (valid where
+    /// `valid`; only the lanes that `enter` its leaf count): per lane the
+    /// first in the order of distance then index, as `Bvh::hit` keeps.
     #[inline(always)]
-    fn bundle_leaf(
-        &self,
+    fn found<R: Wide>(
+        &mut self,
+        closest: &mut R,
+        t: R,
+        valid: R::Mask,
+        enter: R::Mask,
         index: u32,
-        rays: &RayBundle,
-        t_min: f32,
-        enter: &[bool; LANES],
-        mut closest: Lanes,
-        mut best: [u32; LANES],
-    ) -> (Lanes, [u32; LANES]) {
-        let p = self.packet(index);
-        // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
-        let eight = |v: &[Vec4; 2]| -> [f32; 8] {
-            let (a, b) = (v[0].to_array(), v[1].to_array());
-            [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
-        };
-        let (pcx, pcy, pcz, pr2) = (eight(&p.cx), eight(&p.cy), eight(&p.cz), eight(&p.radius2));
-        for s in 0..8 {
-            let sphere = p.index[s];
-            if sphere == NO_CHILD {
-                break;
-            }
-            let (cx, cy, cz, radius2) = (pcx[s], pcy[s], pcz[s], pr2[s]);
-            let [ox, oy, oz] = &rays.origin;
-            let [dx, dy, dz] = &rays.direction;
-            let (mut new_closest, mut new_best) = (closest, best);
-            for l in 0..LANES {
-                let fx = ox[l] - cx;
-                let fy = oy[l] - cy;
-                let fz = oz[l] - cz;
-                let half_b = fx * dx[l] + fy * dy[l] + fz * dz[l];
-                let lx = fx - half_b * dx[l];
-                let ly = fy - half_b * dy[l];
-                let lz = fz - half_b * dz[l];
-                let discriminant = radius2 - (lx * lx + ly * ly + lz * lz);
-                let real = discriminant >= 0.0;
-                let sqrt_d = discriminant.sqrt();
-                let near = -half_b - sqrt_d;
-                let far = -half_b + sqrt_d;
-                // The first root beyond t_min, if it is nearer than the best.
-                let near_ok = t_min < near;
-                let t = if near_ok { near } else { far };
-                let valid = enter[l] & real & (near_ok | (t_min < far));
-                let hit = valid & (t < closest[l]);
-                // Exactly as near as the best (coincident surfaces): the lower
-                // sphere index wins.
-                let tie = valid & (t == closest[l]) & (sphere < best[l]);
-                new_closest[l] = if hit { t } else { closest[l] };
-                new_best[l] = if hit | tie { sphere } else { best[l] };
-            }
-            (closest, best) = (new_closest, new_best);
+    ) {
+        let valid = valid & enter;
+        let hit = valid & t.lt(*closest);
+        let mut take = R::bits(hit);
+        // Exactly as near as the best (coincident surfaces): the lower index
+        // wins.
+        let mut tie = R::bits(valid & t.eq(*closest));
+        while tie != 0 {
+            let l = tie.trailing_zeros() as usize;
+            take |= u32::from(index < self.best[l]) << l;
+            tie &= tie - 1;
         }
-        (closest, best)
+        *closest = R::select(hit, t, *closest);
+        while take != 0 {
+            self.best[take.trailing_zeros() as usize] = index;
+            take &= take - 1;
+        }
+    }
+
+    /// Tests every ray of the bundle against the primitives of `leaf` one by
+    /// one, on lanes `R`, with the kernel the single-ray packet test runs
+    /// (so the same distances); only the lanes that enter the leaf's box
+    /// count, as each ray alone would test it only then.
+    #[inline(always)]
+    fn leaf_in<R: Wide>(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) {
+        let (mut enter, closest) = (0, &self.closest);
+        for l in 0..LANES {
+            enter |= u32::from(entry[l] <= closest[l] * SLACK) << l;
+        }
+        let enter = R::mask_from_bits(enter);
+        let mut closest = R::from_array(self.closest);
+        let ray = RayLanes {
+            origin: self.rays.origin.map(R::from_array),
+            direction: self.rays.direction.map(R::from_array),
+            t_min: R::splat(self.t_min),
+        };
+        let (kind, i) = leaf_parts(leaf);
+        let kind = if SPHERES { Kind::Sphere } else { kind };
+        match kind {
+            Kind::Sphere => {
+                let p = bvh.sphere_packet(i);
+                for s in 0..LANES {
+                    if p.index[s] == NO_CHILD {
+                        break;
+                    }
+                    let (t, valid) = sphere::intersect(&ray, &p.splat(s));
+                    self.found(&mut closest, t, valid, enter, p.index[s]);
+                }
+            }
+            Kind::Triangle => {
+                let p = bvh.triangle_packet(i);
+                let triangle = TriangleRay {
+                    origin: self.triangle.origin.map(R::from_array),
+                    shear: self.triangle.shear.map(R::from_array),
+                    t_min: R::from_array(self.triangle.t_min),
+                };
+                let is_axis = self
+                    .is_axis
+                    .map(|[x, y]| (R::mask_from_bits(x), R::mask_from_bits(y)));
+                for s in 0..LANES {
+                    if p.index[s] == NO_CHILD {
+                        break;
+                    }
+                    // Vertex `v` in every lane's own axes.
+                    let permuted = |v: &[[f32; LANES]; 3]| {
+                        let [x, y, z] = v.map(|c| R::splat(c[s]));
+                        is_axis.map(|(is_x, is_y)| R::select(is_x, x, R::select(is_y, y, z)))
+                    };
+                    let tri = TriangleLanes {
+                        vertices: p.vertices.each_ref().map(permuted),
+                    };
+                    let (t, valid) = triangle::intersect(&triangle, &tri);
+                    self.found(&mut closest, t, valid, enter, p.index[s]);
+                }
+            }
+            Kind::Quad => {
+                let p = bvh.quad_packet(i);
+                for s in 0..LANES {
+                    if p.index[s] == NO_CHILD {
+                        break;
+                    }
+                    let (t, valid) = quad::intersect(&ray, &p.splat(s));
+                    self.found(&mut closest, t, valid, enter, p.index[s]);
+                }
+            }
+            Kind::Instance => unreachable!("instances are traversed by the scene"),
+        }
+        self.closest = closest.to_array();
+    }
+}
+
+/// [`BundleRays::leaf_in`] on AVX lanes, compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+#[allow(unsafe_code)]
+unsafe fn bundle_leaf_avx2<const S: bool>(
+    rays: &mut BundleRays<S>,
+    bvh: &Bvh,
+    leaf: u32,
+    entry: &Lanes,
+) {
+    rays.leaf_in::<crate::lanes::W8>(bvh, leaf, entry)
+}
+
+impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
+    /// Per lane, where the ray enters the box (NaN for lanes that miss it,
+    /// which no comparison accepts).
+    type Entry = Lanes;
+
+    #[inline(always)]
+    fn enter(&self, node: &Node) -> (u32, [Lanes; 4], [f32; 4]) {
+        let rays = self.rays;
+        // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
+        let bounds = node.planes.map(|pair| pair.map(|v| v.to_array()));
+        let mut t_near = [[f32::NAN; LANES]; 4];
+        let mut hit_mask = 0u32;
+        for child in 0..4 {
+            if node.used & (1 << child) == 0 {
+                continue;
+            }
+            let mut any = false;
+            let planes: [[f32; 2]; 3] =
+                std::array::from_fn(|axis| [bounds[axis][0][child], bounds[axis][1][child]]);
+            let (tn, closest) = (&mut t_near[child], &self.closest);
+            for l in 0..LANES {
+                let slab = |axis: usize| {
+                    let (lo, hi) = (planes[axis][0], planes[axis][1]);
+                    let (n, f) = if self.flip[axis][l] {
+                        (hi, lo)
+                    } else {
+                        (lo, hi)
+                    };
+                    let o = rays.origin[axis][l];
+                    let inv = rays.inverse[axis][l];
+                    ((n - o) * inv, (f - o) * inv)
+                };
+                let (x0, x1) = slab(0);
+                let (y0, y1) = slab(1);
+                let (z0, z1) = slab(2);
+                let near = max_ps(max_ps(max_ps(x0, y0), z0), self.t_min);
+                let far = min_ps(min_ps(min_ps(x1, y1), z1), closest[l]) * SLACK;
+                let hit = near <= far;
+                tn[l] = if hit { near } else { f32::NAN };
+                any |= hit;
+            }
+            hit_mask |= u32::from(any) << child;
+        }
+        if hit_mask == 0 {
+            return (0, t_near, [0.0; 4]);
+        }
+        // The order: where the reference ray meets the boxes.
+        let (p, near) = (&node.planes, &self.ref_near);
+        let (o, inv) = (&self.ref_origin, &self.ref_inv);
+        let rx = (p[0][near[0]] - o[0]) * inv[0];
+        let ry = (p[1][near[1]] - o[1]) * inv[1];
+        let rz = (p[2][near[2]] - o[2]) * inv[2];
+        let order = rx.max(ry).max(rz).max(Vec4::splat(self.t_min)).to_array();
+        (hit_mask, t_near, order)
+    }
+
+    #[inline(always)]
+    fn needed(&self, t_near: &Lanes) -> bool {
+        let (mut needed, closest) = (false, &self.closest);
+        for l in 0..LANES {
+            needed |= t_near[l] <= closest[l] * SLACK;
+        }
+        needed
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if bvh.avx2() {
+            // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
+            #[allow(unsafe_code)]
+            unsafe {
+                bundle_leaf_avx2(self, bvh, leaf, entry)
+            };
+            return false;
+        }
+        self.leaf_in::<F8>(bvh, leaf, entry);
+        false
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Sphere;
+    use crate::geometry::{Primitive, Quad, Sphere, Triangle};
     use crate::math::Vec3;
     use crate::rng::Rng;
+
+    fn tree(spheres: &[Sphere]) -> Bvh {
+        let prims: Vec<Primitive> = spheres.iter().map(|&s| Primitive::Sphere(s)).collect();
+        Bvh::new(&prims)
+    }
 
     /// Bundles of nearly parallel rays (as a pixel's camera rays) and of
     /// unrelated rays, of every length, through a sphere field: every lane
     /// must find exactly what `Bvh::hit` finds for its ray alone.
     #[test]
     fn bundles_find_exactly_what_single_rays_find() {
+        bundles_agree_with_single_rays(false);
+    }
+
+    /// The same with triangles (a bundle's rays each in their own axes) and
+    /// quads among the spheres, including a closed triangulated terrain
+    /// whose shared edges and vertices tie.
+    #[test]
+    fn bundles_over_mixed_kinds_find_exactly_what_single_rays_find() {
+        bundles_agree_with_single_rays(true);
+    }
+
+    fn bundles_agree_with_single_rays(mixed: bool) {
         let mut rng = Rng::new(21);
         let mut spheres: Vec<Sphere> = (0..400)
             .map(|_| {
@@ -372,7 +482,29 @@ mod tests {
             })
             .collect();
         spheres.push(Sphere::new(Vec3::new(0.0, -1000.0, 0.0), 1000.0));
-        let bvh = Bvh::new(&spheres);
+        let mut prims: Vec<Primitive> = spheres.iter().map(|&s| Primitive::Sphere(s)).collect();
+        if mixed {
+            prims.truncate(200);
+            // A 20×20 height field of triangles over [-10, 10]², and boxes' faces.
+            let height = |i: i32, j: i32| ((i * 7 + j * 13) % 5) as f32 * 0.1;
+            let at = |i: i32, j: i32| Vec3::new(i as f32, height(i, j), j as f32);
+            for i in -10..10 {
+                for j in -10..10 {
+                    let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                    prims.push(Primitive::Triangle(Triangle::new(a, b, c)));
+                    prims.push(Primitive::Triangle(Triangle::new(a, c, d)));
+                }
+            }
+            for k in 0..30 {
+                let c = Vec3::new(rng.range_f32(-8.0, 8.0), 0.5, rng.range_f32(-8.0, 8.0));
+                let u = Vec3::new(rng.range_f32(0.2, 1.0), 0.0, k as f32 * 0.01);
+                let v = Vec3::new(0.0, rng.range_f32(0.2, 1.0), 0.1);
+                prims.push(Primitive::Quad(
+                    Quad::new(c, u, v).expect("edges not parallel"),
+                ));
+            }
+        }
+        let bvh = Bvh::new(&prims);
         let interval = Interval::new(0.001, f32::INFINITY);
         let mut hits = 0;
         for case in 0..3000 {
@@ -421,7 +553,7 @@ mod tests {
         // reports must not change with the rays beside it.
         let mut spheres = vec![Sphere::new(Vec3::ZERO, 1.0); 20];
         spheres.extend((0..20).map(|i| Sphere::new(Vec3::new(i as f32, 3.0, 0.0), 0.5)));
-        let bvh = Bvh::new(&spheres);
+        let bvh = tree(&spheres);
         let interval = Interval::new(0.001, f32::INFINITY);
         let reference = Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
         let mut rng = Rng::new(4);
@@ -453,7 +585,7 @@ mod tests {
         let c = Vec3::new(-0.79811573, 0.90824604, 1.9778109);
         let mut spheres = vec![Sphere::new(c, 1.8841038); 20];
         spheres.extend((0..20).map(|i| Sphere::new(Vec3::new(i as f32, 8.0, 0.0), 0.5)));
-        let bvh = Bvh::new(&spheres);
+        let bvh = tree(&spheres);
         let interval = Interval::new(0.001, f32::INFINITY);
         let o = Vec3::new(10.488633, 1.1547536, 0.70374763);
         let ray = Ray::new(o, Vec3::new(-0.9906112, -0.025959643, 0.13422203));
@@ -480,7 +612,7 @@ mod tests {
     #[test]
     fn a_lane_missing_a_box_does_not_test_its_spheres() {
         let sphere = Sphere::new(Vec3::new(0.4491043, -1.872978, -2.6306076), 0.5630208);
-        let bvh = Bvh::new(&[sphere]);
+        let bvh = tree(&[sphere]);
         let interval = Interval::new(0.001, f32::INFINITY);
         let o = Vec3::new(3.1213696, 33.058666, -3.1936314);
         let grazing = Ray::new(o, Vec3::new(-0.07628037, -0.99708647, 8.617153e-8));
@@ -500,7 +632,7 @@ mod tests {
             .hit_bundle(&bundle, &ray, all)
             .iter()
             .all(Option::is_none));
-        let one = Bvh::new(&[Sphere::new(Vec3::ZERO, 1.0)]);
+        let one = tree(&[Sphere::new(Vec3::ZERO, 1.0)]);
         let hits = one.hit_bundle(&bundle, &ray, all);
         assert_eq!(hits[0].map(|h| (h.t, h.index)), Some((4.0, 0)));
         assert!(hits[1..].iter().all(Option::is_none));

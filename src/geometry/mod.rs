@@ -5,9 +5,15 @@ pub mod bvh;
 pub mod bvh_build;
 pub mod bvh_bundle;
 pub mod hit;
+pub mod primitive;
+pub mod quad;
 pub mod sphere;
+pub mod triangle;
 
 pub use bvh::Bvh;
 pub use bvh_bundle::RayBundle;
 pub use hit::HitRecord;
+pub use primitive::{Kind, Primitive};
+pub use quad::Quad;
 pub use sphere::Sphere;
+pub use triangle::Triangle;

@@ -5,8 +5,9 @@
 //! (B·B)t² + 2B·(A − C)t + (A − C)·(A − C) − R² = 0, solved here in its
 //! "half-b" form.
 
+use crate::lanes::{Mask, Real};
 use crate::math::{Interval, Point3, Vec3};
-use crate::ray::Ray;
+use crate::ray::{Ray, RayLanes};
 
 /// A sphere given by its centre and (positive) radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,22 +26,7 @@ impl Sphere {
 
     /// The nearest root of the ray–sphere quadratic inside `interval`, if any.
     ///
-    /// The ray's direction must have unit length (every ray the camera and the
-    /// materials make has), so that a = B·B = 1 drops out of the formulas and
-    /// the roots are t = −h ∓ √d, with no division at all.
-    ///
-    /// In `f32` the textbook discriminant h² − c loses every significant digit
-    /// when a small ray grazes a large sphere (the radius-1000 ground of the
-    /// cover scene shows rings). Following Haines et al., *Ray Tracing Gems*
-    /// ch. 7, the discriminant is computed as R² − |l|², where l is the part of
-    /// A − C perpendicular to the ray. The roots −h ∓ √d cancel only when a
-    /// root is close to 0 compared with h, that is for the surface a ray is
-    /// leaving. On a large sphere that error (≈ 2⁻²⁴R/cos θ) can exceed any
-    /// small epsilon, so the renderer starts rays leaving a surface a
-    /// rounding bound off it ([`HitRecord::spawn_origin`]), where the root is
-    /// clearly negative.
-    ///
-    /// [`HitRecord::spawn_origin`]: crate::geometry::HitRecord::spawn_origin
+    /// The ray's direction must have unit length; see [`intersect`].
     #[inline]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
         debug_assert!(
@@ -48,21 +34,16 @@ impl Sphere {
             "ray direction {} is not unit length",
             ray.direction
         );
-        let f = ray.origin - self.center;
-        let half_b = f.dot(ray.direction);
-        let l = f - half_b * ray.direction;
-        let discriminant = self.radius * self.radius - l.length_squared();
-        if discriminant < 0.0 {
-            return None;
-        }
-        let sqrt_d = discriminant.sqrt();
-        let (near, far) = (-half_b - sqrt_d, -half_b + sqrt_d);
-        if interval.surrounds(near) {
-            Some(near)
-        } else if interval.surrounds(far) {
-            Some(far)
-        } else {
-            None
+        let (t, valid) = intersect(&RayLanes::from_ray(ray, interval.min), &self.lanes());
+        (valid && t < interval.max).then_some(t)
+    }
+
+    /// The sphere as one lane of [`intersect`].
+    #[inline(always)]
+    pub fn lanes(&self) -> SphereLanes<f32> {
+        SphereLanes {
+            center: self.center.to_array(),
+            radius2: self.radius * self.radius,
         }
     }
 
@@ -77,6 +58,57 @@ impl Sphere {
         let r = Vec3::splat(self.radius);
         (self.center - r, self.center + r)
     }
+}
+
+/// Spheres in lanes: one per lane of `R`, or one repeated in every lane.
+#[derive(Clone, Copy, Debug)]
+pub struct SphereLanes<R> {
+    /// Centre C.
+    pub center: [R; 3],
+    /// Radius squared; −∞ in unused lanes, which no ray hits.
+    pub radius2: R,
+}
+
+/// The ray–sphere test, written once for any number of lanes: for each lane,
+/// the first root of the quadratic beyond the ray's `t_min`, and whether it
+/// exists. The caller compares the root with the far end of its interval.
+///
+/// The ray's direction must have unit length, so that a = B·B = 1 drops out
+/// and the roots are t = −h ∓ √d. In `f32` the textbook discriminant h² − c
+/// loses every significant digit when a small ray grazes a large sphere (the
+/// radius-1000 ground of the cover shows rings). Following Haines et al.,
+/// *Ray Tracing Gems* ch. 7, the discriminant is computed as R² − |l|², where
+/// l is the part of A − C perpendicular to the ray. The roots −h ∓ √d cancel
+/// only when a root is close to 0 compared with h, that is for the surface a
+/// ray is leaving; on a large sphere that error (≈ 2⁻²⁴R/cos θ) can exceed
+/// any small epsilon, so the renderer starts rays leaving a surface a
+/// rounding bound off it ([`HitRecord::spawn_origin`]), where the root is
+/// clearly negative.
+///
+/// [`HitRecord::spawn_origin`]: crate::geometry::HitRecord::spawn_origin
+#[inline(always)]
+pub fn intersect<R: Real>(ray: &RayLanes<R>, sphere: &SphereLanes<R>) -> (R, R::Mask) {
+    let [ox, oy, oz] = ray.origin;
+    let [dx, dy, dz] = ray.direction;
+    let [cx, cy, cz] = sphere.center;
+    let fx = ox - cx;
+    let fy = oy - cy;
+    let fz = oz - cz;
+    let half_b = fx * dx + fy * dy + fz * dz;
+    let lx = fx - half_b * dx;
+    let ly = fy - half_b * dy;
+    let lz = fz - half_b * dz;
+    let discriminant = sphere.radius2 - (lx * lx + ly * ly + lz * lz);
+    let real = R::splat(0.0).le(discriminant);
+    if !real.any() {
+        return (discriminant, real);
+    }
+    let sqrt_d = discriminant.sqrt();
+    let near = -half_b - sqrt_d;
+    let far = -half_b + sqrt_d;
+    let near_ok = ray.t_min.lt(near);
+    let t = R::select(near_ok, near, far);
+    (t, real & (near_ok | ray.t_min.lt(far)))
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ pub use desc::SceneDesc;
 
 use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::bvh_bundle::LANES;
-use crate::geometry::{Bvh, HitRecord, RayBundle, Sphere};
+use crate::geometry::{Bvh, HitRecord, Primitive, RayBundle, Sphere};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
 use crate::math::{lerp, Color, Interval, Point3, Vec3};
 use crate::ray::Ray;
@@ -348,7 +348,8 @@ impl Scene {
                 }
             }
         }
-        let bvh = Bvh::new(&spheres);
+        let primitives: Vec<Primitive> = spheres.iter().map(|&s| Primitive::Sphere(s)).collect();
+        let bvh = Bvh::new(&primitives);
         Ok(Scene {
             error_scale: error_scale(settings.epsilon),
             settings,

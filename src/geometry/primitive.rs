@@ -1,0 +1,96 @@
+//! The closed set of shapes a BVH holds: spheres, triangles and quads, and
+//! instances of other trees. Each operation is one `match` over the kind;
+//! each kind's intersection is one kernel (see [`crate::lanes`]).
+
+use crate::geometry::bvh_build::Aabb;
+use crate::geometry::{Quad, Sphere, Triangle};
+use crate::math::Interval;
+use crate::ray::Ray;
+
+/// The kind of a primitive, which tags the BVH's leaves: a leaf holds
+/// primitives of one kind, tested by that kind's kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Kind {
+    /// A sphere.
+    Sphere = 0,
+    /// A triangle.
+    Triangle = 1,
+    /// A parallelogram.
+    Quad = 2,
+    /// A placed copy of another tree.
+    Instance = 3,
+}
+
+impl Kind {
+    /// The kind numbered `n` (its discriminant).
+    #[inline(always)]
+    pub fn from_index(n: u32) -> Kind {
+        match n & 3 {
+            0 => Kind::Sphere,
+            1 => Kind::Triangle,
+            2 => Kind::Quad,
+            _ => Kind::Instance,
+        }
+    }
+}
+
+/// One primitive, as a BVH is built from it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Primitive {
+    /// A sphere.
+    Sphere(Sphere),
+    /// A triangle.
+    Triangle(Triangle),
+    /// A parallelogram.
+    Quad(Quad),
+    /// Instance number `index` of the scene, whose world bounds are `bounds`.
+    Instance {
+        /// The instance's world-space bounding box.
+        bounds: Aabb,
+        /// Its number among the scene's instances.
+        index: u32,
+    },
+}
+
+impl Primitive {
+    /// The kind of this primitive.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Primitive::Sphere(_) => Kind::Sphere,
+            Primitive::Triangle(_) => Kind::Triangle,
+            Primitive::Quad(_) => Kind::Quad,
+            Primitive::Instance { .. } => Kind::Instance,
+        }
+    }
+
+    /// The axis-aligned bounding box.
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            Primitive::Sphere(s) => Aabb::new(s.bounds()),
+            Primitive::Triangle(t) => Aabb::new(t.bounds()),
+            Primitive::Quad(q) => Aabb::new(q.bounds()),
+            Primitive::Instance { bounds, .. } => *bounds,
+        }
+    }
+
+    /// The distance along unit `ray` to the primitive, if it is hit strictly
+    /// inside `interval`: the one-lane kernel of its kind, which gives the
+    /// same bits as the BVH's packet tests. Instances answer `None` (their
+    /// shapes are in another tree).
+    pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
+        match self {
+            Primitive::Sphere(s) => s.hit(ray, interval),
+            Primitive::Triangle(t) => t.hit(ray, interval.min, interval.max),
+            Primitive::Quad(q) => q.hit(ray, interval.min, interval.max),
+            Primitive::Instance { .. } => None,
+        }
+    }
+
+    /// The point the BVH build sorts the primitive by.
+    pub fn centroid(&self) -> crate::math::Point3 {
+        match self {
+            Primitive::Sphere(s) => s.center,
+            other => other.bounds().center(),
+        }
+    }
+}

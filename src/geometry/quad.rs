@@ -1,0 +1,204 @@
+//! Quads: parallelograms given by a corner Q and two edge vectors u and v,
+//! as in *Ray Tracing: The Next Week*. A box is six of them.
+//!
+//! The ray meets the quad's plane n·P = D (n the unit normal of u × v) at
+//! t = (D − n·A)/(n·B). The hit point's coordinates in the quad's own
+//! frame, P − Q = αu + βv, come from w = (u × v)/|u × v|²:
+//! α = w·((P − Q) × v), β = w·(u × (P − Q)); the quad holds the points with
+//! α and β in [0, 1], and (α, β) is also its texture coordinate.
+
+use crate::lanes::{Mask, Real};
+use crate::math::{Point3, Vec3};
+use crate::ray::{Ray, RayLanes};
+
+/// Rays closer to parallel with the plane than this (|n·B| for a unit
+/// direction) miss: the book's threshold.
+const PARALLEL: f32 = 1e-8;
+
+/// A parallelogram with corners Q, Q + u, Q + u + v, Q + v.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quad {
+    /// The corner Q.
+    pub corner: Point3,
+    /// The first edge u.
+    pub u: Vec3,
+    /// The second edge v.
+    pub v: Vec3,
+    /// Unit normal along u × v.
+    pub normal: Vec3,
+    /// (u × v)/|u × v|², which turns a point of the plane into (α, β).
+    pub w: Vec3,
+    /// D = n·Q: the plane's offset.
+    pub d: f32,
+}
+
+impl Quad {
+    /// The quad at `corner` with edges `u` and `v`, or `None` when the edges
+    /// are parallel or zero (the quad has no area).
+    pub fn new(corner: Point3, u: Vec3, v: Vec3) -> Option<Quad> {
+        let n = u.cross(v);
+        let n2 = n.length_squared();
+        if !(n2 > 0.0) || !n2.is_finite() {
+            return None;
+        }
+        let normal = n / n2.sqrt();
+        Some(Quad {
+            corner,
+            u,
+            v,
+            normal,
+            w: n / n2,
+            d: normal.dot(corner),
+        })
+    }
+
+    /// The axis-aligned bounding box `(min, max)`.
+    pub fn bounds(&self) -> (Point3, Point3) {
+        let corners = [
+            self.corner,
+            self.corner + self.u,
+            self.corner + self.v,
+            self.corner + self.u + self.v,
+        ];
+        let min = corners.iter().fold(corners[0], |m, &c| m.min(c));
+        let max = corners.iter().fold(corners[0], |m, &c| m.max(c));
+        (min, max)
+    }
+
+    /// The distance along unit `ray` to the quad, if it is hit strictly
+    /// between `t_min` and `t_max`.
+    pub fn hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<f32> {
+        let (t, valid) = intersect(&RayLanes::from_ray(ray, t_min), &self.lanes());
+        (valid && t < t_max).then_some(t)
+    }
+
+    /// The quad's (α, β) coordinates of a point of its plane.
+    pub fn coordinates(&self, point: Point3) -> (f32, f32) {
+        let p = point - self.corner;
+        (self.w.dot(p.cross(self.v)), self.w.dot(self.u.cross(p)))
+    }
+
+    /// The quad as one lane of [`intersect`].
+    pub fn lanes(&self) -> QuadLanes<f32> {
+        QuadLanes {
+            corner: self.corner.to_array(),
+            u: self.u.to_array(),
+            v: self.v.to_array(),
+            normal: self.normal.to_array(),
+            w: self.w.to_array(),
+            d: self.d,
+        }
+    }
+}
+
+/// Quads in lanes (see [`Quad`] for the fields). Unused lanes are NaN,
+/// which no ray hits.
+#[derive(Clone, Copy, Debug)]
+pub struct QuadLanes<R> {
+    /// Corner Q.
+    pub corner: [R; 3],
+    /// Edge u.
+    pub u: [R; 3],
+    /// Edge v.
+    pub v: [R; 3],
+    /// Unit normal.
+    pub normal: [R; 3],
+    /// (u × v)/|u × v|².
+    pub w: [R; 3],
+    /// n·Q.
+    pub d: R,
+}
+
+#[inline(always)]
+fn dot<R: Real>(a: &[R; 3], b: &[R; 3]) -> R {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn cross<R: Real>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The ray–quad test, written once for any number of lanes: for each lane
+/// the distance to the quad and whether the ray hits it beyond `t_min`. The
+/// caller compares the distance with the far end of its interval.
+#[inline(always)]
+pub fn intersect<R: Real>(ray: &RayLanes<R>, quad: &QuadLanes<R>) -> (R, R::Mask) {
+    let denom = dot(&quad.normal, &ray.direction);
+    let eps = R::splat(PARALLEL);
+    let crossing = eps.le(denom) | denom.le(-eps);
+    let t = (quad.d - dot(&quad.normal, &ray.origin)) / denom;
+    let ahead = crossing & ray.t_min.lt(t);
+    if !ahead.any() {
+        return (t, ahead);
+    }
+    let p: [R; 3] = std::array::from_fn(|k| ray.origin[k] + t * ray.direction[k] - quad.corner[k]);
+    let alpha = dot(&quad.w, &cross(&p, &quad.v));
+    let beta = dot(&quad.w, &cross(&quad.u, &p));
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let inside = zero.le(alpha) & alpha.le(one) & zero.le(beta) & beta.le(one);
+    (t, ahead & inside)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn floor() -> Quad {
+        Quad::new(
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
+        )
+        .expect("a real quad")
+    }
+
+    #[test]
+    fn hits_inside_at_the_right_distance_and_coordinates() {
+        let q = floor();
+        let ray = Ray::new(Vec3::new(0.5, 3.0, 0.0), -Vec3::Y);
+        assert_eq!(q.hit(&ray, 0.001, f32::INFINITY), Some(3.0));
+        assert_eq!(q.coordinates(ray.at(3.0)), (0.75, 0.5));
+        // From below (the back face) too.
+        let up = Ray::new(Vec3::new(0.5, -2.0, 0.0), Vec3::Y);
+        assert_eq!(q.hit(&up, 0.001, f32::INFINITY), Some(2.0));
+        let slanted_dir = Vec3::new(1.0, -1.0, 0.0).normalize();
+        let slanted = Ray::new(Vec3::new(-1.0, 1.0, 0.0), slanted_dir);
+        let t = q.hit(&slanted, 0.0, f32::INFINITY).expect("hits");
+        assert!((t - 2f32.sqrt()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn misses_outside_edges_parallel_and_interval() {
+        let q = floor();
+        for (x, z) in [
+            (1.01, 0.0),
+            (-1.01, 0.0),
+            (0.0, 1.01),
+            (0.0, -1.01),
+            (5.0, 5.0),
+        ] {
+            let ray = Ray::new(Vec3::new(x, 1.0, z), -Vec3::Y);
+            assert_eq!(q.hit(&ray, 0.0, f32::INFINITY), None, "({x}, {z})");
+        }
+        // On the edge x = 1: inside (the interval is closed).
+        let edge = Ray::new(Vec3::new(1.0, 1.0, 0.0), -Vec3::Y);
+        assert_eq!(q.hit(&edge, 0.0, f32::INFINITY), Some(1.0));
+        let parallel = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::X);
+        assert_eq!(q.hit(&parallel, 0.0, f32::INFINITY), None);
+        let ray = Ray::new(Vec3::new(0.0, 3.0, 0.0), -Vec3::Y);
+        assert_eq!(q.hit(&ray, 0.0, 2.5), None);
+        assert_eq!(q.hit(&ray, 3.0, 5.0), None);
+    }
+
+    #[test]
+    fn parallel_or_zero_edges_make_no_quad() {
+        assert!(Quad::new(Vec3::ZERO, Vec3::X, 2.0 * Vec3::X).is_none());
+        assert!(Quad::new(Vec3::ZERO, Vec3::ZERO, Vec3::Y).is_none());
+        assert!(Quad::new(Vec3::ZERO, Vec3::X, Vec3::Y).is_some());
+    }
+}
