@@ -9,7 +9,7 @@
 //! stored as structure of arrays and tested together by that kind's kernel on
 //! eight lanes (see [`crate::lanes`]).
 //!
-//! [`Bvh::traverse`] walks the tree for any [`Rays`]: one ray looking for
+//! `Bvh::traverse` walks the tree for any `Rays`: one ray looking for
 //! its nearest hit ([`Bvh::hit`]) or for any hit ([`Bvh::occluded`]), or a
 //! bundle of rays ([`Bvh::hit_bundle`]). It visits the hit children nearest
 //! first and skips any entry of its stack whose box starts beyond the
