@@ -8,6 +8,7 @@ pub mod hit;
 pub mod primitive;
 pub mod quad;
 pub mod sphere;
+pub mod transform;
 pub mod triangle;
 
 pub use bvh::Bvh;
