@@ -497,3 +497,641 @@ fn to_f32(m: &DAffine3) -> Affine3A {
         translation: m.translation.as_vec3a(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Sphere;
+    use crate::math::Interval;
+    use crate::rng::Rng;
+    use TransformStep::{Matrix, Rotate, Scale, Translate};
+
+    fn tf(steps: &[TransformStep]) -> Transform {
+        Transform::from_steps(steps).unwrap()
+    }
+
+    fn refused(steps: &[TransformStep]) -> TransformError {
+        Transform::from_steps(steps).unwrap_err()
+    }
+
+    #[track_caller]
+    fn assert_close(actual: Vec3, expected: Vec3, tolerance: f32) {
+        assert!(
+            (actual - expected).abs().max_element() <= tolerance,
+            "{actual} is not within {tolerance} of {expected}"
+        );
+    }
+
+    fn rz(degrees: f64) -> TransformStep {
+        Rotate {
+            axis: [0.0, 0.0, 1.0],
+            degrees,
+        }
+    }
+
+    fn range(rng: &mut Rng, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * rng.next_f64()
+    }
+
+    fn random_vec(rng: &mut Rng, lo: f32, hi: f32) -> Vec3 {
+        Vec3::new(
+            rng.range_f32(lo, hi),
+            rng.range_f32(lo, hi),
+            rng.range_f32(lo, hi),
+        )
+    }
+
+    /// One to four random steps of every kind, with scales in ±[0.5, 2] and
+    /// shears below 1, so that the condition number stays moderate.
+    fn random_steps(rng: &mut Rng) -> Vec<TransformStep> {
+        let n = 1 + (rng.next_u32() % 4) as usize;
+        (0..n)
+            .map(|_| match rng.next_u32() % 4 {
+                0 => Translate([0; 3].map(|_| range(rng, -10.0, 10.0))),
+                1 => Rotate {
+                    axis: [0; 3].map(|_| range(rng, -1.0, 1.0)),
+                    degrees: range(rng, -360.0, 360.0),
+                },
+                2 => Scale([0; 3].map(|_| {
+                    let s = range(rng, 0.5, 2.0);
+                    if rng.next_u32() % 2 == 0 {
+                        s
+                    } else {
+                        -s
+                    }
+                })),
+                _ => {
+                    let mut rows = [
+                        [1.0, 0.0, 0.0, 0.0],
+                        [0.0, 1.0, 0.0, 0.0],
+                        [0.0, 0.0, 1.0, 0.0],
+                        [0.0, 0.0, 0.0, 1.0],
+                    ];
+                    // A shear (one off-diagonal entry) and a translation.
+                    let (i, j) = match rng.next_u32() % 6 {
+                        0 => (0, 1),
+                        1 => (0, 2),
+                        2 => (1, 0),
+                        3 => (1, 2),
+                        4 => (2, 0),
+                        _ => (2, 1),
+                    };
+                    rows[i][j] = range(rng, -0.9, 0.9);
+                    for row in rows.iter_mut().take(3) {
+                        row[3] = range(rng, -5.0, 5.0);
+                    }
+                    Matrix(rows)
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn steps_apply_in_the_order_written() {
+        let translate = Translate([1.0, 0.0, 0.0]);
+        // Translate, then rotate: (1,0,0) → (2,0,0) → (0,2,0).
+        let t = tf(&[translate, rz(90.0)]);
+        assert_close(t.point(Vec3::X), Vec3::new(0.0, 2.0, 0.0), 1e-6);
+        assert_close(
+            t.point(Vec3::new(0.0, 0.0, 3.0)),
+            Vec3::new(0.0, 1.0, 3.0),
+            1e-6,
+        );
+        // Rotate, then translate: (1,0,0) → (0,1,0) → (1,1,0).
+        let r = tf(&[rz(90.0), translate]);
+        assert_close(r.point(Vec3::X), Vec3::new(1.0, 1.0, 0.0), 1e-6);
+        assert_close(
+            r.point(Vec3::new(0.0, 0.0, 3.0)),
+            Vec3::new(1.0, 0.0, 3.0),
+            1e-6,
+        );
+
+        // Three steps: (1,1,0) scaled by 2 → (2,2,0), translated → (3,2,0),
+        // rotated 90° about z → (−2,3,0).
+        let s = tf(&[Scale([2.0; 3]), translate, rz(90.0)]);
+        assert_close(
+            s.point(Vec3::new(1.0, 1.0, 0.0)),
+            Vec3::new(-2.0, 3.0, 0.0),
+            1e-6,
+        );
+        // Translate first: (2,1,0) → (4,2,0) → (−2,4,0).
+        let s = tf(&[translate, Scale([2.0; 3]), rz(90.0)]);
+        assert_close(
+            s.point(Vec3::new(1.0, 1.0, 0.0)),
+            Vec3::new(-2.0, 4.0, 0.0),
+            1e-6,
+        );
+    }
+
+    #[test]
+    fn rotation_is_right_handed_about_the_normalised_axis() {
+        let about = |axis: [f64; 3], degrees: f64| tf(&[Rotate { axis, degrees }]);
+        let y90 = about([0.0, 1.0, 0.0], 90.0);
+        assert_close(y90.point(Vec3::X), -Vec3::Z, 1e-7);
+        assert_close(y90.point(Vec3::Z), Vec3::X, 1e-7);
+        assert_close(about([0.0, 5.0, 0.0], 90.0).point(Vec3::X), -Vec3::Z, 1e-7);
+        assert_close(about([0.0, 1.0, 0.0], -90.0).point(Vec3::X), Vec3::Z, 1e-7);
+        assert_close(about([0.0, 0.0, 1.0], 90.0).point(Vec3::X), Vec3::Y, 1e-7);
+        assert_close(about([1.0, 0.0, 0.0], 90.0).point(Vec3::Y), Vec3::Z, 1e-7);
+        assert_close(about([0.0, 0.0, 1.0], 450.0).point(Vec3::X), Vec3::Y, 1e-7);
+        // A third of a turn about (1,1,1) cycles x → y → z → x.
+        let diagonal = about([1.0, 1.0, 1.0], 120.0);
+        assert_close(diagonal.point(Vec3::X), Vec3::Y, 1e-6);
+        assert_close(diagonal.point(Vec3::Y), Vec3::Z, 1e-6);
+        assert_close(diagonal.point(Vec3::Z), Vec3::X, 1e-6);
+        let z30 = about([0.0, 0.0, 1.0], 30.0);
+        assert_close(z30.point(Vec3::X), Vec3::new(0.866_025_4, 0.5, 0.0), 1e-6);
+    }
+
+    #[test]
+    fn normals_stay_perpendicular_under_non_uniform_scale() {
+        // The plane x + y = 0 (normal (1,1,0)) stretched 2× along x is the
+        // plane x/2 + y = 0, normal (1,2,0)/√5.
+        let t = tf(&[Scale([2.0, 1.0, 1.0])]);
+        let n = Vec3::new(1.0, 1.0, 0.0);
+        let expected = Vec3::new(1.0, 2.0, 0.0) / 5f32.sqrt();
+        assert_close(t.normal(n), expected, 1e-6);
+        let tangent = t.vector(Vec3::new(1.0, -1.0, 0.0));
+        assert!(t.normal(n).dot(tangent).abs() < 1e-6);
+        // Transforming the normal as a vector would not do.
+        assert!(t.vector(n).normalize().dot(tangent).abs() > 0.5);
+
+        let mut rng = Rng::new(3);
+        let shear = Matrix([
+            [1.0, 0.7, 0.0, 0.0],
+            [0.0, 1.0, -0.4, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]);
+        let rotate = Rotate {
+            axis: [1.0, -2.0, 0.5],
+            degrees: 37.0,
+        };
+        let t = tf(&[
+            Scale([3.0, 0.5, 1.5]),
+            rotate,
+            shear,
+            Translate([4.0, 5.0, 6.0]),
+        ]);
+        for _ in 0..1000 {
+            let n = random_vec(&mut rng, -1.0, 1.0);
+            if n.length() < 0.1 {
+                continue;
+            }
+            let first = n.cross(random_vec(&mut rng, -1.0, 1.0));
+            if first.length() < 0.1 {
+                continue;
+            }
+            let world = t.normal(n);
+            assert!((world.length() - 1.0).abs() < 1e-6);
+            for tangent in [first, n.cross(first)] {
+                let tangent = t.vector(tangent).normalize();
+                assert!(world.dot(tangent).abs() < 1e-5, "{world} · {tangent}");
+            }
+        }
+    }
+
+    #[test]
+    fn normals_keep_their_side_under_mirroring() {
+        let t = tf(&[Scale([-1.0, 1.0, 1.0])]);
+        // The unit sphere's outward normal at (1,0,0) sits at (−1,0,0) in the
+        // world, where the outward normal is −x.
+        assert_close(t.point(Vec3::X), -Vec3::X, 0.0);
+        assert_close(t.normal(Vec3::X), -Vec3::X, 0.0);
+        let mut rng = Rng::new(5);
+        let t = tf(&[Scale([-2.0, 0.5, 1.0]), rz(30.0)]);
+        for _ in 0..200 {
+            let n = random_vec(&mut rng, -1.0, 1.0);
+            let v = random_vec(&mut rng, -1.0, 1.0);
+            let dot = n.dot(v);
+            if dot.abs() < 1e-3 {
+                continue;
+            }
+            assert_eq!(t.normal(n).dot(t.vector(v)) > 0.0, dot > 0.0);
+        }
+    }
+
+    /// A bound on the rounding of `f32` point mappings, from the norms of the
+    /// exact matrices: each coordinate of A·p + b is off by at most a few
+    /// units in the last place of |A||p| + |b|.
+    fn mapping_error(m: &DMat4, p: Vec3) -> f32 {
+        let a = DMat3::from_mat4(*m);
+        let linear = frobenius(&a) as f32;
+        let shift = m.w_axis.truncate().length() as f32;
+        8.0 * f32::EPSILON * (linear * p.length() + shift)
+    }
+
+    #[test]
+    fn inverse_round_trips_on_random_transforms() {
+        let mut rng = Rng::new(7);
+        for _ in 0..500 {
+            let t = tf(&random_steps(&mut rng));
+            let inv = t.inverse();
+            assert_eq!(inv.inverse(), t);
+            let product = t.to_world_matrix() * t.to_object_matrix();
+            assert!(product.abs_diff_eq(DMat4::IDENTITY, 1e-12), "{product}");
+            for _ in 0..10 {
+                let p = random_vec(&mut rng, -10.0, 10.0);
+                let world = t.point(p);
+                // The rounding of the forward mapping, carried through the
+                // inverse, plus that of the inverse mapping itself.
+                let a_inv = frobenius(&DMat3::from_mat4(t.to_object_matrix())) as f32;
+                let tolerance = 2.0
+                    * (a_inv * mapping_error(&t.to_world_matrix(), p)
+                        + mapping_error(&t.to_object_matrix(), world));
+                assert_close(inv.point(world), p, tolerance);
+                let v = random_vec(&mut rng, -1.0, 1.0);
+                assert_close(inv.vector(t.vector(v)), v, 1e-4);
+            }
+        }
+    }
+
+    #[test]
+    fn a_matrix_step_equals_the_same_steps() {
+        // Row-major: the translation is the last column.
+        let shift = tf(&[Matrix([
+            [1.0, 0.0, 0.0, 5.0],
+            [0.0, 1.0, 0.0, 6.0],
+            [0.0, 0.0, 1.0, 7.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])]);
+        assert_close(shift.point(Vec3::ZERO), Vec3::new(5.0, 6.0, 7.0), 0.0);
+        // x' = −y, y' = x: a quarter turn about z, read row by row.
+        let quarter = tf(&[Matrix([
+            [0.0, -1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])]);
+        assert_eq!(quarter, tf(&[rz(90.0)]));
+        assert_close(quarter.point(Vec3::X), Vec3::Y, 0.0);
+
+        // Scale, rotate, translate written out by hand as T·R·S, with R from
+        // glam's own axis-angle rotation.
+        let (s, t) = ([2.0, 3.0, 4.0], [5.0, -6.0, 7.0]);
+        let axis = DVec3::new(1.0, 2.0, 3.0).normalize();
+        let r = DMat3::from_axis_angle(axis, 40f64.to_radians());
+        let mut rows = [[0.0; 4]; 4];
+        for i in 0..3 {
+            for j in 0..3 {
+                rows[i][j] = r.col(j)[i] * s[j];
+            }
+            rows[i][3] = t[i];
+        }
+        rows[3][3] = 1.0;
+        let steps = tf(&[
+            Scale(s),
+            Rotate {
+                axis: [1.0, 2.0, 3.0],
+                degrees: 40.0,
+            },
+            Translate(t),
+        ]);
+        let matrix = tf(&[Matrix(rows)]);
+        assert!(matrix
+            .to_world_matrix()
+            .abs_diff_eq(steps.to_world_matrix(), 1e-12));
+        assert!(matrix
+            .to_object_matrix()
+            .abs_diff_eq(steps.to_object_matrix(), 1e-12));
+        let p = Vec3::new(0.3, -1.2, 2.5);
+        assert_close(matrix.point(p), steps.point(p), 1e-5);
+        assert_eq!(tf(&[Matrix(steps.rows())]), steps);
+    }
+
+    /// The nearest hit of the ellipsoid Σ((x − c)ᵢ/sᵢ)² = 1, in `f64`.
+    fn ellipsoid_hit(ray: &Ray, c: DVec3, s: DVec3) -> Option<f64> {
+        let o = (ray.origin.as_dvec3() - c) / s;
+        let d = ray.direction.as_dvec3() / s;
+        let (a, half_b, k) = (d.dot(d), o.dot(d), o.dot(o) - 1.0);
+        let disc = half_b * half_b - a * k;
+        (disc >= 0.0).then(|| (-half_b - disc.sqrt()) / a)
+    }
+
+    #[test]
+    fn object_space_hits_match_world_space_hits() {
+        let mut rng = Rng::new(11);
+        let world_interval = Interval::new(1e-3, f32::INFINITY);
+        let unit = Sphere::new(Vec3::ZERO, 1.0);
+        let object_hit = |t: &Transform, ray: &Ray| {
+            let (object_ray, scale) = t.to_object_ray(ray);
+            assert!((object_ray.direction.length() - 1.0).abs() < 1e-6);
+            let interval = Interval::new(world_interval.min * scale, world_interval.max * scale);
+            unit.hit(&object_ray, interval)
+                .map(|t_object| (t_object / scale, t.point(object_ray.at(t_object))))
+        };
+
+        // Uniform scale (a sphere of radius s at c), with a rotation that
+        // must not change anything.
+        for (s, c) in [
+            (3.0, [1.0, -2.0, 4.0]),
+            (0.25, [0.0, 5.0, 0.0]),
+            (1.0, [0.0; 3]),
+        ] {
+            let t = tf(&[
+                Scale([s; 3]),
+                Rotate {
+                    axis: [0.3, 1.0, -0.2],
+                    degrees: 71.0,
+                },
+                Translate(c),
+            ]);
+            let world = Sphere::new(Vec3::from_array(c.map(|x| x as f32)), s as f32);
+            let (mut hits, mut misses) = (0, 0);
+            for _ in 0..2000 {
+                let origin = world.center + random_vec(&mut rng, -8.0, 8.0) * world.radius;
+                let target = world.center + random_vec(&mut rng, -1.5, 1.5) * world.radius;
+                let ray = Ray::new(origin, (target - origin).normalize());
+                // Leave out grazing rays and origins near the surface, whose
+                // outcome rounding may decide.
+                let to_centre = world.center - origin;
+                let miss_distance =
+                    (to_centre - to_centre.dot(ray.direction) * ray.direction).length();
+                if (miss_distance / world.radius - 1.0).abs() < 0.01
+                    || (to_centre.length() / world.radius - 1.0).abs() < 0.01
+                {
+                    continue;
+                }
+                let expected = world.hit(&ray, world_interval);
+                let actual = object_hit(&t, &ray);
+                match (expected, actual) {
+                    (None, None) => misses += 1,
+                    (Some(t_world), Some((t_obj, point))) => {
+                        hits += 1;
+                        let scale = world.radius + to_centre.length();
+                        assert!(
+                            (t_world - t_obj).abs() <= 1e-5 * scale,
+                            "{t_world} vs {t_obj}"
+                        );
+                        assert_close(point, ray.at(t_world), 1e-5 * scale);
+                    }
+                    _ => panic!("world {expected:?}, object {actual:?} for {ray:?}"),
+                }
+            }
+            assert!(hits > 300 && misses > 300, "{hits} hits, {misses} misses");
+        }
+
+        // Non-uniform scale: an ellipsoid, solved in the world in f64.
+        let (s, c) = (DVec3::new(2.0, 0.5, 1.5), DVec3::new(1.0, -2.0, 3.0));
+        let t = tf(&[Scale(s.to_array()), Translate(c.to_array())]);
+        let centre = c.as_vec3a();
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = centre + random_vec(&mut rng, -10.0, 10.0);
+            if ((origin.as_dvec3() - c) / s).length() < 1.1 {
+                continue;
+            }
+            let target = centre + random_vec(&mut rng, -0.8, 0.8) * s.as_vec3a() / 3f32.sqrt();
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let expected = ellipsoid_hit(&ray, c, s).expect("aimed inside");
+            let (t_obj, point) = object_hit(&t, &ray).expect("aimed inside");
+            hits += 1;
+            assert!(
+                (expected - f64::from(t_obj)).abs() <= 1e-5 * (1.0 + expected),
+                "{expected} vs {t_obj}"
+            );
+            assert_close(point, ray.at(expected as f32), 1e-4);
+            // The ellipsoid's normal is the gradient ((x − c)ᵢ/sᵢ²).
+            let gradient = ((point.as_dvec3() - c) / (s * s)).normalize().as_vec3a();
+            let (object_ray, scale) = t.to_object_ray(&ray);
+            let object_point = object_ray.at(t_obj * scale);
+            assert_close(t.normal(object_point), gradient, 1e-4);
+        }
+        assert!(hits > 1000);
+    }
+
+    #[test]
+    fn bounds_contain_every_transformed_point() {
+        let mut rng = Rng::new(13);
+        for _ in 0..500 {
+            let mut steps = random_steps(&mut rng);
+            // Far from the origin too, where rounding is coarser.
+            steps.push(Translate([0; 3].map(|_| range(&mut rng, -1e4, 1e4))));
+            let t = tf(&steps);
+            let a = random_vec(&mut rng, -100.0, 100.0);
+            let b = a + random_vec(&mut rng, 0.0, 10.0);
+            let bounds = t.bounds(&Aabb { min: a, max: b });
+            let inside = |p: Vec3| bounds.min.cmple(p).all() && p.cmple(bounds.max).all();
+            for corner in 0..8 {
+                let c = Vec3::new(
+                    if corner & 1 == 0 { a.x } else { b.x },
+                    if corner & 2 == 0 { a.y } else { b.y },
+                    if corner & 4 == 0 { a.z } else { b.z },
+                );
+                assert!(
+                    inside(t.point(c)),
+                    "corner {} outside {bounds:?}",
+                    t.point(c)
+                );
+            }
+            for _ in 0..50 {
+                let p = a + random_vec(&mut rng, 0.0, 1.0) * (b - a);
+                assert!(inside(t.point(p)), "{} outside {bounds:?}", t.point(p));
+            }
+        }
+
+        // And not much larger: the cube [−1,1]³ turned 45° about z spans ±√2
+        // in x and y.
+        let cube = Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::ONE,
+        };
+        let turned = tf(&[rz(45.0)]).bounds(&cube);
+        let r = std::f32::consts::SQRT_2;
+        assert_close(turned.max, Vec3::new(r, r, 1.0), 1e-5);
+        assert_close(turned.min, Vec3::new(-r, -r, -1.0), 1e-5);
+
+        let empty = tf(&[rz(45.0)]).bounds(&Aabb::EMPTY);
+        assert!(empty.min.x > empty.max.x);
+    }
+
+    #[test]
+    fn bad_values_are_refused_with_the_step_index() {
+        let ok = Translate([1.0, 2.0, 3.0]);
+        let cases: Vec<(Vec<TransformStep>, usize, &str)> = vec![
+            (
+                vec![ok, Translate([0.0, f64::NAN, 0.0])],
+                1,
+                "translation y is NaN",
+            ),
+            (
+                vec![Translate([f64::INFINITY, 0.0, 0.0])],
+                0,
+                "translation x is inf",
+            ),
+            (
+                vec![ok, ok, Translate([1e39, 0.0, 0.0])],
+                2,
+                "beyond the range of f32",
+            ),
+            (
+                vec![
+                    ok,
+                    Rotate {
+                        axis: [0.0, 1.0, 0.0],
+                        degrees: f64::NAN,
+                    },
+                ],
+                1,
+                "rotation angle is NaN",
+            ),
+            (
+                vec![Rotate {
+                    axis: [0.0, 1.0, 0.0],
+                    degrees: 1e300,
+                }],
+                0,
+                "beyond the range of f32",
+            ),
+            (
+                vec![
+                    ok,
+                    ok,
+                    Rotate {
+                        axis: [0.0, 0.0, 0.0],
+                        degrees: 30.0,
+                    },
+                ],
+                2,
+                "zero length",
+            ),
+            (
+                vec![Rotate {
+                    axis: [f64::NEG_INFINITY, 0.0, 0.0],
+                    degrees: 30.0,
+                }],
+                0,
+                "rotation axis x is -inf",
+            ),
+            (vec![Scale([1.0, 0.0, 1.0])], 0, "scale y is 0"),
+            (vec![ok, Scale([1.0, 1.0, -0.0])], 1, "scale z is 0"),
+            (vec![ok, Scale([f64::NAN, 1.0, 1.0])], 1, "scale x is NaN"),
+            (vec![Scale([1e-40, 1e-40, 1e-40])], 0, "too close to 0"),
+            (vec![Scale([1e-6, 1.0, 1.0])], 0, "nearly singular"),
+            (
+                vec![ok, Scale([1e-4, 1.0, 1.0]), Scale([1e-3, 1.0, 1.0])],
+                2,
+                "together with the steps before it, the matrix is nearly singular",
+            ),
+            (
+                vec![Scale([1e25; 3]), Scale([1e25; 3])],
+                1,
+                "together with the steps before it, the matrix has entries beyond",
+            ),
+        ];
+        let matrix_cases: Vec<([[f64; 4]; 4], &str)> = vec![
+            (
+                [
+                    [1.0, 2.0, 3.0, 0.0],
+                    [2.0, 4.0, 6.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ],
+                "singular (determinant 0)",
+            ),
+            (
+                [
+                    [1.0, 1.0, 0.0, 0.0],
+                    [1.0, 1.0 + 1e-9, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ],
+                "nearly singular",
+            ),
+            (
+                [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 1.0, 1.0],
+                ],
+                "last row is [0, 0, 1, 1]",
+            ),
+            (
+                [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 2.0],
+                ],
+                "must be [0, 0, 0, 1]",
+            ),
+            (
+                [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, f64::NAN, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ],
+                "matrix entry [1][2] is NaN",
+            ),
+        ];
+        let cases = cases.into_iter().chain(
+            matrix_cases
+                .into_iter()
+                .map(|(rows, text)| (vec![ok, ok, ok, Matrix(rows)], 3, text)),
+        );
+        for (steps, index, text) in cases {
+            let error = refused(&steps);
+            assert_eq!(error.index, index, "{error}");
+            assert!(error.message.contains(text), "{error} lacks {text:?}");
+            assert!(
+                error
+                    .to_string()
+                    .starts_with(&format!("transform[{index}]: ")),
+                "{error}"
+            );
+        }
+        // Just inside the limits.
+        tf(&[Scale([1e-5, 1.0, 1.0])]);
+        tf(&[Scale([1e-30; 3])]);
+        tf(&[Translate([3e38, 0.0, 0.0])]);
+    }
+
+    #[test]
+    fn identity_composition_and_inverse() {
+        assert!(Transform::IDENTITY.is_identity());
+        assert_eq!(tf(&[]), Transform::IDENTITY);
+        assert_eq!(Transform::default(), Transform::IDENTITY);
+        assert!(tf(&[rz(360.0)]).is_identity());
+        assert!(tf(&[rz(90.0), rz(90.0), rz(-270.0), rz(90.0)]).is_identity());
+        assert!(tf(&[Translate([1.5, -2.0, 0.25]), Translate([-1.5, 2.0, -0.25])]).is_identity());
+        assert!(!tf(&[Scale([1.0, 1.0, 2.0])]).is_identity());
+        assert!(!tf(&[rz(1e-3)]).is_identity());
+
+        let mut rng = Rng::new(17);
+        for _ in 0..200 {
+            let (first, second) = (random_steps(&mut rng), random_steps(&mut rng));
+            let (a, b) = (tf(&first), tf(&second));
+            let both = tf(&[first, second].concat());
+            let then = a.then(&b).unwrap();
+            let compose = b.compose(&a).unwrap();
+            for c in [then, compose] {
+                assert!(c
+                    .to_world_matrix()
+                    .abs_diff_eq(both.to_world_matrix(), 1e-9));
+                assert!(c
+                    .to_object_matrix()
+                    .abs_diff_eq(both.to_object_matrix(), 1e-9));
+            }
+            let round = a.then(&a.inverse()).unwrap();
+            assert!(round.to_world_matrix().abs_diff_eq(DMat4::IDENTITY, 1e-12));
+        }
+        // Order matters.
+        let (t, r) = (tf(&[Translate([1.0, 0.0, 0.0])]), tf(&[rz(90.0)]));
+        assert_close(
+            t.then(&r).unwrap().point(Vec3::X),
+            Vec3::new(0.0, 2.0, 0.0),
+            1e-6,
+        );
+        assert_close(
+            t.compose(&r).unwrap().point(Vec3::X),
+            Vec3::new(1.0, 1.0, 0.0),
+            1e-6,
+        );
+
+        // Each well-conditioned, the product not.
+        let flat = tf(&[Scale([1e-3, 1.0, 1.0])]);
+        assert!(flat.then(&flat).is_none());
+    }
+}
