@@ -13,6 +13,7 @@
 //!   intersection kernel exists once.
 //! - [`material`]: diffuse (four bounce models, two attenuation forms),
 //!   metal, dielectric.
+//! - [`mesh`]: triangle meshes and their materials from OBJ and glTF files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampling`] and [`rng`]: random directions and seeded random numbers.
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.
@@ -50,6 +51,7 @@ pub mod isa;
 pub mod lanes;
 pub mod material;
 pub mod math;
+pub mod mesh;
 pub mod output;
 pub mod progressive;
 pub mod ray;
