@@ -292,7 +292,7 @@ fn check_accessor(
         .checked_mul(stride)
         .and_then(|x| x.checked_add(size))
         .and_then(|x| x.checked_add(accessor.offset()));
-    if !needed.is_some_and(|end| end <= view.length()) {
+    if needed.is_none_or(|end| end > view.length()) {
         return Err(format!(
             "{name} ({} elements from byte {}) runs past the end of buffer view {} ({} bytes)",
             accessor.count(),
@@ -302,10 +302,10 @@ fn check_accessor(
         ));
     }
     let buffer = &buffers[view.buffer().index()];
-    if !view
+    if view
         .offset()
         .checked_add(view.length())
-        .is_some_and(|end| end <= buffer.len())
+        .is_none_or(|end| end > buffer.len())
     {
         return Err(format!(
             "buffer view {} (bytes {}..+{}) runs past the end of buffer {} ({} bytes)",

@@ -164,7 +164,7 @@ impl MeshMaterial {
     ///
     /// Colours are clamped to [0, 1] (NaN to 0); emission is not mapped.
     pub fn to_material(&self) -> Material {
-        let unit = |x: f32| x.max(0.0).min(1.0);
+        let unit = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
         let albedo = Color::from_array(self.base_color.map(unit));
         if self.transmission > 0.0 {
             let ior = if self.ior.is_finite() && self.ior > 0.0 {

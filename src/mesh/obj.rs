@@ -33,6 +33,10 @@ pub(super) fn load(path: &Path) -> Result<Model, MeshError> {
         ignore_lines: true,
     };
     let result = tobj::load_obj_buf(&mut text.as_bytes(), &options, |name| {
+        if name.as_os_str().is_empty() {
+            // `mtllib` without a file name: nothing to load.
+            return Err(tobj::LoadError::OpenFileFailed);
+        }
         load_mtl(&dir.join(name), &mtl_error)
     });
     if let Some(e) = mtl_error.into_inner() {
@@ -419,7 +423,9 @@ fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
             "Ns" | "Ni" | "d" => {
                 (!number(words.first())).then(|| format!("{keyword} needs a number"))
             }
-            "illum" => (!words.first().is_some_and(|w| w.parse::<u8>().is_ok()))
+            "illum" => words
+                .first()
+                .is_none_or(|w| w.parse::<u8>().is_err())
                 .then(|| "illum needs an illumination model number 0–10".to_string()),
             k if k.starts_with("map_") || k == "bump" => words
                 .is_empty()

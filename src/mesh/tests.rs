@@ -770,6 +770,11 @@ fn corrupt_or_inconsistent_gltf_is_refused() {
         "no triangles",
     );
 
+    gltf_refused(
+        "attr.gltf",
+        good.replace(r#""POSITION": 0"#, r#""POSITION": 9"#),
+        "attribute accessor 9 does not exist",
+    );
     // An index past the vertices.
     let mut bad = buf.clone();
     bad[38..40].copy_from_slice(&3u16.to_le_bytes());
@@ -845,9 +850,15 @@ fn load_mutant(dir: &TempDir, name: &str, bytes: &[u8]) -> bool {
 
 /// One random change: flip bits of a byte, overwrite a byte with one that
 /// matters to the format, truncate, or delete or duplicate a line.
-fn mutate(rng: &mut crate::rng::Rng, bytes: &mut Vec<u8>) {
+/// Half the changes fall in the first `head` bytes (a GLB's JSON chunk).
+fn mutate(rng: &mut crate::rng::Rng, bytes: &mut Vec<u8>, head: usize) {
     let n = bytes.len().max(1);
-    let at = rng.next_u32() as usize % n;
+    let span = if rng.next_u32() % 2 == 0 {
+        n.min(head)
+    } else {
+        n
+    };
+    let at = rng.next_u32() as usize % span;
     let line_start = |at: usize, b: &[u8]| {
         b[..at]
             .iter()
@@ -891,13 +902,30 @@ fn mutated_bunnies_never_panic() {
     let t = Instant::now();
     let dir = TempDir::new();
     let mut rng = crate::rng::Rng::new(0x6d65_7368);
-    for (name, rounds) in [("bunny.obj", 1500), ("bunny.glb", 2500)] {
-        let original = std::fs::read(asset(name)).unwrap();
+    let glb = std::fs::read(asset("bunny.glb")).unwrap();
+    let json_end = 20 + u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let gltf = gltf_json(
+        &data_uri(&triangle_buffer()),
+        HIERARCHY,
+        r#""scene": 0, "scenes": [{"nodes": [0]}],"#,
+    );
+    dir.write("m.mtl", RICH_MTL);
+    for (name, original, head, rounds) in [
+        (
+            "bunny.obj",
+            std::fs::read(asset("bunny.obj")).unwrap(),
+            usize::MAX,
+            1500,
+        ),
+        ("rich.obj", RICH_OBJ.as_bytes().to_vec(), usize::MAX, 1000),
+        ("bunny.glb", glb, json_end, 2000),
+        ("tree.gltf", gltf.into_bytes(), usize::MAX, 1500),
+    ] {
         let (mut ok, mut refused) = (0, 0);
         for round in 0..rounds {
             let mut bytes = original.clone();
             for _ in 0..1 + rng.next_u32() % 4 {
-                mutate(&mut rng, &mut bytes);
+                mutate(&mut rng, &mut bytes, head);
             }
             let mutant = format!("mutant-{round}.{}", name.rsplit('.').next().unwrap());
             if load_mutant(&dir, &mutant, &bytes) {
@@ -915,5 +943,41 @@ fn mutated_bunnies_never_panic() {
             "{name}: {ok} loaded, {refused} refused"
         );
     }
+    // The MTL file of a fixed OBJ.
+    let obj = dir.write("rich.obj", RICH_OBJ);
+    let mtl = dir.0.join("m.mtl");
+    let (mut ok, mut refused) = (0, 0);
+    for _ in 0..1000 {
+        let mut bytes = RICH_MTL.as_bytes().to_vec();
+        for _ in 0..1 + rng.next_u32() % 4 {
+            mutate(&mut rng, &mut bytes, usize::MAX);
+        }
+        std::fs::write(&mtl, &bytes).unwrap();
+        match load(&obj) {
+            Ok(m) => {
+                assert_eq!(m.triangle_count(), 7);
+                ok += 1;
+            }
+            Err(e) => {
+                assert_eq!(e.file(), mtl, "{e}");
+                refused += 1;
+            }
+        }
+    }
+    eprintln!("m.mtl: {ok} mutants loaded, {refused} refused");
+    assert!(ok > 0 && refused > 0);
     eprintln!("fuzzing took {:?}", t.elapsed());
 }
+
+/// An OBJ with objects, groups, materials, texture coordinates, normals,
+/// quads and relative indices, for the mutation test.
+const RICH_OBJ: &str = "mtllib m.mtl\n# a comment\n\
+    v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1 1\n\
+    vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nvn 0 1 0\n\
+    o first\nusemtl red\nf 1/1/1 2/2/1 3/3/1 4/1/1\nusemtl glass\nf 1//2 2//2 5//2\n\
+    g second\ns 1\nusemtl chrome\nf -5/-3 -4/-2 -3/-1\nf 1 3 5\nl 1 2 3\n\
+    o third\nusemtl nosuch\nf 2 3 4 5\n";
+
+const RICH_MTL: &str = "newmtl red\nKd 1 0.2 0\nKe 0 0 4\n\
+    newmtl chrome\nKd 0 0 0\nKs 0.9 0.8 0.7\nNs 1000\nillum 3\n\
+    newmtl glass\nKd 1 1 1\nNi 1.45\nd 0.1\nTr 0.9\nmap_Kd tex.png\n";
