@@ -81,7 +81,7 @@ pub(super) fn load(path: &Path) -> Result<Model, MeshError> {
 #[derive(Default)]
 struct Builder {
     mesh: TriangleMesh,
-    /// False once a piece lacks normals (resp. texture coordinates).
+    /// Set once a piece lacks normals (resp. texture coordinates).
     missing_normals: bool,
     missing_uvs: bool,
 }
