@@ -707,6 +707,11 @@ fn corrupt_or_inconsistent_gltf_is_refused() {
         "nowhere.bin",
     );
     gltf_refused(
+        "nobin.gltf",
+        good.replace(&format!(r#", "uri": "{}""#, data_uri(&buf)), ""),
+        "binary chunk, which is missing",
+    );
+    gltf_refused(
         "short.gltf",
         gltf_json(&data_uri(&buf[..40]), nodes, ""),
         "declares 44",
