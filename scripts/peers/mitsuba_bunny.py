@@ -261,7 +261,7 @@ def main(argv=None):
     ap.add_argument("--max-depth", type=int, default=MAX_DEPTH)
     ap.add_argument("--samples-per-pass", type=int, default=0,
                     help="split the render into passes of this many spp to bound memory "
-                         "(default: 32 when spp > 32, else one pass)")
+                         "(deprecated in Mitsuba 3.6+; default: Mitsuba chooses)")
     ap.add_argument("--check-depth", action="store_true",
                     help="render with max_depth 1 and check that only the sky is seen")
     args = ap.parse_args(argv)
@@ -275,7 +275,7 @@ def main(argv=None):
     if args.threads > 0:
         dr.set_thread_count(args.threads)
 
-    spp_pass = args.samples_per_pass or (32 if args.spp > 32 and args.spp % 32 == 0 else None)
+    spp_pass = args.samples_per_pass or None
 
     if args.check_depth:
         scene, _ = build_scene(mi, args.mesh, args.sampler, 4, args.seed, args.floor_albedo, 1)
@@ -316,16 +316,22 @@ def main(argv=None):
         "build_s": round(t_build, 3), "first_render_s": round(t_first, 3),
     }
     if args.time:
-        times = []
+        # Wall-clock time, and the CPU time of this process (all its threads),
+        # which depends less on what else runs on a shared machine.
+        times, cpus = [], []
         for i in range(args.runs):
-            t0 = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
             render(args.seed)  # same seed: the compiled kernel is reused
             times.append(time.perf_counter() - t0)
-            print(f"run {i + 1}/{args.runs}: {times[-1]:.3f} s", file=sys.stderr)
-        med = statistics.median(times)
+            cpus.append(time.process_time() - c0)
+            print(f"run {i + 1}/{args.runs}: {times[-1]:.3f} s, {cpus[-1]:.3f} CPU-s", file=sys.stderr)
+        med, med_cpu = statistics.median(times), statistics.median(cpus)
+        nsamples = WIDTH * HEIGHT * args.spp
         result.update({
             "runs": args.runs, "times_s": [round(t, 3) for t in times], "median_s": round(med, 3),
-            "samples_per_s": round(WIDTH * HEIGHT * args.spp / med),
+            "samples_per_s": round(nsamples / med),
+            "cpu_s": [round(t, 3) for t in cpus], "median_cpu_s": round(med_cpu, 3),
+            "samples_per_cpu_s": round(nsamples / med_cpu),
             "loadavg_1m": round(os.getloadavg()[0], 2),
         })
     print(json.dumps(result))
