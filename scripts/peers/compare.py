@@ -252,7 +252,7 @@ def main(argv=None):
     d, se, z, _ = welch(mean_a, mean_b)
     bias = {
         "mean_a": mean_a.mean(0).tolist(), "mean_b": mean_b.mean(0).tolist(),
-        "diff": d.tolist(), "se": se.tolist(), "z": z.tolist(),
+        "diff": d.tolist(), "se": se.tolist(), "t": (d / np.where(se > 0, se, np.inf)).tolist(), "z": z.tolist(),
         "rel_diff": (d / mean_b.mean(0)).tolist(),
     }
     bias["pass"] = bool(np.all(np.abs(z) <= 3))
@@ -279,10 +279,10 @@ def main(argv=None):
     if not args.json:
         print(f"set A: {len(args.a)} renders, set B: {len(args.b)} renders, {A.shape[2]}x{A.shape[1]}"
               + (", grey (R = G = B): one channel tested" if grey else ""))
-        print("image mean     A           B           A-B          s.e.       z      rel")
+        print("image mean     A           B           A-B          s.e.     (A-B)/se    z      rel")
         for c, name in enumerate("Y" if grey else "RGB"):
             print(f"  {name}      {bias['mean_a'][c]:.6f}    {bias['mean_b'][c]:.6f}   "
-                  f"{bias['diff'][c]:+.3e}  {bias['se'][c]:.3e}  {bias['z'][c]:+6.2f}  "
+                  f"{bias['diff'][c]:+.3e}  {bias['se'][c]:.3e}  {bias['t'][c]:+8.2f}  {bias['z'][c]:+6.2f}  "
                   f"{bias['rel_diff'][c]:+.2%}")
         print(f"  bias test |z| <= 3: {'pass' if bias['pass'] else 'FAIL'}")
         for r in (pix, blk):
