@@ -35,7 +35,9 @@ Three scales are tested, each with this same z:
 
 1. The whole image (bias test): the per-seed image means of each channel are
    the samples. Reported: each set's mean, the difference, its standard error
-   sqrt(v_A + v_B), and z. Fails when |z| > 3 in any channel.
+   sqrt(v_A + v_B), the ratio t = difference / s.e., and z. Fails when
+   |z| > 3 in any channel (with 4 + 4 seeds that is |t| > 4.9 at 6 degrees
+   of freedom, up to 9.2 at 3; |t| > 3 alone would fail 2-6% of fair tests).
 2. Pixels: the per-pixel z. Reported: the fraction with |z| > 3 (expected
    0.27%) and RMS(z) (expected 1). Fails when the count with |z| > 3 exceeds
    its binomial expectation by more than 5 standard deviations, or RMS(z)
