@@ -266,6 +266,10 @@ def main(argv=None):
                     help="render with max_depth 1 and check that only the sky is seen")
     args = ap.parse_args(argv)
 
+    if not Path(args.mesh).is_file():
+        print(f"mitsuba_bunny.py: no mesh file {args.mesh} (pass the .glb path)", file=sys.stderr)
+        return 2
+
     if args.variant.startswith("llvm") and not os.environ.get("DRJIT_LIBLLVM_PATH"):
         print("note: DRJIT_LIBLLVM_PATH is not set (eval \"$(scripts/peers/setup.sh)\")", file=sys.stderr)
 
@@ -292,9 +296,13 @@ def main(argv=None):
     scene, ntri = build_scene(mi, args.mesh, args.sampler, args.spp, args.seed,
                               args.floor_albedo, args.max_depth, spp_pass)
     t_build = time.perf_counter() - t0
+    spp_used = scene.sensors()[0].sampler().sample_count()
+    if spp_used != args.spp:  # `stratified` rounds up to a square
+        print(f"note: the {args.sampler} sampler takes {spp_used} spp, not {args.spp}", file=sys.stderr)
+        args.spp = spp_used
 
     def render(seed):
-        img = mi.render(scene, spp=args.spp, seed=seed)
+        img = mi.render(scene, seed=seed)  # spp: the sampler's
         dr.eval(img)
         dr.sync_thread()
         return img

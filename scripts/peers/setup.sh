@@ -98,5 +98,6 @@ print(f"setup.sh: ok: mitsuba {mi.__version__}, drjit {dr.__version__}, variant 
 PYEOF
 fi
 
+[[ -x "$PY" ]] || { log "no venv at $VENV: run scripts/peers/setup.sh without --env first"; exit 1; }
 echo "export DRJIT_LIBLLVM_PATH=$DRJIT_LIBLLVM_PATH"
 echo "export LUMEN_PEERS_PYTHON=$PY"
