@@ -169,6 +169,7 @@ pub fn sphere_field(n: usize) -> SceneDesc {
                 center,
                 radius: 0.2,
                 material: palette[k.min(15)].0.clone(),
+                transform: Vec::new(),
             });
             placed += 1;
         }
@@ -270,6 +271,7 @@ mod tests {
             center: [0.0, 0.0, 0.0],
             radius: 2.0,
             material: "big-diffuse".to_string(),
+            transform: Vec::new(),
         });
         let scene = Scene::from_desc(&desc).expect("one-sphere scene compiles");
         let (film, stats) = render(&scene, &|_| {});

@@ -27,7 +27,7 @@
 use crate::film::Film;
 use crate::output::{self, OutputError};
 use crate::render::RenderStats;
-use crate::scene::SceneDesc;
+use crate::scene::{MeshSource, SceneDesc};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -126,7 +126,25 @@ pub enum CheckpointError {
 /// The canonical text of a scene description that identifies a render:
 /// compact JSON, materials sorted by name (they are a `BTreeMap`).
 pub fn description_text(desc: &SceneDesc) -> String {
-    serde_json::to_string(desc).expect("a scene description always serialises")
+    identity_text(desc, &[])
+}
+
+/// [`description_text`] with the content hashes of the mesh files the
+/// scene reads (`mesh_sources`), so that a changed mesh file is a different
+/// render.
+pub fn identity_text(desc: &SceneDesc, sources: &[MeshSource]) -> String {
+    #[derive(serde::Serialize)]
+    struct Identity<'a> {
+        #[serde(flatten)]
+        desc: &'a SceneDesc,
+        #[serde(skip_serializing_if = "<[MeshSource]>::is_empty")]
+        mesh_sources: &'a [MeshSource],
+    }
+    serde_json::to_string(&Identity {
+        desc,
+        mesh_sources: sources,
+    })
+    .expect("a scene description always serialises")
 }
 
 /// The default checkpoint path of an output image: `out.png` →
@@ -407,6 +425,29 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
         .into_iter()
         .filter(|k| *k != "render" && theirs.get(*k) != ours.get(*k))
         .map(String::as_str)
+        .collect();
+    if differing.contains(&"mesh_sources") {
+        // Name the files whose content changed.
+        let files = |m: &serde_json::Map<String, Value>| -> Vec<(String, Value)> {
+            m.get("mesh_sources")
+                .and_then(Value::as_array)
+                .map(|list| list.iter().map(|s| (show(&s["file"]), s.clone())).collect())
+                .unwrap_or_default()
+        };
+        let (a, b) = (files(&theirs), files(&ours));
+        for (name, source) in &b {
+            match a.iter().find(|(n, _)| n == name) {
+                Some((_, old)) if old != source => {
+                    out.push(format!("mesh file {name} has changed since the checkpoint"))
+                }
+                None => out.push(format!("mesh file {name} is not in the checkpoint")),
+                _ => {}
+            }
+        }
+    }
+    let differing: Vec<&str> = differing
+        .into_iter()
+        .filter(|k| *k != "mesh_sources")
         .collect();
     if !differing.is_empty() {
         out.push(format!(

@@ -175,12 +175,17 @@ pub(crate) fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &m
     let Some(hit) = scene.hit(&ray, hit_range(scene)) else {
         return scene.background.color(ray.direction);
     };
-    let sphere = &scene.spheres[hit.object as usize];
-    let outward = sphere.outward_normal(hit.point);
+    let outward = if hit.front_face {
+        hit.normal
+    } else {
+        -hit.normal
+    };
     match shading {
         Shading::Hit => Color::new(1.0, 0.0, 0.0),
         Shading::NormalsUnit => outward,
-        Shading::NormalsRaw => outward * sphere.radius,
+        // P − C: the unit normal times the radius, for spheres; other
+        // shapes have no centre and show their unit normal.
+        Shading::NormalsRaw => outward * scene.sphere_radius(hit.object).unwrap_or(1.0),
         Shading::NormalsBrightened | Shading::Path => 0.5 * (outward + Color::ONE),
     }
 }

@@ -110,6 +110,15 @@ impl Mask for bool {
     }
 }
 
+/// `[f(a[0]), f(a[1]), f(a[2])]`, always inlined. The kernels build their
+/// lanes with it rather than with `array::map`, which the compiler may leave
+/// as a call: the AVX instructions inside would then be calls too, since a
+/// function compiled without AVX cannot inline them.
+#[inline(always)]
+pub fn map3<T: Copy, U>(a: &[T; 3], f: impl Fn(T) -> U) -> [U; 3] {
+    [f(a[0]), f(a[1]), f(a[2])]
+}
+
 /// Number of lanes of [`F8`] and [`W8`].
 pub const LANES: usize = 8;
 
@@ -439,8 +448,11 @@ mod avx {
         }
         #[inline(always)]
         fn mask_from_bits(bits: u32) -> MW8 {
-            let lanes: [i32; LANES] = std::array::from_fn(|i| -(((bits >> i) & 1) as i32));
-            MW8(unsafe { _mm256_castsi256_ps(_mm256_loadu_si256(lanes.as_ptr().cast())) })
+            unsafe {
+                let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bits);
+                MW8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bits)))
+            }
         }
     }
 

@@ -35,7 +35,7 @@
 //! assert_eq!(session.spp_done(), 24);
 //! ```
 
-use crate::checkpoint::{description_text, Checkpoint, CheckpointError, CheckpointView};
+use crate::checkpoint::{identity_text, Checkpoint, CheckpointError, CheckpointView};
 use crate::film::Film;
 use crate::render::{render_samples_cancellable, RenderStats};
 use crate::scene::{Scene, SceneDesc, SceneError};
@@ -162,8 +162,8 @@ impl Session {
     pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Self {
         let film = Film::new(scene.settings.width, scene.settings.height);
         Self {
+            description: identity_text(desc, &scene.sources),
             scene,
-            description: description_text(desc),
             film,
             backup: Film::new(0, 0),
             stats: RenderStats::default(),
@@ -179,10 +179,16 @@ impl Session {
         checkpoint: Checkpoint,
         path: &Path,
     ) -> Result<Self, SessionError> {
-        // Checked before compiling, so a mismatch is reported as such even
-        // when the checkpoint's scene would not compile any more.
-        checkpoint.check_matches(desc, path)?;
-        Self::new(desc)?.adopt(checkpoint, path)
+        // A description that does not compile any more is still reported
+        // as a mismatch when it is one.
+        let scene = match Scene::from_desc(desc) {
+            Ok(scene) => scene,
+            Err(e) => {
+                checkpoint.check_matches(desc, path)?;
+                return Err(e.into());
+            }
+        };
+        Self::with_scene(desc, scene).restore(checkpoint, path)
     }
 
     /// Continues this new session from `checkpoint` (read from `path`, which

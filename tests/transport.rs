@@ -23,6 +23,8 @@ fn hit_facing_up() -> HitRecord {
     HitRecord {
         point: Vec3::ZERO,
         normal: Vec3::Y,
+        shading_normal: Vec3::Y,
+        uv: [0.0, 0.0],
         t: 1.0,
         front_face: true,
         material: 0,

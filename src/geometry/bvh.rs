@@ -19,11 +19,12 @@
 //! aarch64 (both always present there) and plain scalar code elsewhere.
 
 use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, MAX_LEAF};
+use crate::geometry::instance::Instance;
 use crate::geometry::primitive::{Kind, Primitive};
 use crate::geometry::quad::{self, QuadLanes};
 use crate::geometry::sphere::{self, SphereLanes};
 use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
-use crate::lanes::{max4, min4, Mask, Real, Wide, F8};
+use crate::lanes::{map3, max4, min4, Mask, Real, Wide, F8};
 use crate::math::Interval;
 use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
@@ -109,12 +110,20 @@ pub(super) struct QuadPacket {
     pub(super) index: [u32; 8],
 }
 
+/// Up to eight instances.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct InstancePacket {
+    /// Each lane's instance, in [`Bvh::instances`].
+    pub(super) instance: [u32; 8],
+    pub(super) index: [u32; 8],
+}
+
 impl SpherePacket {
     /// The packet's spheres, one per lane.
     #[inline(always)]
     pub(super) fn lanes<R: Wide>(&self) -> SphereLanes<R> {
         SphereLanes {
-            center: self.center.map(R::from_array),
+            center: map3(&self.center, R::from_array),
             radius2: R::from_array(self.radius2),
         }
     }
@@ -123,7 +132,7 @@ impl SpherePacket {
     #[inline(always)]
     pub(super) fn splat<R: Real>(&self, s: usize) -> SphereLanes<R> {
         SphereLanes {
-            center: self.center.map(|c| R::splat(c[s])),
+            center: map3(&self.center, |c| R::splat(c[s])),
             radius2: R::splat(self.radius2[s]),
         }
     }
@@ -134,7 +143,7 @@ impl TrianglePacket {
     #[inline(always)]
     pub(super) fn lanes<R: Wide>(&self, axes: [usize; 3]) -> TriangleLanes<R> {
         TriangleLanes {
-            vertices: self.vertices.map(|v| axes.map(|k| R::from_array(v[k]))),
+            vertices: map3(&self.vertices, |v| map3(&axes, |k| R::from_array(v[k]))),
         }
     }
 }
@@ -144,11 +153,11 @@ impl QuadPacket {
     #[inline(always)]
     pub(super) fn lanes<R: Wide>(&self) -> QuadLanes<R> {
         QuadLanes {
-            corner: self.corner.map(R::from_array),
-            u: self.u.map(R::from_array),
-            v: self.v.map(R::from_array),
-            normal: self.normal.map(R::from_array),
-            w: self.w.map(R::from_array),
+            corner: map3(&self.corner, R::from_array),
+            u: map3(&self.u, R::from_array),
+            v: map3(&self.v, R::from_array),
+            normal: map3(&self.normal, R::from_array),
+            w: map3(&self.w, R::from_array),
             d: R::from_array(self.d),
         }
     }
@@ -156,7 +165,7 @@ impl QuadPacket {
     /// Quad `s` of the packet in every lane.
     #[inline(always)]
     pub(super) fn splat<R: Real>(&self, s: usize) -> QuadLanes<R> {
-        let f = |c: [Lane8; 3]| c.map(|l| R::splat(l[s]));
+        let f = |c: [Lane8; 3]| map3(&c, |l| R::splat(l[s]));
         QuadLanes {
             corner: f(self.corner),
             u: f(self.u),
@@ -175,6 +184,9 @@ pub struct Hit {
     pub t: f32,
     /// Index of the primitive in the order the BVH was built from.
     pub index: u32,
+    /// For a hit inside an instance, the primitive's index in the
+    /// instance's tree; 0 otherwise.
+    pub sub: u32,
 }
 
 /// A 4-wide SAH bounding volume hierarchy over a set of primitives.
@@ -185,20 +197,43 @@ pub struct Bvh {
     spheres: Vec<SpherePacket>,
     triangles: Vec<TrianglePacket>,
     quads: Vec<QuadPacket>,
+    instance_packets: Vec<InstancePacket>,
+    /// The instances that `Primitive::Instance` items name.
+    instances: Vec<Instance>,
+    /// The box around everything.
+    bounds: Aabb,
     /// Whether the processor has AVX2, asked once when the tree is built:
     /// asking for every ray cost ≈ 20 instructions per ray.
     avx2: bool,
 }
 
 impl Bvh {
-    /// Builds the hierarchy over `primitives`.
+    /// Builds the hierarchy over `primitives`, which hold no instances.
     pub fn new(primitives: &[Primitive]) -> Self {
+        Self::with_instances(primitives, Vec::new())
+    }
+
+    /// Builds the hierarchy over `primitives`, whose `Primitive::Instance`
+    /// items name entries of `instances` (a two-level tree: the instances'
+    /// own trees hold no instances).
+    ///
+    /// # Panics
+    /// When an instance's tree itself holds instances, or an item names an
+    /// instance that `instances` does not have.
+    pub fn with_instances(primitives: &[Primitive], instances: Vec<Instance>) -> Self {
+        assert!(
+            instances.iter().all(|i| i.bvh.instances.is_empty()),
+            "instances hold no instances"
+        );
         let (binary, order) = build_binary(primitives);
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(binary.len() / 3 + 1),
             spheres: Vec::new(),
             triangles: Vec::new(),
             quads: Vec::new(),
+            instance_packets: Vec::new(),
+            instances,
+            bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
         };
         if binary.is_empty() {
@@ -219,7 +254,18 @@ impl Bvh {
         bvh.spheres.shrink_to_fit();
         bvh.triangles.shrink_to_fit();
         bvh.quads.shrink_to_fit();
+        bvh.instance_packets.shrink_to_fit();
         bvh
+    }
+
+    /// The box around everything in the tree.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The instances the tree places.
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
     }
 
     /// Number of nodes (for statistics and memory estimates).
@@ -234,25 +280,27 @@ impl Bvh {
             + self.spheres.capacity() * size_of::<SpherePacket>()
             + self.triangles.capacity() * size_of::<TrianglePacket>()
             + self.quads.capacity() * size_of::<QuadPacket>()
+            + self.instance_packets.capacity() * size_of::<InstancePacket>()
+            + self.instances.capacity() * size_of::<Instance>()
     }
 
     /// The nearest primitive hit by `ray` within `interval`; the ray's
     /// direction must have unit length (see [`sphere::intersect`]).
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
-        let (t, index) = if self.spheres_only() {
+        let (t, index, sub) = if self.spheres_only() {
             self.single::<Nearest, true>(ray, interval)
         } else {
             self.single::<Nearest, false>(ray, interval)
         };
-        (t < interval.max).then_some(Hit { t, index })
+        (t < interval.max).then_some(Hit { t, index, sub })
     }
 
     /// Whether `ray` hits anything within `interval` (the first hit found,
     /// not the nearest: a shadow ray's question).
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
-        let (t, _) = if self.spheres_only() {
+        let (t, ..) = if self.spheres_only() {
             self.single::<AnyHit, true>(ray, interval)
         } else {
             self.single::<AnyHit, false>(ray, interval)
@@ -263,18 +311,23 @@ impl Bvh {
     /// Traverses for one ray asking `Q`; `SPHERES` when the tree holds
     /// spheres only, whose traversal loop then carries no other kind's test
     /// (they would take registers from it). Returns the best (distance,
-    /// index), the distance `interval.max` when nothing counts.
+    /// index, index inside an instance), the distance `interval.max` when
+    /// nothing counts.
     #[inline(always)]
-    fn single<Q: Query, const SPHERES: bool>(&self, ray: &Ray, interval: Interval) -> (f32, u32) {
+    fn single<Q: Query, const SPHERES: bool>(
+        &self,
+        ray: &Ray,
+        interval: Interval,
+    ) -> (f32, u32, u32) {
         let mut query = SingleRay::<Q, SPHERES>::new(self, ray, interval);
         self.traverse(&mut query);
-        (query.closest, query.best)
+        (query.closest, query.best, query.sub)
     }
 
     /// Whether every leaf holds spheres.
     #[inline(always)]
     pub(super) fn spheres_only(&self) -> bool {
-        self.triangles.is_empty() && self.quads.is_empty()
+        self.triangles.is_empty() && self.quads.is_empty() && self.instances.is_empty()
     }
 
     /// Node `i`, which the traversal reached through a child reference.
@@ -315,6 +368,12 @@ impl Bvh {
     #[inline(always)]
     pub(super) fn quad_packet(&self, i: u32) -> &QuadPacket {
         &self.quads[i as usize]
+    }
+
+    /// Instance packet `i`.
+    #[inline(always)]
+    pub(super) fn instance_packet(&self, i: u32) -> &InstancePacket {
+        &self.instance_packets[i as usize]
     }
 
     /// Whether leaves are tested with AVX2 (see [`crate::isa`]).
@@ -464,6 +523,8 @@ struct SingleRay<Q, const SPHERES: bool> {
     /// index 0 is the lowest.
     closest: f32,
     best: u32,
+    /// The primitive inside the instance `best`, if it is one.
+    sub: u32,
     query: std::marker::PhantomData<Q>,
 }
 
@@ -502,6 +563,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             axes,
             closest: interval.max,
             best: 0,
+            sub: 0,
             query: std::marker::PhantomData,
         }
     }
@@ -537,8 +599,8 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
     #[inline(always)]
     fn lanes<R: Real>(&self) -> RayLanes<R> {
         RayLanes {
-            origin: self.ray.origin.to_array().map(R::splat),
-            direction: self.ray.direction.to_array().map(R::splat),
+            origin: map3(&self.ray.origin.to_array(), R::splat),
+            direction: map3(&self.ray.direction.to_array(), R::splat),
             t_min: R::splat(self.t_min),
         }
     }
@@ -560,6 +622,33 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
     fn quads<R: Wide>(&mut self, p: &QuadPacket) -> bool {
         let (t, valid) = quad::intersect(&self.lanes(), &p.lanes());
         self.found::<R>(t, valid, &p.index)
+    }
+
+    /// Traces the ray through each instance of the packet, keeping the
+    /// first hit in the order (distance, index) as for any primitive.
+    #[inline(never)]
+    fn instances(&mut self, bvh: &Bvh, p: &InstancePacket) -> bool {
+        for lane in 0..8 {
+            let index = p.index[lane];
+            if index == NO_CHILD {
+                break;
+            }
+            let instance = &bvh.instances[p.instance[lane] as usize];
+            if Q::ANY {
+                let within = Interval::new(self.t_min, self.closest);
+                if instance.occluded(&self.ray, within) {
+                    self.closest = self.t_min;
+                    return true;
+                }
+                continue;
+            }
+            if let Some((t, sub)) = instance.hit(&self.ray, self.t_min, self.closest) {
+                if t < self.closest || (t == self.closest && index < self.best) {
+                    (self.closest, self.best, self.sub) = (t, index, sub);
+                }
+            }
+        }
+        false
     }
 }
 
@@ -603,8 +692,8 @@ mod single_avx2 {
 #[inline(always)]
 fn splat_triangle_ray<R: Real>(r: &TriangleRay<f32>) -> TriangleRay<R> {
     TriangleRay {
-        origin: r.origin.map(R::splat),
-        shear: r.shear.map(R::splat),
+        origin: map3(&r.origin, R::splat),
+        shear: map3(&r.shear, R::splat),
         t_min: R::splat(r.t_min),
     }
 }
@@ -648,14 +737,14 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
                 Kind::Sphere => unsafe { single_avx2::spheres(self, bvh.sphere_packet(i)) },
                 Kind::Triangle => unsafe { single_avx2::triangles(self, bvh.triangle_packet(i)) },
                 Kind::Quad => unsafe { single_avx2::quads(self, bvh.quad_packet(i)) },
-                Kind::Instance => unreachable!("instances are traversed by the scene"),
+                Kind::Instance => self.instances(bvh, bvh.instance_packet(i)),
             };
         }
         match kind {
             Kind::Sphere => self.spheres::<F8>(bvh.sphere_packet(i)),
             Kind::Triangle => self.triangles::<F8>(bvh.triangle_packet(i)),
             Kind::Quad => self.quads::<F8>(bvh.quad_packet(i)),
-            Kind::Instance => unreachable!("instances are traversed by the scene"),
+            Kind::Instance => self.instances(bvh, bvh.instance_packet(i)),
         }
     }
 }
@@ -710,7 +799,7 @@ pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], 
 /// distance, and which of two tied spheres is found would depend on the order
 /// of the visit. 2⁻¹² is far above those few ulp and costs no measurable
 /// extra visits.
-pub(super) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
+pub(crate) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
 const SLACK4: Vec4 = Vec4::splat(SLACK);
 
 /// Turns the binary tree into 4-wide nodes and packets.
@@ -834,7 +923,25 @@ impl Collapse<'_> {
                 bvh.quads.push(p);
                 bvh.quads.len() - 1
             }
-            Kind::Instance => unreachable!("instances are placed by the scene"),
+            Kind::Instance => {
+                let mut p = InstancePacket {
+                    instance: [NO_CHILD; 8],
+                    index,
+                };
+                for lane in 0..members.len() {
+                    let Primitive::Instance { index, .. } = primitive(lane) else {
+                        unreachable!("a leaf holds one kind")
+                    };
+                    assert!(
+                        (*index as usize) < bvh.instances.len(),
+                        "instance {index} is not among the {} given",
+                        bvh.instances.len()
+                    );
+                    p.instance[lane] = *index;
+                }
+                bvh.instance_packets.push(p);
+                bvh.instance_packets.len() - 1
+            }
         };
         debug_assert!(packet <= INDEX_MASK as usize);
         LEAF_BIT | (kind as u32) << KIND_SHIFT | packet as u32

@@ -27,12 +27,12 @@
 //! does not depend on the order of the visit, nor on the other rays of the
 //! bundle.
 
-use super::bvh::{leaf_parts, Bvh, Hit, Node, Rays, NO_CHILD, SLACK};
+use super::bvh::{leaf_parts, Bvh, Hit, InstancePacket, Node, Rays, NO_CHILD, SLACK};
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
 use crate::geometry::sphere;
 use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
-use crate::lanes::{Wide, F8};
+use crate::lanes::{map3, Wide, F8};
 use crate::math::Interval;
 use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
@@ -157,14 +157,14 @@ impl Bvh {
     ) -> [Option<Hit>; LANES] {
         // As for single rays: a tree of spheres only gets a loop without
         // the other kinds' tests.
-        let (closest, best) = if self.spheres_only() {
+        let (closest, best, sub) = if self.spheres_only() {
             let mut query = BundleRays::<true>::new(self, rays, reference, interval);
             self.traverse(&mut query);
-            (query.closest, query.best)
+            (query.closest, query.best, query.sub)
         } else {
             let mut query = BundleRays::<false>::new(self, rays, reference, interval);
             self.traverse(&mut query);
-            (query.closest, query.best)
+            (query.closest, query.best, query.sub)
         };
         let mut hits = [None; LANES];
         for lane in 0..rays.len {
@@ -172,6 +172,7 @@ impl Bvh {
                 hits[lane] = Some(Hit {
                     t: closest[lane],
                     index: best[lane],
+                    sub: sub[lane],
                 });
             }
         }
@@ -199,6 +200,8 @@ struct BundleRays<'a, const SPHERES: bool> {
     /// they never enter a box or accept a primitive.
     closest: Lanes,
     best: [u32; LANES],
+    /// Per lane, the primitive inside the instance `best`, if it is one.
+    sub: [u32; LANES],
 }
 
 impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
@@ -241,6 +244,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             is_axis,
             closest,
             best: [0; LANES],
+            sub: [0; LANES],
         }
     }
 
@@ -287,8 +291,8 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
         let enter = R::mask_from_bits(enter);
         let mut closest = R::from_array(self.closest);
         let ray = RayLanes {
-            origin: self.rays.origin.map(R::from_array),
-            direction: self.rays.direction.map(R::from_array),
+            origin: map3(&self.rays.origin, R::from_array),
+            direction: map3(&self.rays.direction, R::from_array),
             t_min: R::splat(self.t_min),
         };
         let (kind, i) = leaf_parts(leaf);
@@ -307,24 +311,30 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             Kind::Triangle => {
                 let p = bvh.triangle_packet(i);
                 let triangle = TriangleRay {
-                    origin: self.triangle.origin.map(R::from_array),
-                    shear: self.triangle.shear.map(R::from_array),
+                    origin: map3(&self.triangle.origin, R::from_array),
+                    shear: map3(&self.triangle.shear, R::from_array),
                     t_min: R::from_array(self.triangle.t_min),
                 };
-                let is_axis = self
-                    .is_axis
-                    .map(|[x, y]| (R::mask_from_bits(x), R::mask_from_bits(y)));
+                let is_axis = map3(&self.is_axis, |[x, y]| {
+                    (R::mask_from_bits(x), R::mask_from_bits(y))
+                });
                 for s in 0..LANES {
                     if p.index[s] == NO_CHILD {
                         break;
                     }
                     // Vertex `v` in every lane's own axes.
                     let permuted = |v: &[[f32; LANES]; 3]| {
-                        let [x, y, z] = v.map(|c| R::splat(c[s]));
-                        is_axis.map(|(is_x, is_y)| R::select(is_x, x, R::select(is_y, y, z)))
+                        let [x, y, z] = map3(v, |c| R::splat(c[s]));
+                        map3(&is_axis, |(is_x, is_y)| {
+                            R::select(is_x, x, R::select(is_y, y, z))
+                        })
                     };
                     let tri = TriangleLanes {
-                        vertices: p.vertices.each_ref().map(permuted),
+                        vertices: [
+                            permuted(&p.vertices[0]),
+                            permuted(&p.vertices[1]),
+                            permuted(&p.vertices[2]),
+                        ],
                     };
                     let (t, valid) = triangle::intersect(&triangle, &tri);
                     self.found(&mut closest, t, valid, enter, p.index[s]);
@@ -340,9 +350,41 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
                     self.found(&mut closest, t, valid, enter, p.index[s]);
                 }
             }
-            Kind::Instance => unreachable!("instances are traversed by the scene"),
+            Kind::Instance => {
+                // Each lane that enters traces its own ray through the
+                // instances, exactly as it would alone.
+                self.closest = closest.to_array();
+                self.instances(bvh, bvh.instance_packet(i), R::bits(enter));
+                return;
+            }
         }
         self.closest = closest.to_array();
+    }
+}
+
+impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
+    /// The instances of packet `p` for the lanes of `enter` (bits), one ray
+    /// at a time, keeping per lane the first hit in the order (distance,
+    /// index) as `Bvh::hit` does.
+    #[inline(never)]
+    fn instances(&mut self, bvh: &Bvh, p: &InstancePacket, mut enter: u32) {
+        while enter != 0 {
+            let l = enter.trailing_zeros() as usize;
+            enter &= enter - 1;
+            let ray = self.rays.ray(l);
+            for s in 0..LANES {
+                let index = p.index[s];
+                if index == NO_CHILD {
+                    break;
+                }
+                let instance = &bvh.instances()[p.instance[s] as usize];
+                if let Some((t, sub)) = instance.hit(&ray, self.t_min, self.closest[l]) {
+                    if t < self.closest[l] || (t == self.closest[l] && index < self.best[l]) {
+                        (self.closest[l], self.best[l], self.sub[l]) = (t, index, sub);
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -8,8 +8,16 @@ use crate::ray::Ray;
 pub struct HitRecord {
     /// The hit point p(t).
     pub point: Point3,
-    /// Unit surface normal, turned to face against the incoming ray.
+    /// Unit geometric normal, turned to face against the incoming ray: it
+    /// decides the side a ray leaves to and where it starts.
     pub normal: Vec3,
+    /// Unit shading normal on the same side as `normal`: interpolated from
+    /// a mesh's vertex normals (smooth shading), else `normal` itself.
+    /// Materials scatter around it.
+    pub shading_normal: Vec3,
+    /// Surface coordinates: a sphere's (φ/2π, θ/π), a quad's (α, β), a
+    /// triangle's interpolated texture coordinates or barycentrics (b₁, b₂).
+    pub uv: [f32; 2],
     /// The ray parameter of the hit.
     pub t: f32,
     /// True when the ray hits the outside of the surface (it travels against
@@ -17,12 +25,11 @@ pub struct HitRecord {
     pub front_face: bool,
     /// Index of the hit object's material in the scene's material table.
     pub material: u32,
-    /// Index of the hit object in the scene.
+    /// Index of the hit primitive in the scene's tree.
     pub object: u32,
-    /// A bound on how far `point` may lie from the true surface: `f32`
-    /// rounding of the hit point and of its offset from the sphere's centre.
-    /// 0 when the scene's epsilon is 0, so that rays leave from the point
-    /// itself (the notes' shadow acne).
+    /// A bound on how far `point` may lie from the true surface through
+    /// `f32` rounding. 0 when the scene's epsilon is 0, so that rays leave
+    /// from the point itself (the notes' shadow acne).
     pub error: f32,
 }
 
@@ -41,6 +48,28 @@ impl HitRecord {
             -self.error
         };
         self.point + offset * self.normal
+    }
+
+    /// Whether the shading normal differs from the geometric one (an
+    /// interpolated vertex normal).
+    #[inline(always)]
+    pub fn is_smooth(&self) -> bool {
+        self.shading_normal != self.normal
+    }
+
+    /// `direction` kept on the side of the surface it was meant for: a
+    /// reflection scattered around a smooth shading normal can point below
+    /// the true (geometric) surface, where the path would enter the object
+    /// and darken it; it is mirrored back above. Transmitted directions and
+    /// flat surfaces are left alone.
+    #[inline(always)]
+    pub fn reflected_above(&self, direction: Vec3) -> Vec3 {
+        let cos = direction.dot(self.normal);
+        if self.is_smooth() && cos <= 0.0 {
+            (direction - 2.0 * cos * self.normal).normalize()
+        } else {
+            direction
+        }
     }
 }
 

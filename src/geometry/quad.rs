@@ -136,7 +136,8 @@ pub fn intersect<R: Real>(ray: &RayLanes<R>, quad: &QuadLanes<R>) -> (R, R::Mask
     if !ahead.any() {
         return (t, ahead);
     }
-    let p: [R; 3] = std::array::from_fn(|k| ray.origin[k] + t * ray.direction[k] - quad.corner[k]);
+    let at = |k: usize| ray.origin[k] + t * ray.direction[k] - quad.corner[k];
+    let p = [at(0), at(1), at(2)];
     let alpha = dot(&quad.w, &cross(&p, &quad.v));
     let beta = dot(&quad.w, &cross(&quad.u, &p));
     let (zero, one) = (R::splat(0.0), R::splat(1.0));

@@ -136,7 +136,11 @@ pub fn intersect<R: Real>(ray: &TriangleRay<R>, tri: &TriangleLanes<R>) -> (R, R
         let z = v[2] - ray.origin[2];
         [x - sx * z, y - sy * z, sz * z]
     };
-    let [a, b, c] = tri.vertices.each_ref().map(project);
+    let [a, b, c] = [
+        project(&tri.vertices[0]),
+        project(&tri.vertices[1]),
+        project(&tri.vertices[2]),
+    ];
     // Edge functions of b→c, c→a and a→b at the ray (the frame's origin).
     let u = c[0] * b[1] - c[1] * b[0];
     let v = a[0] * c[1] - a[1] * c[0];

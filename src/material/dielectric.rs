@@ -55,15 +55,15 @@ impl Dielectric {
         } else {
             self.ior
         };
-        let cos_theta = (-direction).dot(hit.normal).min(1.0);
-        let refracted = refract(direction, hit.normal, eta_ratio);
+        let cos_theta = (-direction).dot(hit.shading_normal).min(1.0);
+        let refracted = refract(direction, hit.shading_normal, eta_ratio);
         let direction = match refracted {
             Some(r) if self.refract_only || reflectance(cos_theta, eta_ratio) <= rng.next_f32() => {
                 r.normalize()
             }
             // The normal (P − C)/R is unit only to within ~1e-4 on small
             // spheres far from the origin; the sphere tests need unit rays.
-            _ => reflect(direction, hit.normal).normalize(),
+            _ => hit.reflected_above(reflect(direction, hit.shading_normal).normalize()),
         };
         Some(Scatter {
             attenuation: Color::ONE,

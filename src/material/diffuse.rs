@@ -70,7 +70,7 @@ impl Diffuse {
         };
         Some(Scatter {
             attenuation,
-            direction: bounce_direction(self.bounce, hit.normal, rng),
+            direction: hit.reflected_above(bounce_direction(self.bounce, hit.shading_normal, rng)),
         })
     }
 }

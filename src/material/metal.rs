@@ -30,16 +30,16 @@ impl Metal {
     /// are absorbed.
     #[inline]
     pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
-        let mut reflected = reflect(direction, hit.normal);
+        let mut reflected = reflect(direction, hit.shading_normal);
         if self.fuzz > 0.0 {
             reflected = reflected.normalize() + self.fuzz * sampling::unit_vector(rng);
         }
-        if reflected.dot(hit.normal) <= 0.0 {
+        if reflected.dot(hit.shading_normal) <= 0.0 {
             return None;
         }
         Some(Scatter {
             attenuation: self.albedo,
-            direction: reflected.normalize(),
+            direction: hit.reflected_above(reflected.normalize()),
         })
     }
 }

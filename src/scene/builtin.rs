@@ -111,6 +111,7 @@ impl Builder {
             center,
             radius,
             material: material.to_string(),
+            transform: Vec::new(),
         });
         self
     }

@@ -10,7 +10,7 @@
 
 use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc,
-    SamplingDesc, SceneDesc, ShadingDesc, Triple,
+    SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
 };
 use super::hint;
 use super::source::{Entry, Node, Value};
@@ -587,23 +587,201 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
 #[derive(Clone, Copy)]
 enum ObjectKind {
     Sphere,
+    Quad,
+    Box,
+    Mesh,
 }
 
-const OBJECTS: &[Kind<ObjectKind>] = &[Kind {
-    name: "sphere",
-    kind: ObjectKind::Sphere,
-    what: "a sphere",
-    fields: &["type", "center", "radius", "material"],
-    elsewhere: &[],
-}];
+const OBJECTS: &[Kind<ObjectKind>] = &[
+    Kind {
+        name: "sphere",
+        kind: ObjectKind::Sphere,
+        what: "a sphere",
+        fields: &["type", "center", "radius", "material", "transform"],
+        elsewhere: &[
+            ("corner", "quads"),
+            ("u", "quads"),
+            ("v", "quads"),
+            ("min", "boxes"),
+            ("max", "boxes"),
+            ("file", "meshes"),
+            ("smooth", "meshes"),
+        ],
+    },
+    Kind {
+        name: "quad",
+        kind: ObjectKind::Quad,
+        what: "a quad",
+        fields: &["type", "corner", "u", "v", "material", "transform"],
+        elsewhere: &[
+            ("center", "spheres"),
+            ("radius", "spheres"),
+            ("min", "boxes"),
+            ("max", "boxes"),
+            ("file", "meshes"),
+            ("smooth", "meshes"),
+        ],
+    },
+    Kind {
+        name: "box",
+        kind: ObjectKind::Box,
+        what: "a box",
+        fields: &["type", "min", "max", "material", "transform"],
+        elsewhere: &[
+            ("center", "spheres"),
+            ("radius", "spheres"),
+            ("corner", "quads"),
+            ("u", "quads"),
+            ("v", "quads"),
+            ("file", "meshes"),
+            ("smooth", "meshes"),
+        ],
+    },
+    Kind {
+        name: "mesh",
+        kind: ObjectKind::Mesh,
+        what: "a mesh",
+        fields: &["type", "file", "material", "smooth", "transform"],
+        elsewhere: &[
+            ("center", "spheres"),
+            ("radius", "spheres"),
+            ("corner", "quads"),
+            ("u", "quads"),
+            ("v", "quads"),
+            ("min", "boxes"),
+            ("max", "boxes"),
+        ],
+    },
+];
 
 fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
     let (kind, what, t) = tagged(node, path, "an object", OBJECTS)?;
+    let material = || -> Result<String> { Ok(t.require("material", what, string)?.to_string()) };
+    let transform = t.optional("transform", transforms)?.unwrap_or_default();
     Ok(match kind {
         ObjectKind::Sphere => ObjectDesc::Sphere {
             center: t.require("center", what, triple)?,
             radius: t.require("radius", what, float)?,
-            material: t.require("material", what, string)?.to_string(),
+            material: material()?,
+            transform,
+        },
+        ObjectKind::Quad => ObjectDesc::Quad {
+            corner: t.require("corner", what, triple)?,
+            u: t.require("u", what, triple)?,
+            v: t.require("v", what, triple)?,
+            material: material()?,
+            transform,
+        },
+        ObjectKind::Box => ObjectDesc::Box {
+            min: t.require("min", what, triple)?,
+            max: t.require("max", what, triple)?,
+            material: material()?,
+            transform,
+        },
+        ObjectKind::Mesh => ObjectDesc::Mesh {
+            file: t.require("file", what, string)?.to_string(),
+            material: t.optional("material", string)?.map(str::to_string),
+            smooth: t.optional("smooth", boolean)?.unwrap_or(true),
+            transform,
         },
     })
+}
+
+const TRANSFORM_STEPS: &[&str] = &["translate", "rotate", "scale", "matrix"];
+
+/// A `transform` list: tables of one step each.
+fn transforms(node: &Node, path: &str) -> Result<Vec<TransformDesc>> {
+    let Value::Array(items) = &node.value else {
+        return Err(error(
+            path,
+            &node.span,
+            format!(
+                "expected a list of steps such as [{{ translate = [0, 1, 0] }}, {{ scale = 2 }}], got {}",
+                node.value.describe()
+            ),
+        ));
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| transform_step(item, &format!("{path}[{i}]")))
+        .collect()
+}
+
+fn transform_step(node: &Node, path: &str) -> Result<TransformDesc> {
+    let t = Table::new(node, path, "a transform step", TRANSFORM_STEPS, &[])?;
+    let [entry] = t.entries else {
+        return Err(error(
+            path,
+            &node.span,
+            format!(
+                "a transform step has exactly one of {}, got {}",
+                quoted(TRANSFORM_STEPS),
+                t.entries.len()
+            ),
+        ));
+    };
+    let p = t.path(&entry.key);
+    let n = &entry.node;
+    Ok(match entry.key.as_str() {
+        "translate" => TransformDesc::Translate(triple(n, &p)?),
+        "rotate" => {
+            let r = Table::new(n, &p, "a rotation", &["axis", "degrees"], &[])?;
+            TransformDesc::Rotate {
+                axis: r.require("axis", "a rotation", triple)?,
+                degrees: r.require("degrees", "a rotation", float)?,
+            }
+        }
+        "scale" => TransformDesc::Scale(match &n.value {
+            Value::Array(_) => ScaleDesc::PerAxis(triple(n, &p)?),
+            Value::Float(_) | Value::Integer(_) => ScaleDesc::Uniform(float(n, &p)?),
+            other => {
+                return Err(error(
+                    &p,
+                    &n.span,
+                    format!(
+                        "expected a number or an array of 3 numbers [x, y, z], got {}",
+                        other.describe()
+                    ),
+                ))
+            }
+        }),
+        _ => TransformDesc::Matrix(matrix(n, &p)?),
+    })
+}
+
+/// Four rows of four numbers.
+fn matrix(node: &Node, path: &str) -> Result<[[f64; 4]; 4]> {
+    let bad = |got: String| {
+        error(
+            path,
+            &node.span,
+            format!("expected 4 rows of 4 numbers [[a, b, c, d], …], got {got}"),
+        )
+    };
+    let Value::Array(rows) = &node.value else {
+        return Err(bad(node.value.describe()));
+    };
+    if rows.len() != 4 {
+        return Err(bad(format!("{} rows", rows.len())));
+    }
+    let mut m = [[0.0; 4]; 4];
+    for (i, row) in rows.iter().enumerate() {
+        let row_path = format!("{path}[{i}]");
+        match &row.value {
+            Value::Array(items) if items.len() == 4 => {
+                for (j, item) in items.iter().enumerate() {
+                    m[i][j] = float(item, &format!("{row_path}[{j}]"))?;
+                }
+            }
+            other => {
+                return Err(error(
+                    &row_path,
+                    &row.span,
+                    format!("expected a row of 4 numbers, got {}", other.describe()),
+                ))
+            }
+        }
+    }
+    Ok(m)
 }

@@ -230,7 +230,7 @@ pub enum AttenuationDesc {
     Absorb,
 }
 
-/// An object of the scene.
+/// An object of the scene. Every kind may be placed with a `transform`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum ObjectDesc {
@@ -242,5 +242,103 @@ pub enum ObjectDesc {
         radius: f64,
         /// Name of a material in `materials`.
         material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
     },
+    /// A parallelogram with corners Q, Q + u, Q + u + v, Q + v.
+    Quad {
+        /// The corner Q.
+        corner: Triple,
+        /// The first edge u.
+        u: Triple,
+        /// The second edge v (not parallel to u).
+        v: Triple,
+        /// Name of a material in `materials`.
+        material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
+    /// An axis-aligned box from `min` to `max` (six quads), before its
+    /// transform.
+    Box {
+        /// The lowest corner.
+        min: Triple,
+        /// The highest corner: above `min` on every axis.
+        max: Triple,
+        /// Name of a material in `materials`.
+        material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
+    /// A triangle mesh read from a file (.obj, .gltf or .glb).
+    Mesh {
+        /// The file, relative to the scene file.
+        file: String,
+        /// Name of a material in `materials` for the whole mesh; when
+        /// absent, the file's own materials (and a grey diffuse where the
+        /// file gives none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<String>,
+        /// Interpolate the file's vertex normals (smooth shading); false
+        /// shades every triangle flat.
+        #[serde(default = "yes", skip_serializing_if = "is_true")]
+        smooth: bool,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
+}
+
+impl ObjectDesc {
+    /// The object's transform steps.
+    pub fn transform(&self) -> &[TransformDesc] {
+        match self {
+            ObjectDesc::Sphere { transform, .. }
+            | ObjectDesc::Quad { transform, .. }
+            | ObjectDesc::Box { transform, .. }
+            | ObjectDesc::Mesh { transform, .. } => transform,
+        }
+    }
+}
+
+/// One step of an object's placement; a list of steps is applied in the
+/// order written, the first entry first.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum TransformDesc {
+    /// Move by this vector.
+    Translate(Triple),
+    /// Turn about an axis through the origin, counter-clockwise looking
+    /// down the axis towards the origin.
+    Rotate {
+        /// The axis (any length but zero).
+        axis: Triple,
+        /// The angle in degrees.
+        degrees: f64,
+    },
+    /// Scale about the origin, by one factor or one per axis (none zero).
+    Scale(ScaleDesc),
+    /// A 4×4 affine matrix, row by row; the last row must be [0, 0, 0, 1].
+    Matrix([[f64; 4]; 4]),
+}
+
+/// A scale factor: one for every axis, or one per axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleDesc {
+    /// The same factor on every axis.
+    Uniform(f64),
+    /// A factor per axis.
+    PerAxis(Triple),
 }

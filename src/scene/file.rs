@@ -163,6 +163,8 @@ pub struct SceneFile {
     pub format: Format,
     /// The scene it describes, with defaults filled in.
     pub desc: SceneDesc,
+    /// The directory mesh files are relative to: the file's own.
+    pub dir: std::path::PathBuf,
     source: String,
     root: Node,
 }
@@ -195,10 +197,13 @@ impl SceneFile {
             err.line_col = Some(source::line_col(&text, offset));
             err
         })?;
-        SceneFile::parse(name, text, format)
+        let mut file = SceneFile::parse(name, text, format)?;
+        file.dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        Ok(file)
     }
 
-    /// Parses `text` in `format`; `name` is used in messages.
+    /// Parses `text` in `format`; `name` is used in messages, and mesh
+    /// files are found relative to the working directory.
     pub fn parse(
         name: impl Into<String>,
         text: String,
@@ -229,6 +234,7 @@ impl SceneFile {
             name,
             format,
             desc,
+            dir: std::path::PathBuf::new(),
             source: text,
             root,
         })
@@ -245,7 +251,8 @@ impl SceneFile {
     pub fn resolve(&self, overrides: &Overrides) -> Result<(SceneDesc, Scene), SceneFileError> {
         let mut desc = self.desc.clone();
         overrides.apply(&mut desc);
-        let scene = Scene::from_desc(&desc).map_err(|e| self.locate(&e, overrides))?;
+        let scene =
+            Scene::from_desc_in(&desc, &self.dir).map_err(|e| self.locate(&e, overrides))?;
         Ok((desc, scene))
     }
 

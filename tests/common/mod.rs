@@ -54,6 +54,7 @@ pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth:
             center: FURNACE_CENTER,
             radius: FURNACE_RADIUS,
             material: "m".into(),
+            transform: Vec::new(),
         }],
     };
     Scene::from_desc(&desc).unwrap()

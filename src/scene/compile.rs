@@ -1,0 +1,710 @@
+//! Turning a scene description into a [`Scene`]: settings, camera,
+//! background, materials and objects checked and compiled; meshes loaded,
+//! placed once in world space or shared by instances.
+
+use super::desc::{
+    AttenuationDesc, BackgroundDesc, BounceDesc, MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc,
+};
+use super::world::{Group, Mesh, Shapes, Surface, World};
+use super::{
+    invalid, Background, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings,
+    MAX_COORDINATE, MAX_PIXELS,
+};
+use crate::camera::{Camera, CameraError, CameraSettings};
+use crate::geometry::transform::{Transform, TransformStep};
+use crate::geometry::{Quad, Sphere};
+use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
+use crate::math::{Color, Vec3};
+use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The factor of [`HitRecord::error`]: the hit point and its offset from the
+/// centre are each rounded to about 2⁻²⁴ of their size (the point's
+/// coordinates, the radius); 2⁻²⁰ leaves a wide margin over their sum. With
+/// epsilon 0 (the notes' demonstration of shadow acne) it is 0, and rays
+/// leave from the hit point itself, as in the notes.
+fn error_scale(epsilon: f32) -> f32 {
+    if epsilon > 0.0 {
+        1.0 / (1u32 << 20) as f32
+    } else {
+        0.0
+    }
+}
+
+fn vec3(t: [f64; 3]) -> Vec3 {
+    Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32)
+}
+
+/// Accepts numbers that stay finite once converted to the renderer's `f32`.
+/// `field` is only formatted when a number is refused (scene files may hold
+/// millions of spheres).
+fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
+    // `!(a <= b)` also catches NaN.
+    match values.iter().find(|v| !(v.abs() <= f64::from(f32::MAX))) {
+        None => Ok(()),
+        Some(v) => Err(invalid(
+            field.to_string(),
+            format!(
+                "must be a finite number of magnitude at most {:e}, got {v}",
+                f32::MAX
+            ),
+        )),
+    }
+}
+
+fn color(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+    finite(field, &c)?;
+    if c.iter().any(|&v| v < 0.0) {
+        return Err(invalid(
+            field,
+            format!("colour components must not be negative, got {c:?}"),
+        ));
+    }
+    Ok(vec3(c))
+}
+
+fn albedo(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+    let v = color(field, c)?;
+    if c.iter().any(|&x| x > 1.0) {
+        return Err(invalid(
+            field,
+            format!("albedo components must be in [0, 1], got {c:?}"),
+        ));
+    }
+    Ok(v)
+}
+
+impl Scene {
+    /// Validates and compiles a scene description; mesh files are found
+    /// relative to the working directory.
+    pub fn from_desc(desc: &SceneDesc) -> Result<Scene, SceneError> {
+        Self::from_desc_in(desc, Path::new(""))
+    }
+
+    /// Validates and compiles a scene description whose mesh files are
+    /// relative to `base` (the scene file's directory).
+    pub fn from_desc_in(desc: &SceneDesc, base: &Path) -> Result<Scene, SceneError> {
+        let settings = compile_settings(desc)?;
+        let camera = compile_camera(desc, &settings)?;
+        let background = match &desc.background {
+            BackgroundDesc::Gradient { bottom, top } => Background::Gradient {
+                bottom: color("background.bottom", *bottom)?,
+                top: color("background.top", *top)?,
+            },
+            BackgroundDesc::Solid { color: c } => Background::Solid(color("background.color", *c)?),
+        };
+        let mut materials = Vec::with_capacity(desc.materials.len());
+        let mut material_index = HashMap::with_capacity(desc.materials.len());
+        for (name, m) in &desc.materials {
+            material_index.insert(name.as_str(), materials.len() as u32);
+            materials.push(compile_material(&format!("materials.{name}"), m)?);
+        }
+        let mut objects = Objects {
+            desc,
+            base,
+            materials,
+            material_index,
+            top: Shapes::default(),
+            spheres: Vec::with_capacity(desc.objects.len()),
+            groups: Vec::new(),
+            instances: Vec::new(),
+            models: HashMap::new(),
+            placements: Vec::new(),
+            sources: Vec::new(),
+            stats: SceneStats::default(),
+        };
+        for (i, object) in desc.objects.iter().enumerate() {
+            objects.add(i, object)?;
+        }
+        objects.place_meshes()?;
+        let Objects {
+            materials,
+            top,
+            spheres,
+            groups,
+            instances,
+            sources,
+            mut stats,
+            ..
+        } = objects;
+        let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
+        stats.instances = instances.len() as u64;
+        let scene = Scene {
+            settings,
+            camera,
+            background,
+            materials,
+            spheres,
+            sources,
+            stats,
+            world,
+        };
+        let mesh_bytes: usize = scene
+            .world
+            .top
+            .meshes
+            .iter()
+            .chain(scene.world.groups.iter().flat_map(|g| &g.shapes.meshes))
+            .map(|m| m.data.heap_bytes())
+            .sum();
+        let geometry_bytes = (mesh_bytes + scene.bvh_memory_bytes()) as u64;
+        Ok(Scene {
+            stats: SceneStats {
+                geometry_bytes,
+                ..scene.stats
+            },
+            ..scene
+        })
+    }
+}
+
+fn compile_camera(desc: &SceneDesc, settings: &Settings) -> Result<Camera, SceneError> {
+    let cam = &desc.camera;
+    finite("camera.vfov", &[cam.vfov])?;
+    finite("camera.lookfrom", &cam.lookfrom)?;
+    finite("camera.lookat", &cam.lookat)?;
+    finite("camera.vup", &cam.vup)?;
+    finite("camera.defocus_angle", &[cam.defocus_angle])?;
+    let focus_dist = match cam.focus_dist {
+        Some(d) => {
+            finite("camera.focus_dist", &[d])?;
+            d as f32
+        }
+        None => {
+            let d = glam::DVec3::from(cam.lookfrom).distance(cam.lookat.into());
+            if !(d as f32).is_finite() {
+                return Err(SceneError::Camera(CameraError::Overflow));
+            }
+            d as f32
+        }
+    };
+    Ok(Camera::new(
+        &CameraSettings {
+            vfov: cam.vfov as f32,
+            lookfrom: vec3(cam.lookfrom),
+            lookat: vec3(cam.lookat),
+            vup: vec3(cam.vup),
+            defocus_angle: cam.defocus_angle as f32,
+            focus_dist,
+        },
+        settings.width,
+        settings.height,
+    )?)
+}
+
+/// A loaded mesh file, shared by every object that names it.
+struct LoadedModel {
+    model: Model,
+    /// Scene material of each of the file's materials, once mapped.
+    materials: Vec<Option<u32>>,
+}
+
+/// One placement of one mesh of a file.
+struct Placement {
+    /// Which mesh: (file, mesh of the file, material override, smooth).
+    key: (PathBuf, usize, Option<u32>, bool),
+    transform: Transform,
+}
+
+/// The objects being compiled.
+struct Objects<'a> {
+    desc: &'a SceneDesc,
+    base: &'a Path,
+    materials: Vec<Material>,
+    material_index: HashMap<&'a str, u32>,
+    top: Shapes,
+    spheres: Vec<Sphere>,
+    groups: Vec<Group>,
+    instances: Vec<(u32, Transform)>,
+    models: HashMap<PathBuf, LoadedModel>,
+    placements: Vec<Placement>,
+    sources: Vec<MeshSource>,
+    stats: SceneStats,
+}
+
+impl<'a> Objects<'a> {
+    fn material(&self, i: usize, name: &str) -> Result<u32, SceneError> {
+        self.material_index
+            .get(name)
+            .copied()
+            .ok_or_else(|| SceneError::UnknownMaterial {
+                field: format!("objects[{i}].material"),
+                name: name.to_string(),
+                known: self.desc.materials.keys().cloned().collect(),
+            })
+    }
+
+    fn add(&mut self, i: usize, object: &'a ObjectDesc) -> Result<(), SceneError> {
+        let transform = compile_transform(i, object.transform())?;
+        match object {
+            ObjectDesc::Sphere {
+                center,
+                radius,
+                material,
+                ..
+            } => {
+                finite(format_args!("objects[{i}].center"), center)?;
+                finite(format_args!("objects[{i}].radius"), &[*radius])?;
+                if !(*radius as f32 > 0.0) {
+                    return Err(invalid(
+                        format!("objects[{i}].radius"),
+                        format!("must be greater than 0, got {radius}"),
+                    ));
+                }
+                // The intersection squares the radius and distances of the
+                // order of the centre's coordinates, in f32.
+                let extent = center.iter().fold(*radius, |m, c| m.max(c.abs()));
+                if extent > MAX_COORDINATE {
+                    return Err(invalid(
+                        format!("objects[{i}]"),
+                        format!(
+                            "centre and radius must be at most {MAX_COORDINATE:e} in size, so that their squares fit in f32"
+                        ),
+                    ));
+                }
+                let m = self.material(i, material)?;
+                let sphere = Sphere::new(vec3(*center), *radius as f32);
+                match similarity(&transform) {
+                    Some(scale) => {
+                        let placed =
+                            Sphere::new(transform.point(sphere.center), sphere.radius * scale);
+                        if !placed.center.is_finite() || !(placed.radius.is_finite()) {
+                            return Err(out_of_range(i));
+                        }
+                        self.top.spheres.push(Surface::new(&placed, m));
+                        self.spheres.push(placed);
+                    }
+                    None => {
+                        // Stretched unevenly: an ellipsoid, traced as the
+                        // sphere in its own space.
+                        let shapes = Shapes {
+                            spheres: vec![Surface::new(&sphere, m)],
+                            ..Shapes::default()
+                        };
+                        self.groups.push(Group::new(shapes));
+                        self.instances
+                            .push((self.groups.len() as u32 - 1, transform));
+                    }
+                }
+            }
+            ObjectDesc::Quad {
+                corner,
+                u,
+                v,
+                material,
+                ..
+            } => {
+                for (name, value) in [("corner", corner), ("u", u), ("v", v)] {
+                    finite(format_args!("objects[{i}].{name}"), value)?;
+                }
+                let m = self.material(i, material)?;
+                let quad = place_quad(i, &transform, vec3(*corner), vec3(*u), vec3(*v))?;
+                self.top.quads.push((quad, m));
+            }
+            ObjectDesc::Box {
+                min, max, material, ..
+            } => {
+                finite(format_args!("objects[{i}].min"), min)?;
+                finite(format_args!("objects[{i}].max"), max)?;
+                if !(0..3).all(|k| (min[k] as f32) < (max[k] as f32)) {
+                    return Err(invalid(
+                        format!("objects[{i}].max"),
+                        format!("must be greater than min on every axis, got min {min:?} and max {max:?}"),
+                    ));
+                }
+                let m = self.material(i, material)?;
+                for (q, u, v) in box_faces(vec3(*min), vec3(*max)) {
+                    let quad = place_quad(i, &transform, q, u, v)?;
+                    self.top.quads.push((quad, m));
+                }
+            }
+            ObjectDesc::Mesh {
+                file,
+                material,
+                smooth,
+                ..
+            } => {
+                let override_material = material
+                    .as_deref()
+                    .map(|name| self.material(i, name))
+                    .transpose()?;
+                let path = self.load(i, file)?;
+                let model = &self.models[&path].model;
+                for (mesh, node) in &model.instances {
+                    let node = mat4_transform(node).ok_or_else(|| {
+                        invalid(
+                            format!("objects[{i}].file"),
+                            format!("{file}: a node's transform is singular or out of range"),
+                        )
+                    })?;
+                    let placed = transform.compose(&node).ok_or_else(|| {
+                        invalid(
+                            format!("objects[{i}].transform"),
+                            "together with the file's own node transforms, the transform is singular or out of range",
+                        )
+                    })?;
+                    self.placements.push(Placement {
+                        key: (path.clone(), *mesh, override_material, *smooth),
+                        transform: placed,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Loads mesh file `file` of object `i` (once per file), returning
+    /// where it was found.
+    fn load(&mut self, i: usize, file: &str) -> Result<PathBuf, SceneError> {
+        let path = if Path::new(file).is_absolute() {
+            PathBuf::from(file)
+        } else {
+            self.base.join(file)
+        };
+        let path = std::fs::canonicalize(&path).unwrap_or(path);
+        if self.models.contains_key(&path) {
+            return Ok(path);
+        }
+        let fail = |message: String| invalid(format!("objects[{i}].file"), message);
+        let model = mesh::load(&path).map_err(|e| fail(e.to_string()))?;
+        let bytes = std::fs::read(&path).map_err(|e| fail(format!("{}: {e}", path.display())))?;
+        self.sources.push(MeshSource {
+            file: file.to_string(),
+            crc: crc32fast::hash(&bytes),
+            len: bytes.len() as u64,
+        });
+        self.stats.skipped_degenerate += model.skipped_degenerate as u64;
+        let materials = vec![None; model.materials.len() + 1];
+        self.models
+            .insert(path.clone(), LoadedModel { model, materials });
+        Ok(path)
+    }
+
+    /// The scene material of material `m` of the file at `path`
+    /// (`NO_MATERIAL`: a default grey diffuse).
+    fn file_material(&mut self, path: &Path, m: u32) -> u32 {
+        let loaded = self.models.get_mut(path).expect("loaded");
+        let slot = if m == NO_MATERIAL {
+            loaded.model.materials.len()
+        } else {
+            m as usize
+        };
+        if let Some(index) = loaded.materials[slot] {
+            return index;
+        }
+        let material = loaded.model.materials.get(slot).map_or_else(
+            || MeshMaterial::default().to_material(),
+            MeshMaterial::to_material,
+        );
+        let index = self.materials.len() as u32;
+        self.materials.push(material);
+        loaded.materials[slot] = Some(index);
+        index
+    }
+
+    /// Places every mesh: one placed once goes into the scene's tree in
+    /// world space; one placed several times is stored once with a tree of
+    /// its own, and placed by instances.
+    fn place_meshes(&mut self) -> Result<(), SceneError> {
+        let placements = std::mem::take(&mut self.placements);
+        let mut order: Vec<&(PathBuf, usize, Option<u32>, bool)> = Vec::new();
+        let mut by_key: HashMap<&(PathBuf, usize, Option<u32>, bool), Vec<Transform>> =
+            HashMap::new();
+        for p in &placements {
+            let list = by_key.entry(&p.key).or_default();
+            if list.is_empty() {
+                order.push(&p.key);
+            }
+            list.push(p.transform);
+        }
+        for key in order {
+            let transforms = &by_key[key];
+            let (path, mesh_index, override_material, smooth) = key;
+            let mesh = self.scene_mesh(path, *mesh_index, *override_material, *smooth);
+            let n = mesh.data.triangles.len() as u64;
+            self.stats.triangles += n;
+            self.stats.placed_triangles += n * transforms.len() as u64;
+            if let [transform] = transforms.as_slice() {
+                self.top.meshes.push(place_mesh(mesh, transform)?);
+            } else {
+                let shapes = Shapes {
+                    meshes: vec![mesh],
+                    ..Shapes::default()
+                };
+                self.groups.push(Group::new(shapes));
+                let group = self.groups.len() as u32 - 1;
+                self.instances
+                    .extend(transforms.iter().map(|t| (group, *t)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Mesh `mesh_index` of the file at `path` with scene materials.
+    fn scene_mesh(
+        &mut self,
+        path: &Path,
+        mesh_index: usize,
+        override_material: Option<u32>,
+        smooth: bool,
+    ) -> Mesh {
+        let source = &self.models[path].model.meshes[mesh_index];
+        let mut data = TriangleMesh {
+            positions: source.positions.clone(),
+            normals: if smooth { source.normals.clone() } else { None },
+            uvs: source.uvs.clone(),
+            triangles: source.triangles.clone(),
+            material: Vec::new(),
+        };
+        let file_materials = source.material.clone();
+        data.material = match override_material {
+            Some(m) => vec![m],
+            None => {
+                let mapped: Vec<u32> = file_materials
+                    .iter()
+                    .map(|&m| self.file_material(path, m))
+                    .collect();
+                if mapped.windows(2).all(|w| w[0] == w[1]) {
+                    mapped
+                        .first()
+                        .map_or_else(|| vec![self.file_material(path, NO_MATERIAL)], |&m| vec![m])
+                } else {
+                    mapped
+                }
+            }
+        };
+        data.material.shrink_to_fit();
+        Mesh { data }
+    }
+}
+
+/// The uniform scale of `transform` when it is a similarity (rotation,
+/// uniform scale, translation, reflection), which maps a sphere to a sphere.
+fn similarity(transform: &Transform) -> Option<f32> {
+    let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
+    let (a, b, c) = (x.length(), y.length(), z.length());
+    let close = |p: f32, q: f32| (p - q).abs() <= 1e-5 * p.max(q);
+    let orthogonal = [(x, y), (y, z), (z, x)]
+        .iter()
+        .all(|(p, q)| p.dot(*q).abs() <= 1e-5 * a * a);
+    (close(a, b) && close(b, c) && orthogonal).then_some(a)
+}
+
+fn out_of_range(i: usize) -> SceneError {
+    invalid(
+        format!("objects[{i}].transform"),
+        "places the object beyond the range of f32",
+    )
+}
+
+/// The quad at `corner` with edges `u`, `v`, placed by `transform`.
+fn place_quad(
+    i: usize,
+    transform: &Transform,
+    corner: Vec3,
+    u: Vec3,
+    v: Vec3,
+) -> Result<Quad, SceneError> {
+    if Quad::new(corner, u, v).is_none() {
+        return Err(invalid(
+            format!("objects[{i}]"),
+            format!("edges u {u} and v {v} are parallel or zero: the quad has no area"),
+        ));
+    }
+    let (q, u, v) = (
+        transform.point(corner),
+        transform.vector(u),
+        transform.vector(v),
+    );
+    if !(q.is_finite() && u.is_finite() && v.is_finite()) {
+        return Err(out_of_range(i));
+    }
+    Quad::new(q, u, v).ok_or_else(|| out_of_range(i))
+}
+
+/// The six faces (corner, u, v) of the box from `min` to `max`, each with
+/// u × v pointing out of the box.
+fn box_faces(min: Vec3, max: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
+    let d = max - min;
+    let (dx, dy, dz) = (
+        Vec3::new(d.x, 0.0, 0.0),
+        Vec3::new(0.0, d.y, 0.0),
+        Vec3::new(0.0, 0.0, d.z),
+    );
+    [
+        (Vec3::new(min.x, min.y, max.z), dx, dy),  // front (+z)
+        (Vec3::new(max.x, min.y, max.z), -dz, dy), // right (+x)
+        (Vec3::new(max.x, min.y, min.z), -dx, dy), // back (−z)
+        (Vec3::new(min.x, min.y, min.z), dz, dy),  // left (−x)
+        (Vec3::new(min.x, max.y, max.z), dx, -dz), // top (+y)
+        (Vec3::new(min.x, min.y, min.z), dz, dx),  // bottom (−y)
+    ]
+}
+
+/// `mesh` moved into world space by `transform`.
+fn place_mesh(mut mesh: Mesh, transform: &Transform) -> Result<Mesh, SceneError> {
+    if !transform.is_identity() {
+        for p in &mut mesh.data.positions {
+            *p = transform.point(Vec3::from(*p)).to_array();
+        }
+        if let Some(normals) = &mut mesh.data.normals {
+            for n in normals {
+                *n = transform.normal(Vec3::from(*n)).to_array();
+            }
+        }
+    }
+    if mesh.data.positions.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(invalid(
+            "objects",
+            "a mesh's transform places it beyond the range of f32",
+        ));
+    }
+    Ok(mesh)
+}
+
+/// A file's node matrix (column-major) as a transform.
+fn mat4_transform(m: &glam::Mat4) -> Option<Transform> {
+    let rows: [[f64; 4]; 4] =
+        std::array::from_fn(|r| std::array::from_fn(|c| f64::from(m.col(c)[r])));
+    Transform::from_steps(&[TransformStep::Matrix(rows)]).ok()
+}
+
+/// The transform of object `i`'s steps.
+fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<Transform, SceneError> {
+    let steps: Vec<TransformStep> = steps
+        .iter()
+        .map(|s| match s {
+            TransformDesc::Translate(t) => TransformStep::Translate(*t),
+            TransformDesc::Rotate { axis, degrees } => TransformStep::Rotate {
+                axis: *axis,
+                degrees: *degrees,
+            },
+            TransformDesc::Scale(ScaleDesc::Uniform(s)) => TransformStep::Scale([*s; 3]),
+            TransformDesc::Scale(ScaleDesc::PerAxis(s)) => TransformStep::Scale(*s),
+            TransformDesc::Matrix(m) => TransformStep::Matrix(*m),
+        })
+        .collect();
+    Transform::from_steps(&steps)
+        .map_err(|e| invalid(format!("objects[{i}].transform[{}]", e.index), e.message))
+}
+
+fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
+    let r = &desc.render;
+    if r.width == 0 {
+        return Err(invalid("render.width", "must be at least 1 pixel"));
+    }
+    let height = match r.height {
+        Some(0) => return Err(invalid("render.height", "must be at least 1 pixel")),
+        Some(h) => h,
+        None => {
+            finite("render.aspect_ratio", &[r.aspect_ratio])?;
+            if !(r.aspect_ratio > 0.0) {
+                return Err(invalid(
+                    "render.aspect_ratio",
+                    format!("must be greater than 0, got {}", r.aspect_ratio),
+                ));
+            }
+            let h = (f64::from(r.width) / r.aspect_ratio).floor();
+            if h > f64::from(u32::MAX) {
+                return Err(invalid(
+                    "render.aspect_ratio",
+                    "gives an image taller than 4294967295 pixels",
+                ));
+            }
+            (h as u32).max(1)
+        }
+    };
+    let pixels = u64::from(r.width) * u64::from(height);
+    if pixels > MAX_PIXELS {
+        return Err(invalid(
+            "render",
+            format!(
+                "image {}x{} has {pixels} pixels, more than the {MAX_PIXELS} lumen can hold in memory",
+                r.width, height
+            ),
+        ));
+    }
+    if r.samples_per_pixel == 0 {
+        return Err(invalid("render.samples_per_pixel", "must be at least 1"));
+    }
+    if r.max_depth == 0 {
+        return Err(invalid(
+            "render.max_depth",
+            "must be at least 1 (the camera ray)",
+        ));
+    }
+    finite("render.gamma", &[r.gamma])?;
+    if !(r.gamma as f32 > 0.0) {
+        return Err(invalid(
+            "render.gamma",
+            format!("must be greater than 0, got {}", r.gamma),
+        ));
+    }
+    finite("render.epsilon", &[r.epsilon])?;
+    if !(r.epsilon >= 0.0) {
+        return Err(invalid(
+            "render.epsilon",
+            format!("must not be negative, got {}", r.epsilon),
+        ));
+    }
+    Ok(Settings {
+        width: r.width,
+        height,
+        samples_per_pixel: r.samples_per_pixel,
+        max_depth: r.max_depth,
+        seed: r.seed,
+        sampling: r.sampling,
+        gamma: r.gamma as f32,
+        epsilon: r.epsilon as f32,
+        shading: r.shading,
+    })
+}
+
+fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
+    Ok(match m {
+        MaterialDesc::Diffuse {
+            albedo: a,
+            bounce,
+            attenuation,
+        } => Material::Diffuse(Diffuse {
+            albedo: albedo(&format!("{field}.albedo"), *a)?,
+            bounce: match bounce {
+                BounceDesc::Cube => BounceModel::Cube,
+                BounceDesc::SphereVolume => BounceModel::SphereVolume,
+                BounceDesc::Lambertian => BounceModel::Lambertian,
+                BounceDesc::Hemisphere => BounceModel::Hemisphere,
+            },
+            attenuation: match attenuation {
+                AttenuationDesc::Scale => Attenuation::Scale,
+                AttenuationDesc::Absorb => Attenuation::Absorb,
+            },
+        }),
+        MaterialDesc::Metal { albedo: a, fuzz } => {
+            finite(format_args!("{field}.fuzz"), &[*fuzz])?;
+            if !(0.0..=1.0).contains(fuzz) {
+                return Err(invalid(
+                    format!("{field}.fuzz"),
+                    format!("must be in [0, 1], got {fuzz}"),
+                ));
+            }
+            Material::Metal(Metal {
+                albedo: albedo(&format!("{field}.albedo"), *a)?,
+                fuzz: *fuzz as f32,
+            })
+        }
+        MaterialDesc::Dielectric { ior, refract_only } => {
+            finite(format_args!("{field}.ior"), &[*ior])?;
+            if !(*ior as f32 > 0.0) {
+                return Err(invalid(
+                    format!("{field}.ior"),
+                    format!("index of refraction must be greater than 0, got {ior}"),
+                ));
+            }
+            Material::Dielectric(Dielectric {
+                ior: *ior as f32,
+                refract_only: *refract_only,
+            })
+        }
+    })
+}

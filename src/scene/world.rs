@@ -1,0 +1,374 @@
+//! The scene's shapes compiled for tracing: the tree over them, and what
+//! shading needs of each (materials, normals, texture coordinates), so that
+//! a hit found by the tree becomes a [`HitRecord`].
+//!
+//! The tree's items are numbered spheres first, then quads, then the
+//! triangles of each mesh placed once (stored in world space), then the
+//! instances of meshes placed several times (stored once, in object space,
+//! with a tree of their own). A shape's number is its place in the order of
+//! hits at exactly the same distance.
+
+use crate::geometry::bvh::Hit;
+use crate::geometry::hit::face_normal;
+use crate::geometry::transform::Transform;
+use crate::geometry::{Bvh, HitRecord, Instance, Primitive, Quad, Sphere, Triangle};
+use crate::math::{Point3, Vec3};
+use crate::mesh::TriangleMesh;
+use crate::ray::Ray;
+use std::sync::Arc;
+
+/// The part of a sphere and its material that the record of a hit needs,
+/// together in 32 bytes: one cache line per hit instead of two, and a
+/// multiplication by the inverse radius instead of a division.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Surface {
+    pub(crate) center: Point3,
+    pub(crate) inverse_radius: f32,
+    pub(crate) radius: f32,
+    pub(crate) material: u32,
+}
+
+impl Surface {
+    pub(crate) fn new(sphere: &Sphere, material: u32) -> Self {
+        Surface {
+            center: sphere.center,
+            inverse_radius: 1.0 / sphere.radius,
+            radius: sphere.radius,
+            material,
+        }
+    }
+}
+
+/// A triangle mesh with a scene material per triangle (or one for all).
+#[derive(Clone, Debug)]
+pub(crate) struct Mesh {
+    pub(crate) data: TriangleMesh,
+}
+
+impl Mesh {
+    fn triangle(&self, k: usize) -> Triangle {
+        let [a, b, c] = self.data.triangles[k].map(|i| Vec3::from(self.data.positions[i as usize]));
+        Triangle::new(a, b, c)
+    }
+
+    fn material(&self, k: usize) -> u32 {
+        let m = &self.data.material;
+        if m.len() == 1 {
+            m[0]
+        } else {
+            m[k]
+        }
+    }
+}
+
+/// Shapes numbered as the items of one tree (see the module documentation).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Shapes {
+    pub(crate) spheres: Vec<Surface>,
+    pub(crate) quads: Vec<(Quad, u32)>,
+    pub(crate) meshes: Vec<Mesh>,
+}
+
+/// What item `index` of a tree is.
+enum Item {
+    Sphere(usize),
+    Quad(usize),
+    Triangle(usize, usize),
+    Instance(usize),
+}
+
+impl Shapes {
+    /// The tree's items, in their numbering.
+    pub(crate) fn primitives(&self) -> Vec<Primitive> {
+        let mut items: Vec<Primitive> = self
+            .spheres
+            .iter()
+            .map(|s| Primitive::Sphere(Sphere::new(s.center, s.radius)))
+            .collect();
+        items.extend(self.quads.iter().map(|(q, _)| Primitive::Quad(*q)));
+        for mesh in &self.meshes {
+            items.extend(
+                (0..mesh.data.triangles.len()).map(|k| Primitive::Triangle(mesh.triangle(k))),
+            );
+        }
+        items
+    }
+
+    fn item(&self, mut index: usize) -> Item {
+        if index < self.spheres.len() {
+            return Item::Sphere(index);
+        }
+        index -= self.spheres.len();
+        if index < self.quads.len() {
+            return Item::Quad(index);
+        }
+        index -= self.quads.len();
+        for (m, mesh) in self.meshes.iter().enumerate() {
+            let n = mesh.data.triangles.len();
+            if index < n {
+                return Item::Triangle(m, index);
+            }
+            index -= n;
+        }
+        Item::Instance(index)
+    }
+
+    /// The number of items before the instances.
+    pub(crate) fn len(&self) -> usize {
+        self.spheres.len()
+            + self.quads.len()
+            + self
+                .meshes
+                .iter()
+                .map(|m| m.data.triangles.len())
+                .sum::<usize>()
+    }
+
+    /// The record of a hit on item `index` at distance `t` of `ray`, in the
+    /// space the shapes are stored in; `None` for an instance.
+    #[inline(always)]
+    fn record(&self, ray: &Ray, t: f32, index: u32, error_scale: f32) -> Result<HitRecord, usize> {
+        Ok(match self.item(index as usize) {
+            Item::Sphere(k) => {
+                let surface = &self.spheres[k];
+                let point = ray.at(t);
+                let outward = (point - surface.center) * surface.inverse_radius;
+                let (normal, front_face) = face_normal(ray, outward);
+                HitRecord {
+                    point,
+                    normal,
+                    shading_normal: normal,
+                    uv: sphere_uv(outward),
+                    t,
+                    front_face,
+                    material: surface.material,
+                    object: index,
+                    error: (point.abs().max_element() + surface.radius) * error_scale,
+                }
+            }
+            Item::Quad(k) => {
+                let (quad, material) = &self.quads[k];
+                // On the plane: the ray's rounding along its length removed.
+                let p = ray.at(t);
+                let point = p - (quad.normal.dot(p) - quad.d) * quad.normal;
+                let (normal, front_face) = face_normal(ray, quad.normal);
+                let (alpha, beta) = quad.coordinates(point);
+                HitRecord {
+                    point,
+                    normal,
+                    shading_normal: normal,
+                    uv: [alpha, beta],
+                    t,
+                    front_face,
+                    material: *material,
+                    object: index,
+                    error: (point.abs().max_element() + quad.d.abs()) * error_scale,
+                }
+            }
+            Item::Triangle(m, k) => {
+                let mesh = &self.meshes[m];
+                triangle_record(ray, t, mesh, k, index, error_scale)
+            }
+            Item::Instance(i) => return Err(i),
+        })
+    }
+}
+
+/// A sphere's texture coordinates at the outward normal `n`: u = φ/2π
+/// around the y axis from −x, v = θ/π from −y, as in *The Next Week*.
+#[inline(always)]
+fn sphere_uv(n: Vec3) -> [f32; 2] {
+    let theta = (-n.y).clamp(-1.0, 1.0).acos();
+    let phi = (-n.z).atan2(n.x) + std::f32::consts::PI;
+    [
+        phi / (2.0 * std::f32::consts::PI),
+        theta / std::f32::consts::PI,
+    ]
+}
+
+/// The record of a hit on triangle `k` of `mesh`. The point is rebuilt
+/// from its barycentric coordinates, so that it lies on the triangle to
+/// within the rounding of the vertices, whatever the ray's length.
+fn triangle_record(
+    ray: &Ray,
+    t: f32,
+    mesh: &Mesh,
+    k: usize,
+    index: u32,
+    error_scale: f32,
+) -> HitRecord {
+    let tri = mesh.triangle(k);
+    let [a, b, c] = tri.vertices;
+    let geometric = tri.area_normal().normalize();
+    let b_ = barycentrics(&tri, ray.at(t));
+    let point = b_[0] * a + b_[1] * b + b_[2] * c;
+    let (normal, front_face) = face_normal(ray, geometric);
+    let idx = mesh.data.triangles[k].map(|i| i as usize);
+    let shading_normal = match &mesh.data.normals {
+        Some(ns) => {
+            let n = b_[0] * Vec3::from(ns[idx[0]])
+                + b_[1] * Vec3::from(ns[idx[1]])
+                + b_[2] * Vec3::from(ns[idx[2]]);
+            let n = n.normalize_or_zero();
+            // Towards the side the geometric normal faces.
+            if n == Vec3::ZERO {
+                normal
+            } else if n.dot(normal) < 0.0 {
+                -n
+            } else {
+                n
+            }
+        }
+        None => normal,
+    };
+    let uv = match &mesh.data.uvs {
+        Some(uvs) => {
+            let [p, q, r] = idx.map(|i| uvs[i]);
+            [
+                b_[0] * p[0] + b_[1] * q[0] + b_[2] * r[0],
+                b_[0] * p[1] + b_[1] * q[1] + b_[2] * r[1],
+            ]
+        }
+        None => [b_[1], b_[2]],
+    };
+    let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
+    HitRecord {
+        point,
+        normal,
+        shading_normal,
+        uv,
+        t,
+        front_face,
+        material: mesh.material(k),
+        object: index,
+        error: extent.max_element() * error_scale,
+    }
+}
+
+/// The barycentric coordinates of `p` (near the triangle's plane) in
+/// `tri`, from the areas of the sub-triangles, clamped to the triangle.
+fn barycentrics(tri: &Triangle, p: Point3) -> [f32; 3] {
+    let [a, b, c] = tri.vertices;
+    let n = tri.area_normal();
+    let n2 = n.length_squared();
+    let b1 = (p - a).cross(c - a).dot(n) / n2;
+    let b2 = (b - a).cross(p - a).dot(n) / n2;
+    let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0));
+    let s = b1 + b2;
+    let (b1, b2) = if s > 1.0 { (b1 / s, b2 / s) } else { (b1, b2) };
+    [1.0 - b1 - b2, b1, b2]
+}
+
+/// Shapes shared by instances, with their own tree.
+#[derive(Clone, Debug)]
+pub(crate) struct Group {
+    pub(crate) shapes: Shapes,
+    pub(crate) bvh: Arc<Bvh>,
+}
+
+impl Group {
+    pub(crate) fn new(shapes: Shapes) -> Group {
+        let bvh = Arc::new(Bvh::new(&shapes.primitives()));
+        Group { shapes, bvh }
+    }
+}
+
+/// The compiled shapes of a scene.
+#[derive(Clone, Debug)]
+pub(crate) struct World {
+    pub(crate) bvh: Bvh,
+    pub(crate) top: Shapes,
+    pub(crate) groups: Vec<Group>,
+    /// Per instance: its group.
+    pub(crate) instance_group: Vec<u32>,
+    pub(crate) error_scale: f32,
+}
+
+impl World {
+    /// Builds the tree over `top` and the placements `instances` of
+    /// `groups` (group, transform).
+    pub(crate) fn new(
+        top: Shapes,
+        groups: Vec<Group>,
+        instances: &[(u32, Transform)],
+        error_scale: f32,
+    ) -> World {
+        let mut items = top.primitives();
+        let first = items.len() as u32;
+        let placed: Vec<Instance> = instances
+            .iter()
+            .map(|(g, transform)| Instance::new(*transform, groups[*g as usize].bvh.clone()))
+            .collect();
+        items.extend(
+            placed
+                .iter()
+                .enumerate()
+                .map(|(i, inst)| Primitive::Instance {
+                    bounds: inst.bounds(),
+                    index: i as u32,
+                }),
+        );
+        debug_assert_eq!(first as usize, top.len());
+        let bvh = Bvh::with_instances(&items, placed);
+        World {
+            bvh,
+            top,
+            groups,
+            instance_group: instances.iter().map(|(g, _)| *g).collect(),
+            error_scale,
+        }
+    }
+
+    /// The full record of a hit the tree found.
+    #[inline(always)]
+    pub(crate) fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
+        match self.top.record(ray, hit.t, hit.index, self.error_scale) {
+            Ok(record) => record,
+            Err(i) => self.instance_record(ray, hit, i),
+        }
+    }
+
+    #[inline(never)]
+    fn instance_record(&self, ray: &Ray, hit: Hit, i: usize) -> HitRecord {
+        let instance = &self.bvh.instances()[i];
+        let group = &self.groups[self.instance_group[i] as usize];
+        let transform = &instance.transform;
+        let (object_ray, scale) = transform.to_object_ray(ray);
+        let inner = group
+            .shapes
+            .record(&object_ray, hit.t * scale, hit.sub, self.error_scale)
+            .expect("instances hold no instances");
+        let outward = if inner.front_face {
+            inner.normal
+        } else {
+            -inner.normal
+        };
+        let point = transform.point(inner.point);
+        let (normal, front_face) = face_normal(ray, transform.normal(outward));
+        let mut shading_normal = transform.normal(inner.shading_normal);
+        if shading_normal.dot(normal) < 0.0 {
+            shading_normal = -shading_normal;
+        }
+        if !inner.is_smooth() {
+            shading_normal = normal;
+        }
+        // The transform stretches the object's rounding by at most its
+        // linear part's Frobenius norm.
+        let stretch = [Vec3::X, Vec3::Y, Vec3::Z]
+            .map(|e| transform.vector(e).length_squared())
+            .iter()
+            .sum::<f32>()
+            .sqrt();
+        HitRecord {
+            point,
+            normal,
+            shading_normal,
+            uv: inner.uv,
+            t: hit.t,
+            front_face,
+            material: inner.material,
+            object: hit.index,
+            error: inner.error * stretch * 4.0 + point.abs().max_element() * self.error_scale,
+        }
+    }
+}
