@@ -200,11 +200,15 @@ struct LoadedModel {
     materials: Vec<Option<u32>>,
 }
 
+/// Which mesh: (file, mesh of the file, smooth).
+type MeshKey = (PathBuf, usize, bool);
+
 /// One placement of one mesh of a file.
 struct Placement {
-    /// Which mesh: (file, mesh of the file, material override, smooth).
-    key: (PathBuf, usize, Option<u32>, bool),
+    key: MeshKey,
     transform: Transform,
+    /// The material that replaces the file's, if the object names one.
+    material: Option<u32>,
 }
 
 /// The objects being compiled.
@@ -216,7 +220,7 @@ struct Objects<'a> {
     top: Shapes,
     spheres: Vec<Sphere>,
     groups: Vec<Group>,
-    instances: Vec<(u32, Transform)>,
+    instances: Vec<(u32, Transform, Option<u32>)>,
     models: HashMap<PathBuf, LoadedModel>,
     placements: Vec<Placement>,
     sources: Vec<MeshSource>,
@@ -284,7 +288,7 @@ impl<'a> Objects<'a> {
                         };
                         self.groups.push(Group::new(shapes));
                         self.instances
-                            .push((self.groups.len() as u32 - 1, transform));
+                            .push((self.groups.len() as u32 - 1, transform, None));
                     }
                 }
             }
@@ -345,8 +349,9 @@ impl<'a> Objects<'a> {
                         )
                     })?;
                     self.placements.push(Placement {
-                        key: (path.clone(), *mesh, override_material, *smooth),
+                        key: (path.clone(), *mesh, *smooth),
                         transform: placed,
+                        material: override_material,
                     });
                 }
             }
@@ -408,26 +413,31 @@ impl<'a> Objects<'a> {
     /// its own, and placed by instances.
     fn place_meshes(&mut self) -> Result<(), SceneError> {
         let placements = std::mem::take(&mut self.placements);
-        let mut order: Vec<&(PathBuf, usize, Option<u32>, bool)> = Vec::new();
-        let mut by_key: HashMap<&(PathBuf, usize, Option<u32>, bool), Vec<Transform>> =
-            HashMap::new();
+        let mut order: Vec<&MeshKey> = Vec::new();
+        let mut by_key: HashMap<&MeshKey, Vec<&Placement>> = HashMap::new();
         for p in &placements {
             let list = by_key.entry(&p.key).or_default();
             if list.is_empty() {
                 order.push(&p.key);
             }
-            list.push(p.transform);
+            list.push(p);
         }
         for key in order {
-            let transforms = &by_key[key];
-            let (path, mesh_index, override_material, smooth) = key;
-            let mesh = self.scene_mesh(path, *mesh_index, *override_material, *smooth);
-            let n = mesh.data.triangles.len() as u64;
-            self.stats.triangles += n;
-            self.stats.placed_triangles += n * transforms.len() as u64;
-            if let [transform] = transforms.as_slice() {
-                self.top.meshes.push(place_mesh(mesh, transform)?);
+            let placed = &by_key[key];
+            let (path, mesh_index, smooth) = key;
+            if let [only] = placed.as_slice() {
+                let mesh = self.scene_mesh(path, *mesh_index, only.material, *smooth);
+                let n = mesh.data.triangles.len() as u64;
+                self.stats.triangles += n;
+                self.stats.placed_triangles += n;
+                self.top.meshes.push(place_mesh(mesh, &only.transform)?);
             } else {
+                // Stored once with the file's materials; an instance whose
+                // object names a material uses it instead.
+                let mesh = self.scene_mesh(path, *mesh_index, None, *smooth);
+                let n = mesh.data.triangles.len() as u64;
+                self.stats.triangles += n;
+                self.stats.placed_triangles += n * placed.len() as u64;
                 let shapes = Shapes {
                     meshes: vec![mesh],
                     ..Shapes::default()
@@ -435,7 +445,7 @@ impl<'a> Objects<'a> {
                 self.groups.push(Group::new(shapes));
                 let group = self.groups.len() as u32 - 1;
                 self.instances
-                    .extend(transforms.iter().map(|t| (group, *t)));
+                    .extend(placed.iter().map(|p| (group, p.transform, p.material)));
             }
         }
         Ok(())

@@ -281,23 +281,25 @@ pub(crate) struct World {
     pub(crate) groups: Vec<Group>,
     /// Per instance: its group.
     pub(crate) instance_group: Vec<u32>,
+    /// Per instance: the material replacing its shapes' own, if any.
+    pub(crate) instance_material: Vec<Option<u32>>,
     pub(crate) error_scale: f32,
 }
 
 impl World {
     /// Builds the tree over `top` and the placements `instances` of
-    /// `groups` (group, transform).
+    /// `groups` (group, transform, material replacing the group's own).
     pub(crate) fn new(
         top: Shapes,
         groups: Vec<Group>,
-        instances: &[(u32, Transform)],
+        instances: &[(u32, Transform, Option<u32>)],
         error_scale: f32,
     ) -> World {
         let mut items = top.primitives();
         let first = items.len() as u32;
         let placed: Vec<Instance> = instances
             .iter()
-            .map(|(g, transform)| Instance::new(*transform, groups[*g as usize].bvh.clone()))
+            .map(|(g, transform, _)| Instance::new(*transform, groups[*g as usize].bvh.clone()))
             .collect();
         items.extend(
             placed
@@ -314,7 +316,8 @@ impl World {
             bvh,
             top,
             groups,
-            instance_group: instances.iter().map(|(g, _)| *g).collect(),
+            instance_group: instances.iter().map(|(g, ..)| *g).collect(),
+            instance_material: instances.iter().map(|(_, _, m)| *m).collect(),
             error_scale,
         }
     }
@@ -366,7 +369,7 @@ impl World {
             uv: inner.uv,
             t: hit.t,
             front_face,
-            material: inner.material,
+            material: self.instance_material[i].unwrap_or(inner.material),
             object: hit.index,
             error: inner.error * stretch * 4.0 + point.abs().max_element() * self.error_scale,
         }
