@@ -5,7 +5,10 @@
 # alike; prints each round's B/A ratio and their median.
 #
 # usage: scripts/ab-pair.sh BINARY_A BINARY_B [ROUNDS]   (needs taskset, two cores)
+# LUMEN_BENCH_ARGS adds arguments to both benches, e.g. "--workload
+# cover-400x225" when both binaries know it (it skips the other workloads).
 set -eu
+workload=${LUMEN_BENCH_ARGS:-}
 a=$1
 b=$2
 rounds=${3:-8}
@@ -17,7 +20,7 @@ trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"; exit 130' INT TERM
 
 # Runs binary $1 on core $2, its output to $3, in the background.
 bench() {
-    taskset -c "$2" "$1" bench --threads 1 --runs 3 --spp 64 >"$3" 2>&1 &
+    taskset -c "$2" "$1" bench --threads 1 --runs 3 --spp 64 $workload >"$3" 2>&1 &
 }
 
 # The cover's M rays/s in output file $1, or the output and exit 1.

@@ -3,7 +3,9 @@
 use crate::render::{render, RenderStats};
 use crate::rng::Rng;
 use crate::scene::builtin;
-use crate::scene::desc::{AttenuationDesc, BounceDesc, MaterialDesc, ObjectDesc, SceneDesc};
+use crate::scene::desc::{
+    AttenuationDesc, BounceDesc, MaterialDesc, ObjectDesc, SceneDesc, TransformDesc,
+};
 use crate::scene::{Scene, SceneError};
 use std::time::{Duration, Instant};
 
@@ -41,8 +43,94 @@ impl Measurement {
     }
 }
 
-/// The standard workloads: the cover at 400×225 and the three-ball scene,
-/// at `spp` samples per pixel and depth 50.
+/// The 235,136-triangle bunny of the mesh workload (the bunny split three
+/// times by midpoint subdivision), in the source tree.
+pub const BUNNY_235K: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny_235k.glb");
+
+/// The mesh workload: the 235,136-triangle bunny (diffuse 0.7, flat
+/// shading) on a 60×60 grey (0.5) floor quad at y = 0, under a uniform
+/// white sky, seen from (0, 8, 22) looking at (0, 4.5, 0) with a 40° field
+/// of view, 400×400, depth 8. `scripts/peers/mitsuba_bunny.py` renders the
+/// same scene in Mitsuba 3.
+pub fn bunny_scene(file: &str) -> SceneDesc {
+    let mut desc = SceneDesc {
+        caption: "the 235k-triangle bunny on a floor under a white sky".into(),
+        ..SceneDesc::default()
+    };
+    desc.render.width = 400;
+    desc.render.height = Some(400);
+    desc.render.max_depth = 8;
+    desc.camera.vfov = 40.0;
+    desc.camera.lookfrom = [0.0, 8.0, 22.0];
+    desc.camera.lookat = [0.0, 4.5, 0.0];
+    desc.background = crate::scene::desc::BackgroundDesc::Solid {
+        color: [1.0, 1.0, 1.0],
+    };
+    let diffuse = |a: f64| MaterialDesc::Diffuse {
+        albedo: [a; 3],
+        bounce: BounceDesc::Lambertian,
+        attenuation: AttenuationDesc::Scale,
+    };
+    desc.materials.insert("bunny".into(), diffuse(0.7));
+    desc.materials.insert("floor".into(), diffuse(0.5));
+    desc.objects.push(ObjectDesc::Quad {
+        corner: [-30.0, 0.0, -30.0],
+        u: [60.0, 0.0, 0.0],
+        v: [0.0, 0.0, 60.0],
+        material: "floor".into(),
+        transform: Vec::new(),
+    });
+    desc.objects.push(ObjectDesc::Mesh {
+        file: file.into(),
+        material: Some("bunny".into()),
+        smooth: false,
+        transform: Vec::new(),
+    });
+    desc
+}
+
+/// A field of `n` bunnies (`file`) on a grid 12 units apart, each turned
+/// about the vertical by its own angle: one mesh, `n` instances, seen from
+/// above at 400×225, depth 8.
+pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
+    let mut desc = bunny_scene(file);
+    desc.caption = format!("a field of {n} instanced bunnies");
+    desc.render.height = Some(225);
+    let side = (n as f64).sqrt().ceil().max(1.0) as usize;
+    let half = (side as f64 - 1.0) * 6.0;
+    desc.camera.lookfrom = [0.0, 1.5 * half + 30.0, 2.0 * half + 40.0];
+    desc.camera.lookat = [0.0, 0.0, 0.0];
+    desc.camera.vfov = 45.0;
+    let ObjectDesc::Quad { corner, u, v, .. } = &mut desc.objects[0] else {
+        unreachable!("the floor comes first")
+    };
+    let size = 12.0 * side as f64 + 60.0;
+    *corner = [-size / 2.0, 0.0, -size / 2.0];
+    *u = [size, 0.0, 0.0];
+    *v = [0.0, 0.0, size];
+    desc.objects.truncate(1);
+    let mut rng = Rng::new(FIELD_SEED);
+    for k in 0..n {
+        let (i, j) = ((k % side) as f64, (k / side) as f64);
+        desc.objects.push(ObjectDesc::Mesh {
+            file: file.into(),
+            material: Some("bunny".into()),
+            smooth: false,
+            transform: vec![
+                TransformDesc::Rotate {
+                    axis: [0.0, 1.0, 0.0],
+                    degrees: 360.0 * rng.next_f64(),
+                },
+                TransformDesc::Translate([12.0 * i - half, 0.0, 12.0 * j - half]),
+            ],
+        });
+    }
+    desc
+}
+
+/// The standard workloads: the cover at 400×225 and the three-ball scene
+/// (depth 50), and the mesh workload ([`bunny_scene`], depth 8), at `spp`
+/// samples per pixel.
 pub fn standard_workloads(spp: u32) -> Vec<Workload> {
     let mut cover = builtin::cover();
     cover.render.width = 400;
@@ -61,10 +149,57 @@ pub fn standard_workloads(spp: u32) -> Vec<Workload> {
         },
     ];
     for w in &mut list {
-        w.desc.render.samples_per_pixel = spp;
         w.desc.render.max_depth = 50;
     }
+    list.push(Workload {
+        name: "bunny-235k-400x400",
+        desc: bunny_scene(BUNNY_235K),
+    });
+    for w in &mut list {
+        w.desc.render.samples_per_pixel = spp;
+    }
     list
+}
+
+/// One row of the instancing table.
+#[derive(Clone, Debug)]
+pub struct InstancePoint {
+    /// Instances of the 235k-triangle bunny.
+    pub instances: usize,
+    /// Time to compile the scene (loading the mesh and building the trees).
+    pub build: Duration,
+    /// Bytes held by meshes and trees.
+    pub geometry_bytes: u64,
+    /// The process's peak resident memory after rendering, if known.
+    pub peak_bytes: Option<u64>,
+    /// The render measurement.
+    pub measurement: Measurement,
+}
+
+/// Builds and renders a field of `n` instances of the 235k-triangle bunny.
+pub fn measure_instances(n: usize, spp: u32, runs: usize) -> Result<InstancePoint, SceneError> {
+    let mut desc = bunny_field(BUNNY_235K, n);
+    desc.render.samples_per_pixel = spp;
+    let start = Instant::now();
+    let scene = Scene::from_desc(&desc)?;
+    let build = start.elapsed();
+    drop(desc);
+    let measurement = measure_scene("instances", &scene, runs);
+    Ok(InstancePoint {
+        instances: n,
+        build,
+        geometry_bytes: scene.stats.geometry_bytes,
+        peak_bytes: peak_memory(),
+        measurement,
+    })
+}
+
+/// The process's peak resident memory (Linux `VmHWM`), if known.
+pub fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 /// Renders `workload` `runs` times (after one warm-up) and takes the median time.

@@ -192,7 +192,7 @@ impl Mesh {
             });
             let e = |p: [f64; 2], q: [f64; 2]| q[0] * p[1] - q[1] * p[0];
             let f = [e(p[1], p[2]), e(p[2], p[0]), e(p[0], p[1])];
-            let zero = f.iter().any(|&x| x == 0.0);
+            let zero = f.contains(&0.0);
             let mixed = f.iter().any(|&x| x < 0.0) && f.iter().any(|&x| x > 0.0);
             zero && !mixed && f != [0.0; 3]
         })
@@ -881,10 +881,10 @@ fn rays_along_edges_and_in_planes_are_treated_as_a_displaced_ray() {
                             o[axis] = -d * 20.0;
                             o[(axis + 1) % 3] = face;
                             o[(axis + 2) % 3] = i as f32 * 0.5;
-                            check(o, dir, format!("in the plane of a face"));
+                            check(o, dir, "in the plane of a face".to_string());
                             o[(axis + 2) % 3] = face;
                             o[(axis + 1) % 3] = i as f32 * 0.5;
-                            check(o, dir, format!("in the plane of a face"));
+                            check(o, dir, "in the plane of a face".to_string());
                         }
                     }
                 }

@@ -69,23 +69,76 @@ pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<(
     Ok(())
 }
 
-pub(crate) fn bench_command(spp: u32, runs: u32) -> Result<()> {
+pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<()> {
+    let workloads: Vec<_> = bench::standard_workloads(spp)
+        .into_iter()
+        .filter(|w| only.is_none_or(|name| w.name == name))
+        .collect();
+    if workloads.is_empty() {
+        let names: Vec<_> = bench::standard_workloads(1)
+            .iter()
+            .map(|w| w.name)
+            .collect();
+        return Err(anyhow!(
+            "no workload named '{}'; the workloads are {}",
+            only.unwrap_or(""),
+            names.join(", ")
+        ));
+    }
     outln!(
-        "lumen bench: {}, {spp} spp, depth 50, median of {runs} runs",
+        "lumen bench: {}, {spp} spp, median of {runs} runs",
         machine()
     )?;
     outln!(
-        "{:<24} {:>10} {:>14} {:>16}",
+        "{:<24} {:>6} {:>10} {:>14} {:>16}",
         "workload",
+        "depth",
         "median s",
         "M rays/s",
         "M samples/s"
     )?;
-    for w in bench::standard_workloads(spp) {
+    for w in workloads {
         let m = bench::measure(&w, runs as usize).map_err(|e| anyhow!("{}: {e}", w.name))?;
         outln!(
-            "{:<24} {:>10.3} {:>14.2} {:>16.2}",
+            "{:<24} {:>6} {:>10.3} {:>14.2} {:>16.2}",
             m.name,
+            w.desc.render.max_depth,
+            m.median.as_secs_f64(),
+            m.rays_per_second() / 1e6,
+            m.samples_per_second() / 1e6
+        )?;
+    }
+    Ok(())
+}
+
+pub(crate) fn instances_command(counts: &[usize], spp: u32, runs: u32) -> Result<()> {
+    outln!(
+        "lumen bench: fields of instanced 235,136-triangle bunnies at 400x225, {}, {spp} spp, depth 8, median of {runs} runs",
+        machine()
+    )?;
+    outln!(
+        "{:>9} {:>14} {:>9} {:>11} {:>11} {:>10} {:>10} {:>12}",
+        "instances",
+        "triangles",
+        "build s",
+        "geometry MB",
+        "peak MB",
+        "median s",
+        "M rays/s",
+        "M samples/s"
+    )?;
+    for &n in counts {
+        let p = bench::measure_instances(n, spp, runs as usize)
+            .map_err(|e| anyhow!("{n} instances: {e}"))?;
+        let m = &p.measurement;
+        outln!(
+            "{:>9} {:>14} {:>9.3} {:>11.1} {:>11} {:>10.3} {:>10.2} {:>12.2}",
+            p.instances,
+            p.instances as u64 * 235_136,
+            p.build.as_secs_f64(),
+            p.geometry_bytes as f64 / 1e6,
+            p.peak_bytes
+                .map_or("n/a".to_string(), |b| format!("{:.1}", b as f64 / 1e6)),
             m.median.as_secs_f64(),
             m.rays_per_second() / 1e6,
             m.samples_per_second() / 1e6

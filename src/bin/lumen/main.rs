@@ -68,8 +68,20 @@ enum Command {
         scaling: bool,
         /// Render only the cover-like field of about N small spheres (to measure
         /// one size's peak memory with /usr/bin/time -v).
-        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100_000_000), conflicts_with = "instances")]
         field: Option<u64>,
+        /// Instead of the standard workloads, render fields of 1, 10, 100,
+        /// 1,000 and 10,000 instances of the 235k-triangle bunny (or only N
+        /// with --instance-count N): rays/s, build time and memory.
+        #[arg(long, conflicts_with = "scaling")]
+        instances: bool,
+        /// With --instances: only this many instances.
+        #[arg(long, value_name = "N", requires = "instances", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+        instance_count: Option<u64>,
+        /// Run only the standard workload of this name (cover-400x225,
+        /// three-spheres-400x225, bunny-235k-400x400).
+        #[arg(long, value_name = "NAME", conflicts_with_all = ["scaling", "field", "instances"])]
+        workload: Option<String>,
     },
 }
 
@@ -168,7 +180,7 @@ mod render;
 mod scenes;
 mod signals;
 
-use commands::{bench_command, gallery_command, scaling_command};
+use commands::{bench_command, gallery_command, instances_command, scaling_command};
 use render::render_command;
 use scenes::export_command;
 
@@ -221,12 +233,22 @@ fn run(cli: Cli) -> Result<ExitCode> {
             threads,
             scaling,
             field,
+            instances,
+            instance_count,
+            workload,
         } => {
             with_threads(threads, || {
+                if instances {
+                    let counts = match instance_count {
+                        Some(n) => vec![n as usize],
+                        None => vec![1, 10, 100, 1_000, 10_000],
+                    };
+                    return instances_command(&counts, spp, runs);
+                }
                 let fields: Vec<usize> = match (scaling, field) {
                     (true, _) => vec![100, 1_000, 10_000, 100_000, 1_000_000],
                     (false, Some(n)) => vec![n as usize],
-                    (false, None) => return bench_command(spp, runs),
+                    (false, None) => return bench_command(spp, runs, workload.as_deref()),
                 };
                 scaling_command(&fields, spp, runs)
             })?;
