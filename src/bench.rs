@@ -419,4 +419,21 @@ mod tests {
         let centre = film.pixel(w / 2, h / 2);
         assert!(centre.length() < sky.length() && centre != Vec3::ZERO);
     }
+
+    #[test]
+    fn bunny_fields_place_one_mesh_many_times() {
+        let small = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny.obj");
+        let mut desc = bunny_field(small, 9);
+        desc.render.width = 16;
+        desc.render.height = Some(9);
+        desc.render.samples_per_pixel = 1;
+        let scene = Scene::from_desc(&desc).expect("the field compiles");
+        assert_eq!(scene.stats.instances, 9);
+        assert_eq!(scene.stats.triangles, 3_674);
+        assert_eq!(scene.stats.placed_triangles, 9 * 3_674);
+        let (_, stats) = render(&scene, &|_| {});
+        assert!(stats.rays > stats.samples, "camera rays hit the field");
+        let one = Scene::from_desc(&bunny_scene(small)).expect("the bench scene compiles");
+        assert_eq!((one.stats.instances, one.stats.triangles), (0, 3_674));
+    }
 }
