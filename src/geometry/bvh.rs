@@ -110,6 +110,18 @@ pub(super) struct QuadPacket {
     pub(super) index: [u32; 8],
 }
 
+/// Lane `s` of each of three fields, each in every lane of `R`. (Indexed in
+/// place: mapping a copy of the arrays made the compiler store each one to
+/// the stack before reading its lane back.)
+#[inline(always)]
+fn splat_lane<R: Real>(fields: &[Lane8; 3], s: usize) -> [R; 3] {
+    [
+        R::splat(fields[0][s]),
+        R::splat(fields[1][s]),
+        R::splat(fields[2][s]),
+    ]
+}
+
 /// Up to eight instances.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct InstancePacket {
@@ -132,7 +144,7 @@ impl SpherePacket {
     #[inline(always)]
     pub(super) fn splat<R: Real>(&self, s: usize) -> SphereLanes<R> {
         SphereLanes {
-            center: map3(&self.center, |c| R::splat(c[s])),
+            center: splat_lane(&self.center, s),
             radius2: R::splat(self.radius2[s]),
         }
     }
@@ -165,13 +177,13 @@ impl QuadPacket {
     /// Quad `s` of the packet in every lane.
     #[inline(always)]
     pub(super) fn splat<R: Real>(&self, s: usize) -> QuadLanes<R> {
-        let f = |c: [Lane8; 3]| map3(&c, |l| R::splat(l[s]));
+        let f = |c: &[Lane8; 3]| splat_lane(c, s);
         QuadLanes {
-            corner: f(self.corner),
-            u: f(self.u),
-            v: f(self.v),
-            normal: f(self.normal),
-            w: f(self.w),
+            corner: f(&self.corner),
+            u: f(&self.u),
+            v: f(&self.v),
+            normal: f(&self.normal),
+            w: f(&self.w),
             d: R::splat(self.d[s]),
         }
     }
@@ -205,6 +217,8 @@ pub struct Bvh {
     /// Whether the processor has AVX2, asked once when the tree is built:
     /// asking for every ray cost ≈ 20 instructions per ray.
     avx2: bool,
+    /// Whether every leaf holds spheres, kept so that a ray reads one flag.
+    spheres_only: bool,
 }
 
 impl Bvh {
@@ -235,6 +249,7 @@ impl Bvh {
             instances,
             bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
+            spheres_only: true,
         };
         if binary.is_empty() {
             return bvh;
@@ -255,6 +270,8 @@ impl Bvh {
         bvh.triangles.shrink_to_fit();
         bvh.quads.shrink_to_fit();
         bvh.instance_packets.shrink_to_fit();
+        bvh.spheres_only =
+            bvh.triangles.is_empty() && bvh.quads.is_empty() && bvh.instances.is_empty();
         bvh
     }
 
@@ -327,7 +344,7 @@ impl Bvh {
     /// Whether every leaf holds spheres.
     #[inline(always)]
     pub(super) fn spheres_only(&self) -> bool {
-        self.triangles.is_empty() && self.quads.is_empty() && self.instances.is_empty()
+        self.spheres_only
     }
 
     /// Node `i`, which the traversal reached through a child reference.
@@ -408,7 +425,7 @@ impl Bvh {
                 }
             } else {
                 let node = self.node(current);
-                let (mask, entries, order) = rays.enter(node);
+                let (mask, entries) = rays.enter(node);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize & 3;
                     let rest = mask & (mask - 1);
@@ -422,6 +439,7 @@ impl Bvh {
                         // Two children (most of the rest): push the farther,
                         // go on with the nearer (the first lane on a tie).
                         let second = rest.trailing_zeros() as usize & 3;
+                        let order = rays.order(node, &entries);
                         let (near, far) = if order[second] < order[first] {
                             (second, first)
                         } else {
@@ -435,7 +453,7 @@ impl Bvh {
                     }
                     // Three or four: push the hit children farthest first; go
                     // on with the nearest.
-                    let (lanes, n) = farthest_first(mask, order);
+                    let (lanes, n) = farthest_first(mask, rays.order(node, &entries));
                     for &lane in &lanes[..n - 1] {
                         stack[top].write((node.children[lane], entries[lane]));
                         top += 1;
@@ -469,9 +487,12 @@ pub(super) trait Rays {
     /// Where the rays enter a box: one distance, or one per ray.
     type Entry: Copy + Default;
     /// Tests the four boxes of `node`: the children to visit (bit per
-    /// child), where the rays enter each, and an order to visit them in
-    /// (nearest first; only speed depends on it).
-    fn enter(&self, node: &Node) -> (u32, [Self::Entry; 4], [f32; 4]);
+    /// child) and where the rays enter each.
+    fn enter(&self, node: &Node) -> (u32, [Self::Entry; 4]);
+    /// The order to visit the children of `node` in, nearest first (only
+    /// speed depends on it), given where the rays enter them: asked only
+    /// when two or more are hit.
+    fn order(&self, node: &Node, entries: &[Self::Entry; 4]) -> [f32; 4];
     /// Whether a box the rays enter at `entry` may still hold a hit that matters.
     fn needed(&self, entry: &Self::Entry) -> bool;
     /// Tests the primitives of `leaf` (a leaf reference), which the rays
@@ -537,7 +558,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             ray.direction
         );
         let (o, inv) = (ray.origin, ray.direction.recip());
-        let (axes, triangle) = if bvh.has_triangles() {
+        let (axes, triangle) = if !SPHERES && bvh.has_triangles() {
             let axes = TriangleRay::axes_of(ray.direction);
             (axes, TriangleRay::new(ray, axes, interval.min))
         } else {
@@ -702,7 +723,7 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
     type Entry = f32;
 
     #[inline(always)]
-    fn enter(&self, node: &Node) -> (u32, [f32; 4], [f32; 4]) {
+    fn enter(&self, node: &Node) -> (u32, [f32; 4]) {
         let (p, near, o, inv) = (&node.planes, &self.near, &self.origin, &self.inv);
         let tx0 = (p[0][near[0]] - o[0]) * inv[0];
         let tx1 = (p[0][1 - near[0]] - o[0]) * inv[0];
@@ -715,8 +736,12 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
         let t_near = max4(max4(max4(tx0, ty0), tz0), Vec4::splat(self.t_min));
         let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(self.closest)) * SLACK4;
         let mask = t_near.cmple(t_far).bitmask() & node.used;
-        let t_near = t_near.to_array();
-        (mask, t_near, t_near)
+        (mask, t_near.to_array())
+    }
+
+    #[inline(always)]
+    fn order(&self, _: &Node, t_near: &[f32; 4]) -> [f32; 4] {
+        *t_near
     }
 
     #[inline(always)]

@@ -27,7 +27,10 @@
 //! does not depend on the order of the visit, nor on the other rays of the
 //! bundle.
 
-use super::bvh::{leaf_parts, Bvh, Hit, InstancePacket, Node, Rays, NO_CHILD, SLACK};
+use super::bvh::{
+    leaf_parts, Bvh, Hit, InstancePacket, Node, QuadPacket, Rays, SpherePacket, TrianglePacket,
+    NO_CHILD, SLACK,
+};
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
 use crate::geometry::sphere;
@@ -272,91 +275,102 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             tie &= tie - 1;
         }
         *closest = R::select(hit, t, *closest);
-        while take != 0 {
-            self.best[take.trailing_zeros() as usize] = index;
-            take &= take - 1;
+        // Without a branch per taking lane: which lanes take is unpredictable.
+        for l in 0..LANES {
+            self.best[l] = if take >> l & 1 != 0 {
+                index
+            } else {
+                self.best[l]
+            };
         }
     }
 
-    /// Tests every ray of the bundle against the primitives of `leaf` one by
-    /// one, on lanes `R`, with the kernel the single-ray packet test runs
-    /// (so the same distances); only the lanes that enter the leaf's box
-    /// count, as each ray alone would test it only then.
+    /// Where the lanes that enter a leaf's box at `entry` are set: only
+    /// those test its primitives, as each ray alone would test them only
+    /// then.
     #[inline(always)]
-    fn leaf_in<R: Wide>(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) {
-        let (mut enter, closest) = (0, &self.closest);
-        for l in 0..LANES {
-            enter |= u32::from(entry[l] <= closest[l] * SLACK) << l;
-        }
-        let enter = R::mask_from_bits(enter);
-        let mut closest = R::from_array(self.closest);
-        let ray = RayLanes {
+    fn entering<R: Wide>(&self, entry: &Lanes) -> R::Mask {
+        R::from_array(*entry).le(R::from_array(self.closest) * R::splat(SLACK))
+    }
+
+    /// The bundle's rays on lanes `R`.
+    #[inline(always)]
+    fn ray_lanes<R: Wide>(&self) -> RayLanes<R> {
+        RayLanes {
             origin: map3(&self.rays.origin, R::from_array),
             direction: map3(&self.rays.direction, R::from_array),
             t_min: R::splat(self.t_min),
+        }
+    }
+
+    /// Tests every ray of the bundle that enters the leaf's box at `entry`
+    /// against the spheres of `p` one by one, on lanes `R`, with the kernel
+    /// the single-ray packet test runs (so the same distances). The
+    /// triangle and quad tests below do the same for their kinds; each kind
+    /// is its own function so that the AVX2 version of each stays small
+    /// enough to be inlined into the render loop.
+    #[inline(always)]
+    fn spheres<R: Wide>(&mut self, p: &SpherePacket, entry: &Lanes) {
+        let enter = self.entering::<R>(entry);
+        let ray = self.ray_lanes::<R>();
+        let mut closest = R::from_array(self.closest);
+        for s in 0..LANES {
+            if p.index[s] == NO_CHILD {
+                break;
+            }
+            let (t, valid) = sphere::intersect_with::<R, false>(&ray, &p.splat(s));
+            self.found(&mut closest, t, valid, enter, p.index[s]);
+        }
+        self.closest = closest.to_array();
+    }
+
+    #[inline(always)]
+    fn triangles<R: Wide>(&mut self, p: &TrianglePacket, entry: &Lanes) {
+        let enter = self.entering::<R>(entry);
+        let mut closest = R::from_array(self.closest);
+        let triangle = TriangleRay {
+            origin: map3(&self.triangle.origin, R::from_array),
+            shear: map3(&self.triangle.shear, R::from_array),
+            t_min: R::from_array(self.triangle.t_min),
         };
-        let (kind, i) = leaf_parts(leaf);
-        let kind = if SPHERES { Kind::Sphere } else { kind };
-        match kind {
-            Kind::Sphere => {
-                let p = bvh.sphere_packet(i);
-                for s in 0..LANES {
-                    if p.index[s] == NO_CHILD {
-                        break;
-                    }
-                    let (t, valid) = sphere::intersect(&ray, &p.splat(s));
-                    self.found(&mut closest, t, valid, enter, p.index[s]);
-                }
+        let is_axis = map3(&self.is_axis, |[x, y]| {
+            (R::mask_from_bits(x), R::mask_from_bits(y))
+        });
+        for s in 0..LANES {
+            if p.index[s] == NO_CHILD {
+                break;
             }
-            Kind::Triangle => {
-                let p = bvh.triangle_packet(i);
-                let triangle = TriangleRay {
-                    origin: map3(&self.triangle.origin, R::from_array),
-                    shear: map3(&self.triangle.shear, R::from_array),
-                    t_min: R::from_array(self.triangle.t_min),
-                };
-                let is_axis = map3(&self.is_axis, |[x, y]| {
-                    (R::mask_from_bits(x), R::mask_from_bits(y))
-                });
-                for s in 0..LANES {
-                    if p.index[s] == NO_CHILD {
-                        break;
-                    }
-                    // Vertex `v` in every lane's own axes.
-                    let permuted = |v: &[[f32; LANES]; 3]| {
-                        let [x, y, z] = map3(v, |c| R::splat(c[s]));
-                        map3(&is_axis, |(is_x, is_y)| {
-                            R::select(is_x, x, R::select(is_y, y, z))
-                        })
-                    };
-                    let tri = TriangleLanes {
-                        vertices: [
-                            permuted(&p.vertices[0]),
-                            permuted(&p.vertices[1]),
-                            permuted(&p.vertices[2]),
-                        ],
-                    };
-                    let (t, valid) = triangle::intersect(&triangle, &tri);
-                    self.found(&mut closest, t, valid, enter, p.index[s]);
-                }
+            // Vertex `v` in every lane's own axes.
+            let permuted = |v: &[[f32; LANES]; 3]| {
+                let (x, y, z) = (R::splat(v[0][s]), R::splat(v[1][s]), R::splat(v[2][s]));
+                map3(&is_axis, |(is_x, is_y)| {
+                    R::select(is_x, x, R::select(is_y, y, z))
+                })
+            };
+            let tri = TriangleLanes {
+                vertices: [
+                    permuted(&p.vertices[0]),
+                    permuted(&p.vertices[1]),
+                    permuted(&p.vertices[2]),
+                ],
+            };
+            let (t, valid) = triangle::intersect(&triangle, &tri);
+            self.found(&mut closest, t, valid, enter, p.index[s]);
+        }
+        self.closest = closest.to_array();
+    }
+
+    #[inline(always)]
+    fn quads<R: Wide>(&mut self, p: &QuadPacket, entry: &Lanes) {
+        let enter = self.entering::<R>(entry);
+        let ray = self.ray_lanes::<R>();
+        let mut closest = R::from_array(self.closest);
+        for s in 0..LANES {
+            if p.index[s] == NO_CHILD {
+                break;
             }
-            Kind::Quad => {
-                let p = bvh.quad_packet(i);
-                for s in 0..LANES {
-                    if p.index[s] == NO_CHILD {
-                        break;
-                    }
-                    let (t, valid) = quad::intersect(&ray, &p.splat(s));
-                    self.found(&mut closest, t, valid, enter, p.index[s]);
-                }
-            }
-            Kind::Instance => {
-                // Each lane that enters traces its own ray through the
-                // instances, exactly as it would alone.
-                self.closest = closest.to_array();
-                self.instances(bvh, bvh.instance_packet(i), R::bits(enter));
-                return;
-            }
+            let (t, valid) = quad::intersect(&ray, &p.splat(s));
+            self.found(&mut closest, t, valid, enter, p.index[s]);
         }
         self.closest = closest.to_array();
     }
@@ -388,18 +402,44 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
     }
 }
 
-/// [`BundleRays::leaf_in`] on AVX lanes, compiled for AVX2.
+/// The leaf tests of [`BundleRays`] on AVX lanes, each compiled for AVX2
+/// and small enough to be inlined into the AVX2 render loop.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
 #[allow(unsafe_code)]
-unsafe fn bundle_leaf_avx2<const S: bool>(
-    rays: &mut BundleRays<S>,
-    bvh: &Bvh,
-    leaf: u32,
-    entry: &Lanes,
-) {
-    rays.leaf_in::<crate::lanes::W8>(bvh, leaf, entry)
+mod bundle_avx2 {
+    use super::{BundleRays, Lanes};
+    use crate::geometry::bvh::{QuadPacket, SpherePacket, TrianglePacket};
+    use crate::lanes::W8;
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn spheres<const S: bool>(
+        r: &mut BundleRays<S>,
+        p: &SpherePacket,
+        entry: &Lanes,
+    ) {
+        r.spheres::<W8>(p, entry)
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn triangles<const S: bool>(
+        r: &mut BundleRays<S>,
+        p: &TrianglePacket,
+        entry: &Lanes,
+    ) {
+        r.triangles::<W8>(p, entry)
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn quads<const S: bool>(
+        r: &mut BundleRays<S>,
+        p: &QuadPacket,
+        entry: &Lanes,
+    ) {
+        r.quads::<W8>(p, entry)
+    }
 }
 
 impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
@@ -408,7 +448,7 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
     type Entry = Lanes;
 
     #[inline(always)]
-    fn enter(&self, node: &Node) -> (u32, [Lanes; 4], [f32; 4]) {
+    fn enter(&self, node: &Node) -> (u32, [Lanes; 4]) {
         let rays = self.rays;
         // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
         let bounds = node.planes.map(|pair| pair.map(|v| v.to_array()));
@@ -445,17 +485,18 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
             }
             hit_mask |= u32::from(any) << child;
         }
-        if hit_mask == 0 {
-            return (0, t_near, [0.0; 4]);
-        }
-        // The order: where the reference ray meets the boxes.
+        (hit_mask, t_near)
+    }
+
+    /// Where the reference ray meets the boxes.
+    #[inline(always)]
+    fn order(&self, node: &Node, _: &[Lanes; 4]) -> [f32; 4] {
         let (p, near) = (&node.planes, &self.ref_near);
         let (o, inv) = (&self.ref_origin, &self.ref_inv);
         let rx = (p[0][near[0]] - o[0]) * inv[0];
         let ry = (p[1][near[1]] - o[1]) * inv[1];
         let rz = (p[2][near[2]] - o[2]) * inv[2];
-        let order = rx.max(ry).max(rz).max(Vec4::splat(self.t_min)).to_array();
-        (hit_mask, t_near, order)
+        rx.max(ry).max(rz).max(Vec4::splat(self.t_min)).to_array()
     }
 
     #[inline(always)]
@@ -469,16 +510,35 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
 
     #[inline(always)]
     fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) -> bool {
+        let (kind, i) = leaf_parts(leaf);
+        let kind = if SPHERES { Kind::Sphere } else { kind };
+        // SAFETY (the AVX2 calls): `avx2` is true only when `Isa::detect`
+        // found AVX2.
         #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
         if bvh.avx2() {
-            // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
-            #[allow(unsafe_code)]
-            unsafe {
-                bundle_leaf_avx2(self, bvh, leaf, entry)
-            };
+            match kind {
+                Kind::Sphere => unsafe { bundle_avx2::spheres(self, bvh.sphere_packet(i), entry) },
+                Kind::Triangle => unsafe {
+                    bundle_avx2::triangles(self, bvh.triangle_packet(i), entry)
+                },
+                Kind::Quad => unsafe { bundle_avx2::quads(self, bvh.quad_packet(i), entry) },
+                Kind::Instance => {
+                    let enter = F8::bits(self.entering::<F8>(entry));
+                    self.instances(bvh, bvh.instance_packet(i), enter)
+                }
+            }
             return false;
         }
-        self.leaf_in::<F8>(bvh, leaf, entry);
+        match kind {
+            Kind::Sphere => self.spheres::<F8>(bvh.sphere_packet(i), entry),
+            Kind::Triangle => self.triangles::<F8>(bvh.triangle_packet(i), entry),
+            Kind::Quad => self.quads::<F8>(bvh.quad_packet(i), entry),
+            Kind::Instance => {
+                let enter = F8::bits(self.entering::<F8>(entry));
+                self.instances(bvh, bvh.instance_packet(i), enter)
+            }
+        }
         false
     }
 }

@@ -88,6 +88,19 @@ pub struct SphereLanes<R> {
 /// [`HitRecord::spawn_origin`]: crate::geometry::HitRecord::spawn_origin
 #[inline(always)]
 pub fn intersect<R: Real>(ray: &RayLanes<R>, sphere: &SphereLanes<R>) -> (R, R::Mask) {
+    intersect_with::<R, true>(ray, sphere)
+}
+
+/// [`intersect`], which leaves early when no lane's discriminant is
+/// non-negative if `EARLY_OUT` is set, and otherwise finishes every lane
+/// without that branch; the result is the same either way. A packet of
+/// spheres against one ray misses all of them often enough for the exit to
+/// pay; a bundle of rays against one sphere does not, and mispredicts it.
+#[inline(always)]
+pub fn intersect_with<R: Real, const EARLY_OUT: bool>(
+    ray: &RayLanes<R>,
+    sphere: &SphereLanes<R>,
+) -> (R, R::Mask) {
     let [ox, oy, oz] = ray.origin;
     let [dx, dy, dz] = ray.direction;
     let [cx, cy, cz] = sphere.center;
@@ -100,7 +113,7 @@ pub fn intersect<R: Real>(ray: &RayLanes<R>, sphere: &SphereLanes<R>) -> (R, R::
     let lz = fz - half_b * dz;
     let discriminant = sphere.radius2 - (lx * lx + ly * ly + lz * lz);
     let real = R::splat(0.0).le(discriminant);
-    if !real.any() {
+    if EARLY_OUT && !real.any() {
         return (discriminant, real);
     }
     let sqrt_d = discriminant.sqrt();
