@@ -206,3 +206,170 @@ pub fn read_exr_rgb(path: &std::path::Path) -> ((usize, usize), Vec<[f32; 3]>) {
         img.layer_data.channel_data.pixels.1,
     )
 }
+
+/// A fresh empty directory for one test (removed first if a previous run
+/// left it behind).
+pub fn scratch_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("lumen-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The path of the bundled Stanford bunny OBJ.
+pub fn bunny_obj() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny.obj")
+}
+
+/// Writes `text` to `dir/name` and reads it as a scene file.
+pub fn scene_file(dir: &std::path::Path, name: &str, text: &str) -> lumen::scene::file::SceneFile {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    lumen::scene::file::SceneFile::read(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Writes `text` to `dir/name` and compiles it as a scene file.
+pub fn compile_file(dir: &std::path::Path, name: &str, text: &str) -> Scene {
+    scene_file(dir, name, text)
+        .compile(&Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// An OBJ of an icosphere of radius `radius` centred at the origin:
+/// the icosahedron with every face split `subdivisions` times, vertices
+/// pushed onto the sphere, faces counter-clockwise seen from outside. With
+/// `normals` the file gives every vertex its normal (`vn`), the unit radial
+/// direction times `normals` (use −1 for normals pointing inwards).
+pub fn icosphere_obj(subdivisions: u32, radius: f64, normals: Option<f64>) -> String {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let unit = |p: [f64; 3]| {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / l, p[1] / l, p[2] / l]
+    };
+    for p in &mut v {
+        *p = unit(*p);
+    }
+    let mut f: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut mid = std::collections::HashMap::new();
+        let mut midpoint = |a: usize, b: usize, v: &mut Vec<[f64; 3]>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (v[a], v[b]);
+                v.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                v.len() - 1
+            })
+        };
+        let mut next = Vec::with_capacity(f.len() * 4);
+        for [a, b, c] in f {
+            let ab = midpoint(a, b, &mut v);
+            let bc = midpoint(b, c, &mut v);
+            let ca = midpoint(c, a, &mut v);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    let mut obj = String::from("# icosphere\n");
+    for p in &v {
+        obj += &format!("v {} {} {}\n", p[0] * radius, p[1] * radius, p[2] * radius);
+    }
+    if let Some(s) = normals {
+        for p in &v {
+            obj += &format!("vn {} {} {}\n", p[0] * s, p[1] * s, p[2] * s);
+        }
+    }
+    for [a, b, c] in f {
+        let (a, b, c) = (a + 1, b + 1, c + 1);
+        obj += &if normals.is_some() {
+            format!("f {a}//{a} {b}//{b} {c}//{c}\n")
+        } else {
+            format!("f {a} {b} {c}\n")
+        };
+    }
+    obj
+}
+
+/// Renders `scene` on a pool of `threads` threads.
+pub fn render_with_threads(scene: &Scene, threads: usize) -> (Film, RenderStats) {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| lumen::render::render(scene, &|_| {}))
+}
+
+/// Compares two renders of the same view pixel by pixel: every pixel's
+/// means must agree within `k` combined standard errors (from each pixel's
+/// own sample variance; the two estimates are treated as independent, which
+/// over-states the noise when they share a seed). Returns the largest
+/// |difference| / standard error seen and the number of pixels compared with
+/// a non-zero standard error.
+pub fn assert_pixels_agree(what: &str, a: &PixelStats, b: &PixelStats, k: f64) -> (f64, usize) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut worst: f64 = 0.0;
+    let mut noisy = 0;
+    for i in 0..a.mean.len() {
+        for c in 0..3 {
+            let d = (a.mean[i][c] - b.mean[i][c]).abs();
+            let se = (a.var[i][c] / f64::from(a.counts[i]) + b.var[i][c] / f64::from(b.counts[i]))
+                .sqrt();
+            if se == 0.0 {
+                // Both pixels are exact (every sample equal): so must be
+                // their means, to rounding.
+                assert!(
+                    d <= 1e-6,
+                    "{what}: pixel {i} channel {c}: {} vs {}, both without noise",
+                    a.mean[i][c],
+                    b.mean[i][c]
+                );
+                continue;
+            }
+            noisy += 1;
+            worst = worst.max(d / se);
+            assert!(
+                d <= k * se,
+                "{what}: pixel ({}, {}) channel {c}: {} vs {} differ by {:.2} standard errors",
+                i as u32 % a.width,
+                i as u32 / a.width,
+                a.mean[i][c],
+                b.mean[i][c],
+                d / se
+            );
+        }
+    }
+    (worst, noisy)
+}
