@@ -59,6 +59,25 @@ const TOKENS: &[&str] = &[
     "#",
     "'",
     "1979-05-27T07:32:00Z",
+    "\"quad\"",
+    "\"box\"",
+    "\"mesh\"",
+    "transform",
+    "transform = []",
+    "transform = [{ scale = 0 }]",
+    "{ rotate = { axis = [0, 0, 0], degrees = 90 } }",
+    "{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]] }",
+    "{ translate = [1e38, 0, 0] }, { scale = 1e38 }",
+    "\"matrix\": [[0, 0, 0, 0]]",
+    "scale",
+    "smooth = false",
+    "file = \"\"",
+    "file = \".\"",
+    "\"missing.glb\"",
+    "min",
+    "max",
+    "[0, 0, 0]",
+    "1e-40",
 ];
 
 #[derive(Clone, Debug)]
@@ -108,10 +127,18 @@ fn apply(text: &mut String, e: &Edit) {
 /// Parses, compiles and (when valid) renders a few pixels: nothing may panic,
 /// and every error must format.
 fn exercise(text: String, format: Format) {
+    // A mistake inside an object is always written somewhere in the file:
+    // its message must give the line.
+    let located = |e: &lumen::scene::file::SceneFileError| {
+        if e.field.as_deref().is_some_and(|f| f.starts_with("objects[")) {
+            assert!(e.line_col.is_some(), "not located: {e}");
+        }
+    };
     match SceneFile::parse("fuzz", text, format) {
         Err(e) => {
             let message = e.to_string();
             assert!(message.starts_with("fuzz"), "{message}");
+            located(&e);
         }
         Ok(file) => {
             let tiny = Overrides {
@@ -121,7 +148,10 @@ fn exercise(text: String, format: Format) {
                 seed: None,
             };
             match file.compile(&tiny) {
-                Err(e) => assert!(e.to_string().starts_with("fuzz")),
+                Err(e) => {
+                    assert!(e.to_string().starts_with("fuzz"));
+                    located(&e);
+                }
                 // Refuse huge heights kept in proportion to a tiny width.
                 Ok(scene) if scene.settings.height <= 64 => {
                     render(&scene, &|_| {});
@@ -160,6 +190,116 @@ proptest! {
             apply(&mut text, e);
         }
         exercise(text, format);
+    }
+}
+
+/// A scene with every object kind and transform step, its mesh (a
+/// tetrahedron, written once to a temporary directory) named by absolute
+/// path so that mangled copies still find it.
+fn placed_seed(format: Format) -> String {
+    static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    let dir = DIR.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("lumen-fuzz-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("t.obj"),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nf 1//1 3//1 2//1\nf 1//1 2//1 4//1\nf 1//1 4//1 3//1\nf 2//1 3//1 4//1\n",
+        )
+        .unwrap();
+        dir
+    });
+    let file = dir.join("t.obj").display().to_string();
+    match format {
+        Format::Toml => format!(
+            r#"[render]
+width = 8
+max_depth = 3
+
+[materials.m]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, -3]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "m"
+transform = [{{ rotate = {{ axis = [0, 1, 0], degrees = 30 }} }}]
+
+[[objects]]
+type = "box"
+min = [0, 0, -3]
+max = [1, 1, -2]
+material = "m"
+transform = [{{ scale = [1, 2, 1] }}, {{ translate = [0, -1, 0] }}]
+
+[[objects]]
+type = "mesh"
+file = "{file}"
+material = "m"
+transform = [{{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -3], [0, 0, 0, 1]] }}]
+
+[[objects]]
+type = "mesh"
+file = "{file}"
+material = "m"
+smooth = false
+transform = [{{ scale = 0.5 }}, {{ translate = [1, 0, -4] }}]
+
+[[objects]]
+type = "sphere"
+center = [0, 0, -5]
+radius = 0.5
+material = "m"
+transform = [{{ scale = [1, 3, 1] }}]
+"#
+        ),
+        Format::Json => format!(
+            r#"{{"render": {{"width": 8, "max_depth": 3}},
+"materials": {{"m": {{"type": "metal", "albedo": [0.5, 0.5, 0.5]}}}},
+"objects": [
+{{"type": "quad", "corner": [-1, -1, -3], "u": [2, 0, 0], "v": [0, 2, 0], "material": "m",
+  "transform": [{{"rotate": {{"axis": [0, 1, 0], "degrees": 30}}}}]}},
+{{"type": "box", "min": [0, 0, -3], "max": [1, 1, -2], "material": "m",
+  "transform": [{{"scale": [1, 2, 1]}}, {{"translate": [0, -1, 0]}}]}},
+{{"type": "mesh", "file": "{file}", "material": "m",
+  "transform": [{{"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -3], [0, 0, 0, 1]]}}]}},
+{{"type": "mesh", "file": "{file}", "smooth": false, "transform": [{{"scale": 0.5}}]}}
+]}}
+"#
+        ),
+    }
+}
+
+proptest! {
+    #![proptest_config(Config {
+        cases: 192,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(0x0B7EC7),
+        ..Config::default()
+    })]
+
+    #[test]
+    fn mangled_files_with_placed_objects_never_panic(
+        json in any::<bool>(),
+        edits in proptest::collection::vec(edit(), 1..6),
+    ) {
+        let format = if json { Format::Json } else { Format::Toml };
+        let mut text = placed_seed(format);
+        for e in &edits {
+            apply(&mut text, e);
+        }
+        exercise(text, format);
+    }
+}
+
+#[test]
+fn the_placed_seeds_are_valid() {
+    for format in [Format::Toml, Format::Json] {
+        let file = SceneFile::parse("seed", placed_seed(format), format).unwrap_or_else(|e| panic!("{e}"));
+        let scene = file.compile(&Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.stats.placed_triangles >= 8);
     }
 }
 
