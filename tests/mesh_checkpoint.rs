@@ -93,31 +93,55 @@ fn resume_refuses_a_changed_mesh_and_finishes_an_unchanged_one_bit_identically()
     let saved = std::fs::read(&ckpt).unwrap();
 
     let bunny = std::fs::read(dir.join("bunny.obj")).unwrap();
-    let nudged = String::from_utf8(bunny.clone()).unwrap().replacen("v 1.301895", "v 1.301896", 1);
+    let nudged = String::from_utf8(bunny.clone())
+        .unwrap()
+        .replacen("v 1.301895", "v 1.301896", 1);
     assert_ne!(nudged.as_bytes(), &bunny[..]);
     let cases: [(&str, Vec<u8>, Vec<u8>); 3] = [
         ("bunny.obj", nudged.into_bytes(), bunny.clone()),
         // Same geometry, other bytes: the content is what counts.
-        ("bunny.obj", [&bunny[..], b"# a comment\n"].concat(), bunny.clone()),
+        (
+            "bunny.obj",
+            [&bunny[..], b"# a comment\n"].concat(),
+            bunny.clone(),
+        ),
         // The mesh shared by two instances.
-        ("meshes/ball.obj", ball.replacen("v ", "v  ", 1).into_bytes(), ball.clone().into_bytes()),
+        (
+            "meshes/ball.obj",
+            ball.replacen("v ", "v  ", 1).into_bytes(),
+            ball.clone().into_bytes(),
+        ),
     ];
     for (name, changed, original) in cases {
         std::fs::write(dir.join(name), &changed).unwrap();
         let (status, err) = run(&args, &out, &["--resume"]);
         assert_eq!(status.code(), Some(1), "{name}: {err}");
-        assert!(err.contains(&format!("mesh file {name} has changed")) || err.contains(&format!("mesh file \"{name}\" has changed")), "{name}: {err}");
-        assert!(!err.contains("pass "), "{name}: rendered before refusing: {err}");
+        assert!(
+            err.contains(&format!("mesh file {name} has changed"))
+                || err.contains(&format!("mesh file \"{name}\" has changed")),
+            "{name}: {err}"
+        );
+        assert!(
+            !err.contains("pass "),
+            "{name}: rendered before refusing: {err}"
+        );
         assert!(!err.contains("panicked"), "{err}");
         assert!(!out.exists(), "{name}: image written");
-        assert_eq!(std::fs::read(&ckpt).unwrap(), saved, "{name}: checkpoint changed");
+        assert_eq!(
+            std::fs::read(&ckpt).unwrap(),
+            saved,
+            "{name}: checkpoint changed"
+        );
         std::fs::write(dir.join(name), &original).unwrap();
     }
 
     let (status, err) = run(&args, &out, &["--resume"]);
     assert!(status.success(), "{err}");
     assert!(err.contains("resuming at"), "{err}");
-    assert!(std::fs::read(&out).unwrap() == reference, "resumed image differs");
+    assert!(
+        std::fs::read(&out).unwrap() == reference,
+        "resumed image differs"
+    );
     assert!(!ckpt.exists(), "a finished render removes its checkpoint");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -7,8 +7,8 @@
 mod common;
 
 use common::{
-    assert_pixels_agree, bunny_obj, compile_file, icosphere_obj, pixel_stats,
-    render_with_threads, scratch_dir, K,
+    assert_pixels_agree, bunny_obj, compile_file, icosphere_obj, pixel_stats, render_with_threads,
+    scratch_dir, K,
 };
 use lumen::film::Film;
 use lumen::render::{render, render_samples};
@@ -88,12 +88,12 @@ fn box_as_quads(min: [f64; 3], max: [f64; 3], r: &M3, t: [f64; 3]) -> String {
     let d = [max[0] - min[0], max[1] - min[1], max[2] - min[2]];
     let (dx, dy, dz) = ([d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]);
     let faces = [
-        (min, dy, dx),                        // z = min
-        ([min[0], min[1], max[2]], dx, dy),   // z = max
-        (min, dx, dz),                        // y = min
-        ([min[0], max[1], min[2]], dz, dx),   // y = max
-        ([max[0], min[1], min[2]], dz, dy),   // x = max
-        (min, dy, dz),                        // x = min
+        (min, dy, dx),                      // z = min
+        ([min[0], min[1], max[2]], dx, dy), // z = max
+        (min, dx, dz),                      // y = min
+        ([min[0], max[1], min[2]], dz, dx), // y = max
+        ([max[0], min[1], min[2]], dz, dy), // x = max
+        (min, dy, dz),                      // x = min
     ];
     let mut text = String::new();
     for (corner, u, v) in faces {
@@ -128,8 +128,16 @@ fn a_box_turned_a_quarter_is_exactly_its_six_quads() {
     let (min, max) = ([-1.0, -0.5, -0.25], [0.5, 0.5, 0.75]);
     let t = [0.25, -0.5, -4.0];
     let r = rotation([0.0, 1.0, 0.0], 90.0);
-    let a = compile_file(&dir, "box.toml", &(HEAD.to_string() + &placed_box(min, max, [0.0, 1.0, 0.0], 90.0, t)));
-    let b = compile_file(&dir, "quads.toml", &(HEAD.to_string() + &box_as_quads(min, max, &r, t)));
+    let a = compile_file(
+        &dir,
+        "box.toml",
+        &(HEAD.to_string() + &placed_box(min, max, [0.0, 1.0, 0.0], 90.0, t)),
+    );
+    let b = compile_file(
+        &dir,
+        "quads.toml",
+        &(HEAD.to_string() + &box_as_quads(min, max, &r, t)),
+    );
     let (fa, sa) = render(&a, &|_| {});
     let (fb, sb) = render(&b, &|_| {});
     let red = fa.linear().iter().filter(|c| c.x > 2.0 * c.y).count();
@@ -148,8 +156,16 @@ fn a_box_turned_at_any_angle_matches_its_six_quads_within_noise() {
     let (min, max) = ([-1.0, -0.5, -0.25], [0.5, 0.5, 0.75]);
     let (axis, degrees, t) = ([1.0, 2.0, 3.0], 33.0, [0.2, -0.3, -4.0]);
     let r = rotation(axis, degrees);
-    let a = compile_file(&dir, "box.toml", &(HEAD.to_string() + &placed_box(min, max, axis, degrees, t)));
-    let b = compile_file(&dir, "quads.toml", &(HEAD.to_string() + &box_as_quads(min, max, &r, t)));
+    let a = compile_file(
+        &dir,
+        "box.toml",
+        &(HEAD.to_string() + &placed_box(min, max, axis, degrees, t)),
+    );
+    let b = compile_file(
+        &dir,
+        "quads.toml",
+        &(HEAD.to_string() + &box_as_quads(min, max, &r, t)),
+    );
     let (pa, pb) = (pixel_stats(&a), pixel_stats(&b));
     let (worst, noisy) = assert_pixels_agree("box vs quads", &pa, &pb, K);
     let close = pa
@@ -159,7 +175,10 @@ fn a_box_turned_at_any_angle_matches_its_six_quads_within_noise() {
         .filter(|(x, y)| (0..3).all(|c| (x[c] - y[c]).abs() <= 1e-4))
         .count();
     eprintln!("box vs quads: worst {worst:.2} standard errors over {noisy} pixel channels; {close} of {} pixels within 1e-4", pa.mean.len());
-    assert!(close * 10 >= pa.mean.len() * 9, "only {close} pixels nearly identical");
+    assert!(
+        close * 10 >= pa.mean.len() * 9,
+        "only {close} pixels nearly identical"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -177,9 +196,17 @@ fn moving_the_scene_and_the_camera_together_changes_nothing() {
     let t = |p: [f64; 3]| add(apply(&r, p), shift);
     let scene = |moved: bool| {
         let (from, at, up) = ([0.0, 1.0, 2.0], [0.0, 0.0, -4.0], [0.0, 1.0, 0.0]);
-        let (from, at, up) = if moved { (t(from), t(at), apply(&r, up)) } else { (from, at, up) };
+        let (from, at, up) = if moved {
+            (t(from), t(at), apply(&r, up))
+        } else {
+            (from, at, up)
+        };
         let step = if moved {
-            format!(", {{ rotate = {{ axis = {}, degrees = {degrees:?} }} }}, {{ translate = {} }}", triple(axis), triple(shift))
+            format!(
+                ", {{ rotate = {{ axis = {}, degrees = {degrees:?} }} }}, {{ translate = {} }}",
+                triple(axis),
+                triple(shift)
+            )
         } else {
             String::new()
         };
@@ -248,7 +275,10 @@ transform = [{{ scale = 0.15 }}, {{ translate = [0, -1.5, -5] }}{step}]
     let (a, b) = (pixel_stats(&still), pixel_stats(&moved));
     let (worst, noisy) = assert_pixels_agree("moved vs still", &a, &b, K);
     eprintln!("moved vs still: worst {worst:.2} standard errors over {noisy} pixel channels");
-    assert!(noisy > 1000, "too few noisy pixels ({noisy}) for the comparison to mean much");
+    assert!(
+        noisy > 1000,
+        "too few noisy pixels ({noisy}) for the comparison to mean much"
+    );
     // Not a flat image: the objects are in view.
     let distinct = a.mean.iter().filter(|m| (m[0] - 1.0).abs() > 0.05).count();
     assert!(distinct > 300, "only {distinct} pixels show an object");
@@ -280,7 +310,11 @@ fn a_mesh_shared_by_instances_renders_like_two_copies() {
     let (a, b) = (pixel_stats(&shared), pixel_stats(&copies));
     let (worst, noisy) = assert_pixels_agree("instances vs copies", &a, &b, K);
     eprintln!("instances vs copies: worst {worst:.2} standard errors over {noisy} pixel channels");
-    let red = a.mean.iter().filter(|m| m[0] > 2.0 * m[1] && m[0] > 0.05).count();
+    let red = a
+        .mean
+        .iter()
+        .filter(|m| m[0] > 2.0 * m[1] && m[0] > 0.05)
+        .count();
     assert!(red > 20, "the red bunnies cover only {red} pixels");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -305,7 +339,11 @@ fn inside_a_closed_mesh_no_light_gets_in() {
     let depth: u32 = 6;
     for (file, transform, from) in [
         ("bunny.obj", "[{ scale = 2 }]", [-1.0, 6.0, 1.0]),
-        ("smooth.obj", "[{ scale = [3, 2, 2.5] }, { rotate = { axis = [1, 0, 0], degrees = 30 } }]", [0.3, 0.2, -0.4]),
+        (
+            "smooth.obj",
+            "[{ scale = [3, 2, 2.5] }, { rotate = { axis = [1, 0, 0], degrees = 30 } }]",
+            [0.3, 0.2, -0.4],
+        ),
     ] {
         let text = format!(
             "[render]\nwidth = 32\nheight = 24\nsamples_per_pixel = 32\nmax_depth = {depth}\ngamma = 1\nepsilon = 1e-7\n\n[camera]\nvfov = 120\nlookfrom = {}\nlookat = {}\n\n[background]\ntype = \"solid\"\ncolor = [1, 1, 1]\n\n[materials.m]\ntype = \"diffuse\"\nalbedo = [0.7, 0.7, 0.7]\n\n[[objects]]\ntype = \"mesh\"\nfile = \"{file}\"\nmaterial = \"m\"\ntransform = {transform}\n",
@@ -321,7 +359,11 @@ fn inside_a_closed_mesh_no_light_gets_in() {
             stats.samples * u64::from(depth) - stats.rays,
             stats.samples
         );
-        let lit = film.linear().iter().filter(|c| c.max_element() > 0.0).count();
+        let lit = film
+            .linear()
+            .iter()
+            .filter(|c| c.max_element() > 0.0)
+            .count();
         assert_eq!(lit, 0, "{file}: light got in at {lit} pixels");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -373,7 +415,10 @@ fn a_convex_mesh_in_a_white_furnace_returns_its_albedo_exactly() {
                 // with a whole number of hits.
                 for (i, m) in s.mean.iter().enumerate() {
                     let hits = (1.0 - m[0]) / (1.0 - hit) * f64::from(s.counts[i]);
-                    assert!((hits - hits.round()).abs() < 1e-3, "{what}: pixel {i} mean {m:?}");
+                    assert!(
+                        (hits - hits.round()).abs() < 1e-3,
+                        "{what}: pixel {i} mean {m:?}"
+                    );
                 }
                 let segments = s.stats.rays as f64 / s.stats.samples as f64;
                 let most = if depth == 1 { 1.0 } else { 2.0 };
@@ -408,7 +453,10 @@ fn renders_with_meshes_are_bit_identical_across_threads_and_passes() {
     let dir = scratch_dir("mixed");
     let scene = mixed_scene(&dir);
     let (one, stats) = render_with_threads(&scene, 1);
-    assert!(one.linear().iter().any(|c| *c != one.pixel(0, 0)), "flat image");
+    assert!(
+        one.linear().iter().any(|c| *c != one.pixel(0, 0)),
+        "flat image"
+    );
     let (two, stats2) = render_with_threads(&scene, 2);
     assert!(one == two, "2 threads differ from 1");
     assert_eq!(stats, stats2);
@@ -417,7 +465,10 @@ fn renders_with_meshes_are_bit_identical_across_threads_and_passes() {
         let mut film = Film::new(scene.settings.width, scene.settings.height);
         let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
         passes.add(render_samples(&scene, &mut film, split..spp, &|_| {}));
-        assert!(film == one, "0..{split} then {split}..{spp} differs from 0..{spp}");
+        assert!(
+            film == one,
+            "0..{split} then {split}..{spp} differs from 0..{spp}"
+        );
         assert_eq!(passes, stats);
     }
     std::fs::remove_dir_all(&dir).unwrap();

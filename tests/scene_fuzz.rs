@@ -130,7 +130,10 @@ fn exercise(text: String, format: Format) {
     // A mistake inside an object is always written somewhere in the file:
     // its message must give the line.
     let located = |e: &lumen::scene::file::SceneFileError| {
-        if e.field.as_deref().is_some_and(|f| f.starts_with("objects[")) {
+        if e.field
+            .as_deref()
+            .is_some_and(|f| f.starts_with("objects["))
+        {
             assert!(e.line_col.is_some(), "not located: {e}");
         }
     };
@@ -297,8 +300,11 @@ proptest! {
 #[test]
 fn the_placed_seeds_are_valid() {
     for format in [Format::Toml, Format::Json] {
-        let file = SceneFile::parse("seed", placed_seed(format), format).unwrap_or_else(|e| panic!("{e}"));
-        let scene = file.compile(&Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+        let file =
+            SceneFile::parse("seed", placed_seed(format), format).unwrap_or_else(|e| panic!("{e}"));
+        let scene = file
+            .compile(&Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         assert!(scene.stats.placed_triangles >= 8);
     }
 }

@@ -26,7 +26,8 @@ material = "m"
 "#;
 
 const QUAD: &str = "[[objects]]\ntype = \"quad\"\ncorner = [0, 0, -2]\nu = [1, 0, 0]\nv = [0, 1, 0]\nmaterial = \"m\"\n";
-const BOX: &str = "[[objects]]\ntype = \"box\"\nmin = [0, 0, -3]\nmax = [1, 1, -2]\nmaterial = \"m\"\n";
+const BOX: &str =
+    "[[objects]]\ntype = \"box\"\nmin = [0, 0, -3]\nmax = [1, 1, -2]\nmaterial = \"m\"\n";
 const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 fn mesh(file: &str) -> String {
@@ -44,7 +45,12 @@ struct Case {
     says: Vec<&'static str>,
 }
 
-fn case(name: &'static str, objects: impl Into<String>, at: &'static str, says: &[&'static str]) -> Case {
+fn case(
+    name: &'static str,
+    objects: impl Into<String>,
+    at: &'static str,
+    says: &[&'static str],
+) -> Case {
     Case {
         name,
         objects: objects.into(),
@@ -77,61 +83,235 @@ fn cases() -> Vec<Case> {
 "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
 "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#;
     vec![
-        case("missing", mesh("nope.obj"), "file = \"nope.obj\"", &["objects[1].file", "nope.obj", "no such file"]),
-        case("directory", mesh("folder.obj"), "file = \"folder.obj\"", &["objects[1].file", "folder.obj", "is a directory"]),
-        case("bad-number", mesh("n.obj"), "file = \"n.obj\"", &["objects[1].file", "n.obj:3:"])
-            .with("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n"),
-        case("index-range", mesh("r.obj"), "file = \"r.obj\"", &["objects[1].file", "r.obj:4:", "out of range"])
-            .with("r.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"),
-        case("index-zero", mesh("z.obj"), "file = \"z.obj\"", &["objects[1].file", "z.obj:4:", "index 0"])
-            .with("z.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"),
-        case("short-face", mesh("s.obj"), "file = \"s.obj\"", &["objects[1].file", "s.obj:5:", "2 vertices"])
-            .with("s.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"),
-        case("truncated-glb", mesh("t.glb"), "file = \"t.glb\"", &["objects[1].file", "t.glb", "truncated"])
-            .with("t.glb", glb()[..100].to_vec()),
-        case("corrupt-glb", mesh("c.glb"), "file = \"c.glb\"", &["objects[1].file", "c.glb"])
-            .with("c.glb", corrupt),
-        case("gltf-missing-buffer", mesh("b.gltf"), "file = \"b.gltf\"", &["objects[1].file", "b.gltf", "missing.bin"])
-            .with("b.gltf", nobuf),
-        case("no-triangles", mesh("e.obj"), "file = \"e.obj\"", &["objects[1].file", "e.obj", "no triangles"])
-            .with("e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
-        case("only-degenerate", mesh("d.obj"), "file = \"d.obj\"", &["objects[1].file", "d.obj", "no triangles"])
-            .with("d.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n"),
-        case("unsupported", mesh("m.ply"), "file = \"m.ply\"", &["objects[1].file", "m.ply", ".obj"]),
-        case("nan", transformed("{ translate = [0, nan, 0] }"), "nan", &["objects[1].transform[1].translate[1]", "finite"]),
-        case("inf", transformed("{ rotate = { axis = [0, 1, 0], degrees = inf } }"), "inf", &["objects[1].transform[1].rotate.degrees", "finite"]),
-        case("too-large", transformed("{ translate = [0, 1e39, 0] }"), "transform", &["objects[1].transform[1]", "f32"]),
-        case("singular", transformed("{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]] }"), "transform", &["objects[1].transform[1]", "singular"]),
-        case("last-row", transformed("{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]] }"), "transform", &["objects[1].transform[1]", "last row"]),
-        case("zero-scale", transformed("{ scale = 0 }"), "transform", &["objects[1].transform[1]", "scale x is 0"]),
-        case("zero-scale-axis", transformed("{ scale = [1, 0, 1] }"), "transform", &["objects[1].transform[1]", "scale y is 0"]),
-        case("zero-axis", transformed("{ rotate = { axis = [0, 0, 0], degrees = 10 } }"), "transform", &["objects[1].transform[1]", "zero length"]),
-        case("two-keys", transformed("{ translate = [0, 1, 0], scale = 3 }"), "transform", &["objects[1].transform[1]", "exactly one of"]),
-        case("unknown-key", transformed("{ rotat = { axis = [0, 1, 0], degrees = 3 } }"), "transform", &["objects[1].transform[1].rotat", "did you mean `rotate`?"]),
-        case("step-not-table", format!("{QUAD}transform = [3]\n"), "transform", &["objects[1].transform[0]", "transform step"]),
-        case("parallel-edges", QUAD.replace("v = [0, 1, 0]", "v = [-2, 0, 0]"), "[[objects]]\ntype = \"quad\"", &["objects[1]", "parallel or zero"]),
-        case("zero-edge", QUAD.replace("u = [1, 0, 0]", "u = [0, 0, 0]"), "[[objects]]\ntype = \"quad\"", &["objects[1]", "parallel or zero"]),
-        case("flat-box", BOX.replace("max = [1, 1, -2]", "max = [1, 0, -2]"), "max = ", &["objects[1].max", "greater than min"]),
-        case("inverted-box", BOX.replace("max = [1, 1, -2]", "max = [-1, 1, -2]"), "max = ", &["objects[1].max", "greater than min"]),
-        case("quad-material", QUAD.replace("\"m\"", "\"n\""), "material = \"n\"", &["objects[1].material", "no material named \"n\""]),
-        case("box-material", BOX.replace("\"m\"", "\"n\""), "material = \"n\"", &["objects[1].material", "no material named \"n\""]),
-        case("mesh-material", mesh("tri.obj") + "material = \"n\"\n", "material = \"n\"", &["objects[1].material", "no material named \"n\""])
-            .with("tri.obj", TRI),
-        case("mesh-smooth-type", mesh("tri.obj") + "smooth = 1\n", "smooth = 1", &["objects[1].smooth", "true or false"])
-            .with("tri.obj", TRI),
-        case("sphere-field-on-box", BOX.to_string() + "radius = 1\n", "radius = 1", &["objects[1].radius", "belongs to spheres"]),
+        case(
+            "missing",
+            mesh("nope.obj"),
+            "file = \"nope.obj\"",
+            &["objects[1].file", "nope.obj", "no such file"],
+        ),
+        case(
+            "directory",
+            mesh("folder.obj"),
+            "file = \"folder.obj\"",
+            &["objects[1].file", "folder.obj", "is a directory"],
+        ),
+        case(
+            "bad-number",
+            mesh("n.obj"),
+            "file = \"n.obj\"",
+            &["objects[1].file", "n.obj:3:"],
+        )
+        .with("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n"),
+        case(
+            "index-range",
+            mesh("r.obj"),
+            "file = \"r.obj\"",
+            &["objects[1].file", "r.obj:4:", "out of range"],
+        )
+        .with("r.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"),
+        case(
+            "index-zero",
+            mesh("z.obj"),
+            "file = \"z.obj\"",
+            &["objects[1].file", "z.obj:4:", "index 0"],
+        )
+        .with("z.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"),
+        case(
+            "short-face",
+            mesh("s.obj"),
+            "file = \"s.obj\"",
+            &["objects[1].file", "s.obj:5:", "2 vertices"],
+        )
+        .with("s.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"),
+        case(
+            "truncated-glb",
+            mesh("t.glb"),
+            "file = \"t.glb\"",
+            &["objects[1].file", "t.glb", "truncated"],
+        )
+        .with("t.glb", glb()[..100].to_vec()),
+        case(
+            "corrupt-glb",
+            mesh("c.glb"),
+            "file = \"c.glb\"",
+            &["objects[1].file", "c.glb"],
+        )
+        .with("c.glb", corrupt),
+        case(
+            "gltf-missing-buffer",
+            mesh("b.gltf"),
+            "file = \"b.gltf\"",
+            &["objects[1].file", "b.gltf", "missing.bin"],
+        )
+        .with("b.gltf", nobuf),
+        case(
+            "no-triangles",
+            mesh("e.obj"),
+            "file = \"e.obj\"",
+            &["objects[1].file", "e.obj", "no triangles"],
+        )
+        .with("e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
+        case(
+            "only-degenerate",
+            mesh("d.obj"),
+            "file = \"d.obj\"",
+            &["objects[1].file", "d.obj", "no triangles"],
+        )
+        .with("d.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n"),
+        case(
+            "unsupported",
+            mesh("m.ply"),
+            "file = \"m.ply\"",
+            &["objects[1].file", "m.ply", ".obj"],
+        ),
+        case(
+            "nan",
+            transformed("{ translate = [0, nan, 0] }"),
+            "nan",
+            &["objects[1].transform[1].translate[1]", "finite"],
+        ),
+        case(
+            "inf",
+            transformed("{ rotate = { axis = [0, 1, 0], degrees = inf } }"),
+            "inf",
+            &["objects[1].transform[1].rotate.degrees", "finite"],
+        ),
+        case(
+            "too-large",
+            transformed("{ translate = [0, 1e39, 0] }"),
+            "transform",
+            &["objects[1].transform[1]", "f32"],
+        ),
+        case(
+            "singular",
+            transformed("{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]] }"),
+            "transform",
+            &["objects[1].transform[1]", "singular"],
+        ),
+        case(
+            "last-row",
+            transformed("{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]] }"),
+            "transform",
+            &["objects[1].transform[1]", "last row"],
+        ),
+        case(
+            "zero-scale",
+            transformed("{ scale = 0 }"),
+            "transform",
+            &["objects[1].transform[1]", "scale x is 0"],
+        ),
+        case(
+            "zero-scale-axis",
+            transformed("{ scale = [1, 0, 1] }"),
+            "transform",
+            &["objects[1].transform[1]", "scale y is 0"],
+        ),
+        case(
+            "zero-axis",
+            transformed("{ rotate = { axis = [0, 0, 0], degrees = 10 } }"),
+            "transform",
+            &["objects[1].transform[1]", "zero length"],
+        ),
+        case(
+            "two-keys",
+            transformed("{ translate = [0, 1, 0], scale = 3 }"),
+            "transform",
+            &["objects[1].transform[1]", "exactly one of"],
+        ),
+        case(
+            "unknown-key",
+            transformed("{ rotat = { axis = [0, 1, 0], degrees = 3 } }"),
+            "transform",
+            &["objects[1].transform[1].rotat", "did you mean `rotate`?"],
+        ),
+        case(
+            "step-not-table",
+            format!("{QUAD}transform = [3]\n"),
+            "transform",
+            &["objects[1].transform[0]", "transform step"],
+        ),
+        case(
+            "parallel-edges",
+            QUAD.replace("v = [0, 1, 0]", "v = [-2, 0, 0]"),
+            "[[objects]]\ntype = \"quad\"",
+            &["objects[1]", "parallel or zero"],
+        ),
+        case(
+            "zero-edge",
+            QUAD.replace("u = [1, 0, 0]", "u = [0, 0, 0]"),
+            "[[objects]]\ntype = \"quad\"",
+            &["objects[1]", "parallel or zero"],
+        ),
+        case(
+            "flat-box",
+            BOX.replace("max = [1, 1, -2]", "max = [1, 0, -2]"),
+            "max = ",
+            &["objects[1].max", "greater than min"],
+        ),
+        case(
+            "inverted-box",
+            BOX.replace("max = [1, 1, -2]", "max = [-1, 1, -2]"),
+            "max = ",
+            &["objects[1].max", "greater than min"],
+        ),
+        case(
+            "quad-material",
+            QUAD.replace("\"m\"", "\"n\""),
+            "material = \"n\"",
+            &["objects[1].material", "no material named \"n\""],
+        ),
+        case(
+            "box-material",
+            BOX.replace("\"m\"", "\"n\""),
+            "material = \"n\"",
+            &["objects[1].material", "no material named \"n\""],
+        ),
+        case(
+            "mesh-material",
+            mesh("tri.obj") + "material = \"n\"\n",
+            "material = \"n\"",
+            &["objects[1].material", "no material named \"n\""],
+        )
+        .with("tri.obj", TRI),
+        case(
+            "mesh-smooth-type",
+            mesh("tri.obj") + "smooth = 1\n",
+            "smooth = 1",
+            &["objects[1].smooth", "true or false"],
+        )
+        .with("tri.obj", TRI),
+        case(
+            "sphere-field-on-box",
+            BOX.to_string() + "radius = 1\n",
+            "radius = 1",
+            &["objects[1].radius", "belongs to spheres"],
+        ),
         // A mesh placed once far beyond f32 once transformed; and the same
         // mesh placed twice (shared by instances) must be refused alike.
-        case("mesh-out-of-range", mesh("tri.obj") + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n", "transform = [{ scale = 1e38 }", &["objects[1].transform", "beyond the range of f32"])
-            .with("tri.obj", TRI),
-        case("instanced-out-of-range", mesh("tri.obj") + &mesh("tri.obj") + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n", "transform = [{ scale = 1e38 }", &["objects[2].transform", "beyond the range of f32"])
-            .with("tri.obj", TRI),
+        case(
+            "mesh-out-of-range",
+            mesh("tri.obj") + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n",
+            "transform = [{ scale = 1e38 }",
+            &["objects[1].transform", "beyond the range of f32"],
+        )
+        .with("tri.obj", TRI),
+        case(
+            "instanced-out-of-range",
+            mesh("tri.obj")
+                + &mesh("tri.obj")
+                + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n",
+            "transform = [{ scale = 1e38 }",
+            &["objects[2].transform", "beyond the range of f32"],
+        )
+        .with("tri.obj", TRI),
     ]
 }
 
 /// 1-based line of the first occurrence of `at` in `text`.
 fn line_of(text: &str, at: &str) -> usize {
-    let i = text.find(at).unwrap_or_else(|| panic!("{at:?} not in\n{text}"));
+    let i = text
+        .find(at)
+        .unwrap_or_else(|| panic!("{at:?} not in\n{text}"));
     text[..i].matches('\n').count() + 1
 }
 
@@ -149,14 +329,27 @@ fn refuse(dir: &Path, scene_name: &str, text: &str, at: &str, says: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{scene_name}: {err}");
     assert!(!err.contains("panicked"), "{scene_name}: {err}");
-    assert!(!err.contains("pass 1"), "{scene_name}: rendered before refusing: {err}");
-    assert_eq!(err.matches("error:").count(), 1, "{scene_name}: one message: {err}");
+    assert!(
+        !err.contains("pass 1"),
+        "{scene_name}: rendered before refusing: {err}"
+    );
+    assert_eq!(
+        err.matches("error:").count(),
+        1,
+        "{scene_name}: one message: {err}"
+    );
     let first = err.lines().next().unwrap_or("");
     let line = line_of(text, at);
     let located = format!("{}:{line}:", scene.display());
-    assert!(first.contains(&located), "{scene_name}: {located:?} not in {first:?}");
+    assert!(
+        first.contains(&located),
+        "{scene_name}: {located:?} not in {first:?}"
+    );
     for s in says {
-        assert!(first.contains(s) || err.contains(s), "{scene_name}: {s:?} not in: {err}");
+        assert!(
+            first.contains(s) || err.contains(s),
+            "{scene_name}: {s:?} not in: {err}"
+        );
     }
     assert!(!out.exists(), "{scene_name}: image written");
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{scratch_dir, scene_file};
+use common::{scene_file, scratch_dir};
 use lumen::scene::desc::{MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc};
 use lumen::scene::file::{export, Format, SceneFile};
 use lumen::scene::{Overrides, SceneDesc};
@@ -332,7 +332,8 @@ fn every_step_form_reads_alone() {
 fn export_round_trips_every_kind_and_step() {
     for format in [Format::Toml, Format::Json] {
         let text = export(&expected(), format).unwrap();
-        let back = SceneFile::parse("x", text.clone(), format).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let back =
+            SceneFile::parse("x", text.clone(), format).unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(back.desc, expected(), "{format:?}:\n{text}");
         assert_eq!(export(&back.desc, format).unwrap(), text, "{format:?}");
         // The exported text also reads through serde.
@@ -374,9 +375,25 @@ fn the_command_exports_scene_files_with_every_kind() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         o
     };
-    let (toml_in, json_out, toml_out) = (dir.join("all.toml"), dir.join("all.json"), dir.join("again.toml"));
-    run(&["scenes".as_ref(), "export".as_ref(), toml_in.as_os_str(), "-o".as_ref(), json_out.as_os_str()]);
-    run(&["scenes".as_ref(), "export".as_ref(), json_out.as_os_str(), "-o".as_ref(), toml_out.as_os_str()]);
+    let (toml_in, json_out, toml_out) = (
+        dir.join("all.toml"),
+        dir.join("all.json"),
+        dir.join("again.toml"),
+    );
+    run(&[
+        "scenes".as_ref(),
+        "export".as_ref(),
+        toml_in.as_os_str(),
+        "-o".as_ref(),
+        json_out.as_os_str(),
+    ]);
+    run(&[
+        "scenes".as_ref(),
+        "export".as_ref(),
+        json_out.as_os_str(),
+        "-o".as_ref(),
+        toml_out.as_os_str(),
+    ]);
     let json_text = std::fs::read_to_string(&json_out).unwrap();
     assert_eq!(json_text, export(&expected(), Format::Json).unwrap());
     let toml_text = std::fs::read_to_string(&toml_out).unwrap();
@@ -384,7 +401,12 @@ fn the_command_exports_scene_files_with_every_kind() {
     assert_eq!(SceneFile::read(&toml_out).unwrap().desc, expected());
     // The converted files render (the mesh is found beside them).
     let png = dir.join("all.png");
-    run(&["render".as_ref(), toml_out.as_os_str(), "-o".as_ref(), png.as_os_str()]);
+    run(&[
+        "render".as_ref(),
+        toml_out.as_os_str(),
+        "-o".as_ref(),
+        png.as_os_str(),
+    ]);
     assert!(png.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -209,6 +209,8 @@ struct Placement {
     transform: Transform,
     /// The material that replaces the file's, if the object names one.
     material: Option<u32>,
+    /// The object that places it.
+    object: usize,
 }
 
 /// The objects being compiled.
@@ -352,6 +354,7 @@ impl<'a> Objects<'a> {
                         key: (path.clone(), *mesh, *smooth),
                         transform: placed,
                         material: override_material,
+                        object: i,
                     });
                 }
             }
@@ -430,7 +433,9 @@ impl<'a> Objects<'a> {
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n;
-                self.top.meshes.push(place_mesh(mesh, &only.transform)?);
+                self.top
+                    .meshes
+                    .push(place_mesh(mesh, &only.transform, only.object)?);
             } else {
                 // Stored once with the file's materials; an instance whose
                 // object names a material uses it instead.
@@ -438,6 +443,26 @@ impl<'a> Objects<'a> {
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n * placed.len() as u64;
+                // Each placement must stay within f32, as a mesh placed once
+                // must: the corners of the mesh's bounds, placed.
+                let (lo, hi) = mesh.data.positions.iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), p| (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p))),
+                );
+                for p in placed {
+                    let inside = (0..8).all(|c| {
+                        let pick = |k: usize, a: f32, b: f32| if c & (1 << k) == 0 { a } else { b };
+                        let corner = Vec3::new(
+                            pick(0, lo.x, hi.x),
+                            pick(1, lo.y, hi.y),
+                            pick(2, lo.z, hi.z),
+                        );
+                        p.transform.point(corner).is_finite()
+                    });
+                    if !inside {
+                        return Err(out_of_range(p.object));
+                    }
+                }
                 let shapes = Shapes {
                     meshes: vec![mesh],
                     ..Shapes::default()
@@ -553,7 +578,7 @@ fn box_faces(min: Vec3, max: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
 }
 
 /// `mesh` moved into world space by `transform`.
-fn place_mesh(mut mesh: Mesh, transform: &Transform) -> Result<Mesh, SceneError> {
+fn place_mesh(mut mesh: Mesh, transform: &Transform, object: usize) -> Result<Mesh, SceneError> {
     if !transform.is_identity() {
         for p in &mut mesh.data.positions {
             *p = transform.point(Vec3::from(*p)).to_array();
@@ -565,10 +590,7 @@ fn place_mesh(mut mesh: Mesh, transform: &Transform) -> Result<Mesh, SceneError>
         }
     }
     if mesh.data.positions.iter().flatten().any(|c| !c.is_finite()) {
-        return Err(invalid(
-            "objects",
-            "a mesh's transform places it beyond the range of f32",
-        ));
+        return Err(out_of_range(object));
     }
     Ok(mesh)
 }
