@@ -90,22 +90,22 @@ pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<(
         machine()
     )?;
     outln!(
-        "{:<24} {:>6} {:>10} {:>14} {:>16}",
+        "{:<24} {:>10} {:>14} {:>16} {:>6}",
         "workload",
-        "depth",
         "median s",
         "M rays/s",
-        "M samples/s"
+        "M samples/s",
+        "depth"
     )?;
     for w in workloads {
         let m = bench::measure(&w, runs as usize).map_err(|e| anyhow!("{}: {e}", w.name))?;
         outln!(
-            "{:<24} {:>6} {:>10.3} {:>14.2} {:>16.2}",
+            "{:<24} {:>10.3} {:>14.2} {:>16.2} {:>6}",
             m.name,
-            w.desc.render.max_depth,
             m.median.as_secs_f64(),
             m.rays_per_second() / 1e6,
-            m.samples_per_second() / 1e6
+            m.samples_per_second() / 1e6,
+            w.desc.render.max_depth
         )?;
     }
     Ok(())
