@@ -15,8 +15,10 @@ pub struct HitRecord {
     /// a mesh's vertex normals (smooth shading), else `normal` itself.
     /// Materials scatter around it.
     pub shading_normal: Vec3,
-    /// Surface coordinates: a sphere's (φ/2π, θ/π), a quad's (α, β), a
-    /// triangle's interpolated texture coordinates or barycentrics (b₁, b₂).
+    /// Surface coordinates: a quad's (α, β), a triangle's interpolated
+    /// texture coordinates or barycentrics (b₁, b₂); (0, 0) on spheres, whose
+    /// (φ/2π, θ/π) [`Sphere::uv`](crate::geometry::Sphere::uv) computes from
+    /// the outward normal when a texture needs them.
     pub uv: [f32; 2],
     /// The ray parameter of the hit.
     pub t: f32,

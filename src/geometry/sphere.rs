@@ -53,6 +53,18 @@ impl Sphere {
         (point - self.center) / self.radius
     }
 
+    /// The texture coordinates at the unit outward normal `n`: u = φ/2π
+    /// around the y axis from −x, v = θ/π from −y, as in *The Next Week*.
+    /// Hit records leave them to be computed here, when a texture asks.
+    pub fn uv(n: Vec3) -> [f32; 2] {
+        let theta = (-n.y).clamp(-1.0, 1.0).acos();
+        let phi = (-n.z).atan2(n.x) + std::f32::consts::PI;
+        [
+            phi / (2.0 * std::f32::consts::PI),
+            theta / std::f32::consts::PI,
+        ]
+    }
+
     /// The axis-aligned bounding box `(min, max)`.
     pub fn bounds(&self) -> (Point3, Point3) {
         let r = Vec3::splat(self.radius);
@@ -193,6 +205,17 @@ mod tests {
             let err = ((p - ground.center).length() - ground.radius).abs();
             assert!(err < 2e-3, "hit point off the surface by {err}");
         }
+    }
+
+    #[test]
+    fn texture_coordinates_follow_the_book() {
+        // (1, 0, 0) → (0.5, 0.5); (0, 1, 0) → (0.5, 1); (0, 0, 1) → (0.25, 0.5).
+        let close =
+            |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+        assert!(close(Sphere::uv(Vec3::X), [0.5, 0.5]));
+        assert!(close(Sphere::uv(Vec3::Y), [0.5, 1.0]));
+        assert!(close(Sphere::uv(Vec3::Z), [0.25, 0.5]));
+        assert!(close(Sphere::uv(Vec3::new(-1.0, 0.0, 0.0)), [0.0, 0.5]));
     }
 
     #[test]

@@ -138,7 +138,9 @@ impl Shapes {
                     point,
                     normal,
                     shading_normal: normal,
-                    uv: sphere_uv(outward),
+                    // Computed when asked for (`Sphere::uv`): the inverse
+                    // trigonometry cost a fifth of the cover's render.
+                    uv: [0.0, 0.0],
                     t,
                     front_face,
                     material: surface.material,
@@ -172,18 +174,6 @@ impl Shapes {
             Item::Instance(i) => return Err(i),
         })
     }
-}
-
-/// A sphere's texture coordinates at the outward normal `n`: u = φ/2π
-/// around the y axis from −x, v = θ/π from −y, as in *The Next Week*.
-#[inline(always)]
-fn sphere_uv(n: Vec3) -> [f32; 2] {
-    let theta = (-n.y).clamp(-1.0, 1.0).acos();
-    let phi = (-n.z).atan2(n.x) + std::f32::consts::PI;
-    [
-        phi / (2.0 * std::f32::consts::PI),
-        theta / std::f32::consts::PI,
-    ]
 }
 
 /// The record of a hit on triangle `k` of `mesh`. The point is rebuilt
