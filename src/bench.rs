@@ -75,8 +75,8 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
     desc.materials.insert("floor".into(), diffuse(0.5));
     desc.objects.push(ObjectDesc::Quad {
         corner: [-30.0, 0.0, -30.0],
-        u: [60.0, 0.0, 0.0],
-        v: [0.0, 0.0, 60.0],
+        u: [0.0, 0.0, 60.0],
+        v: [60.0, 0.0, 0.0],
         material: "floor".into(),
         transform: Vec::new(),
     });
@@ -106,8 +106,8 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
     };
     let size = 12.0 * side as f64 + 60.0;
     *corner = [-size / 2.0, 0.0, -size / 2.0];
-    *u = [size, 0.0, 0.0];
-    *v = [0.0, 0.0, size];
+    *u = [0.0, 0.0, size];
+    *v = [size, 0.0, 0.0];
     desc.objects.truncate(1);
     let mut rng = Rng::new(FIELD_SEED);
     for k in 0..n {

@@ -6,9 +6,11 @@
 //! bundle against one shape. Every lane performs the same IEEE operations in
 //! the same order, so all three give bit-identical distances.
 //!
-//! [`F8`] is a plain `[f32; 8]` worked on by simple loops, which the compiler
-//! turns into one 8-wide vector instruction in the AVX2 version of the render
-//! loop and into two 4-wide ones in the baseline (SSE2, NEON) version.
+//! Eight lanes come in two forms: [`F8`], two 4-lane vectors of the
+//! architecture's baseline (SSE2, NEON), and on x86-64 [`W8`], one AVX
+//! register, used only inside functions compiled for AVX2. (A plain
+//! `[f32; 8]` worked on by loops was vectorised badly, with gathers and
+//! shuffles; see docs/performance.md.)
 
 use glam::{BVec4A, Vec4};
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -124,9 +126,7 @@ pub const LANES: usize = 8;
 
 /// Eight lanes, with what a packet's test and a bundle need beyond
 /// [`Real`]: moving to and from arrays, the smallest lane, masks as bits.
-pub trait Wide: Real<Mask = Self::WideMask> {
-    /// The mask type, with its bit form.
-    type WideMask: Mask + Copy;
+pub trait Wide: Real {
     /// The lanes of `a`.
     fn from_array(a: [f32; LANES]) -> Self;
     /// The lanes as an array.
@@ -136,9 +136,9 @@ pub trait Wide: Real<Mask = Self::WideMask> {
     /// order of comparisons.
     fn min_lane(self) -> f32;
     /// Bit `i` set for each true lane `i`.
-    fn bits(mask: Self::WideMask) -> u32;
+    fn bits(mask: Self::Mask) -> u32;
     /// Lane `i` true where bit `i` of `bits` is set.
-    fn mask_from_bits(bits: u32) -> Self::WideMask;
+    fn mask_from_bits(bits: u32) -> Self::Mask;
 }
 
 /// Eight `f32` lanes as two 4-lane vectors of the architecture's baseline
@@ -216,7 +216,6 @@ impl Real for F8 {
 }
 
 impl Wide for F8 {
-    type WideMask = M8;
     #[inline(always)]
     fn from_array(a: [f32; LANES]) -> Self {
         F8([
@@ -421,7 +420,6 @@ mod avx {
     }
 
     impl Wide for W8 {
-        type WideMask = MW8;
         #[inline(always)]
         fn from_array(a: [f32; LANES]) -> Self {
             W8(unsafe { _mm256_loadu_ps(a.as_ptr()) })

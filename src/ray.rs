@@ -43,27 +43,15 @@ pub struct RayLanes<R> {
     pub t_min: R,
 }
 
-impl RayLanes<f32> {
-    /// One ray as one lane.
-    #[inline(always)]
-    pub fn from_ray(ray: &Ray, t_min: f32) -> Self {
-        RayLanes {
-            origin: ray.origin.to_array(),
-            direction: ray.direction.to_array(),
-            t_min,
-        }
-    }
-}
-
-impl RayLanes<crate::lanes::F8> {
-    /// One ray repeated in all eight lanes.
+impl<R: crate::lanes::Real> RayLanes<R> {
+    /// One ray repeated in every lane (as one lane, for `f32`).
     #[inline(always)]
     pub fn splat(ray: &Ray, t_min: f32) -> Self {
-        use crate::lanes::{Real, F8};
+        use crate::lanes::map3;
         RayLanes {
-            origin: ray.origin.to_array().map(F8::splat),
-            direction: ray.direction.to_array().map(F8::splat),
-            t_min: F8::splat(t_min),
+            origin: map3(&ray.origin.to_array(), R::splat),
+            direction: map3(&ray.direction.to_array(), R::splat),
+            t_min: R::splat(t_min),
         }
     }
 }

@@ -170,7 +170,10 @@ impl Mesh {
             .triangles
             .iter()
             .enumerate()
-            .filter_map(|(i, t)| t.hit(ray, 0.0, f32::INFINITY).map(|t| (t, i)))
+            .filter_map(|(i, t)| {
+                t.hit(ray, Interval::new(0.0, f32::INFINITY))
+                    .map(|t| (t, i))
+            })
             .collect();
         h.sort_by(|a, b| a.partial_cmp(b).unwrap());
         h

@@ -177,13 +177,12 @@ impl QuadPacket {
     /// Quad `s` of the packet in every lane.
     #[inline(always)]
     pub(super) fn splat<R: Real>(&self, s: usize) -> QuadLanes<R> {
-        let f = |c: &[Lane8; 3]| splat_lane(c, s);
         QuadLanes {
-            corner: f(&self.corner),
-            u: f(&self.u),
-            v: f(&self.v),
-            normal: f(&self.normal),
-            w: f(&self.w),
+            corner: splat_lane(&self.corner, s),
+            u: splat_lane(&self.u, s),
+            v: splat_lane(&self.v, s),
+            normal: splat_lane(&self.normal, s),
+            w: splat_lane(&self.w, s),
             d: R::splat(self.d[s]),
         }
     }
@@ -616,19 +615,10 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
         false
     }
 
-    /// The ray in every lane of `R`.
-    #[inline(always)]
-    fn lanes<R: Real>(&self) -> RayLanes<R> {
-        RayLanes {
-            origin: map3(&self.ray.origin.to_array(), R::splat),
-            direction: map3(&self.ray.direction.to_array(), R::splat),
-            t_min: R::splat(self.t_min),
-        }
-    }
-
     #[inline(always)]
     fn spheres<R: Wide>(&mut self, p: &SpherePacket) -> bool {
-        let (t, valid) = sphere::intersect(&self.lanes(), &p.lanes());
+        let ray = RayLanes::splat(&self.ray, self.t_min);
+        let (t, valid) = sphere::intersect(&ray, &p.lanes());
         self.found::<R>(t, valid, &p.index)
     }
 
@@ -641,7 +631,8 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
 
     #[inline(always)]
     fn quads<R: Wide>(&mut self, p: &QuadPacket) -> bool {
-        let (t, valid) = quad::intersect(&self.lanes(), &p.lanes());
+        let ray = RayLanes::splat(&self.ray, self.t_min);
+        let (t, valid) = quad::intersect(&ray, &p.lanes());
         self.found::<R>(t, valid, &p.index)
     }
 
@@ -658,13 +649,14 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             if Q::ANY {
                 let within = Interval::new(self.t_min, self.closest);
                 if instance.occluded(&self.ray, within) {
+                    // Any distance below the interval's end says "hit".
                     self.closest = self.t_min;
                     return true;
                 }
                 continue;
             }
             if let Some((t, sub)) = instance.hit(&self.ray, self.t_min, self.closest) {
-                if t < self.closest || (t == self.closest && index < self.best) {
+                if comes_before((t, index), (self.closest, self.best)) {
                     (self.closest, self.best, self.sub) = (t, index, sub);
                 }
             }
@@ -753,6 +745,9 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
     fn leaf(&mut self, bvh: &Bvh, leaf: u32, _: &f32) -> bool {
         let (kind, i) = leaf_parts(leaf);
         let kind = if SPHERES { Kind::Sphere } else { kind };
+        if kind == Kind::Instance {
+            return self.instances(bvh, bvh.instance_packet(i));
+        }
         // SAFETY (the AVX2 calls): `avx2` is true only when `Isa::detect`
         // found AVX2.
         #[cfg(target_arch = "x86_64")]
@@ -761,29 +756,36 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
             return match kind {
                 Kind::Sphere => unsafe { single_avx2::spheres(self, bvh.sphere_packet(i)) },
                 Kind::Triangle => unsafe { single_avx2::triangles(self, bvh.triangle_packet(i)) },
-                Kind::Quad => unsafe { single_avx2::quads(self, bvh.quad_packet(i)) },
-                Kind::Instance => self.instances(bvh, bvh.instance_packet(i)),
+                _ => unsafe { single_avx2::quads(self, bvh.quad_packet(i)) },
             };
         }
         match kind {
             Kind::Sphere => self.spheres::<F8>(bvh.sphere_packet(i)),
             Kind::Triangle => self.triangles::<F8>(bvh.triangle_packet(i)),
-            Kind::Quad => self.quads::<F8>(bvh.quad_packet(i)),
-            Kind::Instance => self.instances(bvh, bvh.instance_packet(i)),
+            _ => self.quads::<F8>(bvh.quad_packet(i)),
         }
     }
 }
 
+/// Whether hit (distance, index) comes before hit `other` in the order every
+/// query keeps: nearer first, the lower index among hits at exactly the same
+/// distance (coincident surfaces), so that the result does not depend on the
+/// order of the visit.
+#[inline(always)]
+pub(super) fn comes_before((t, index): (f32, u32), (closest, best): (f32, u32)) -> bool {
+    t < closest || (t == closest && index < best)
+}
+
 /// The end of a packet test: `t_best` is the nearest distance found, not
 /// beyond `closest`, and bit `lane` of `equal` is set for the lanes at that
-/// distance, whose sphere indices are `index[lane]`. Returns the hit if
+/// distance, whose primitive indices are `index[lane]`. Returns the hit if
 /// (t_best, lowest of those indices) comes before (closest, best).
 #[inline(always)]
 fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Option<(f32, u32)> {
     let first = equal.trailing_zeros() as usize;
     let mut lowest = index[first];
     if equal & (equal - 1) != 0 {
-        // Several spheres at exactly the same distance (coincident surfaces):
+        // Several primitives at exactly the same distance (coincident surfaces):
         // the lowest index wins, wherever the spheres sit in the tree.
         let mut rest = equal & (equal - 1);
         while rest != 0 {
@@ -791,7 +793,8 @@ fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Op
             rest &= rest - 1;
         }
     }
-    (t_best < closest || lowest < best).then_some((t_best, lowest))
+    // t_best is not beyond closest: equal or nearer.
+    comes_before((t_best, lowest), (closest, best)).then_some((t_best, lowest))
 }
 
 /// The lanes set in `mask` (at least one, of four) ordered by `distance`,
@@ -1123,7 +1126,7 @@ mod tests {
             let d = crate::sampling::unit_vector(&mut rng);
             let ray = Ray::new(point(&mut rng, 6.0), d);
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
-            let lanes = RayLanes::splat(&ray, interval.min);
+            let lanes = RayLanes::<F8>::splat(&ray, interval.min);
             let axes = TriangleRay::axes_of(d);
             let tri_ray = splat_triangle_ray(&TriangleRay::new(&ray, axes, interval.min));
             let mut check = |t: F8, valid: crate::lanes::M8, index: &[u32; 8]| {

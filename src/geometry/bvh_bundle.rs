@@ -28,8 +28,8 @@
 //! bundle.
 
 use super::bvh::{
-    leaf_parts, Bvh, Hit, InstancePacket, Node, QuadPacket, Rays, SpherePacket, TrianglePacket,
-    NO_CHILD, SLACK,
+    comes_before, leaf_parts, Bvh, Hit, InstancePacket, Node, QuadPacket, Rays, SpherePacket,
+    TrianglePacket, NO_CHILD, SLACK,
 };
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
@@ -219,7 +219,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             t_min: [interval.min; LANES],
         };
         let mut is_axis = [[0; 2]; 3];
-        if bvh.has_triangles() {
+        if !SPHERES && bvh.has_triangles() {
             for lane in 0..LANES {
                 let ray = rays.ray(lane);
                 let axes = TriangleRay::axes_of(ray.direction);
@@ -393,7 +393,7 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
                 }
                 let instance = &bvh.instances()[p.instance[s] as usize];
                 if let Some((t, sub)) = instance.hit(&ray, self.t_min, self.closest[l]) {
-                    if t < self.closest[l] || (t == self.closest[l] && index < self.best[l]) {
+                    if comes_before((t, index), (self.closest[l], self.best[l])) {
                         (self.closest[l], self.best[l], self.sub[l]) = (t, index, sub);
                     }
                 }
@@ -512,6 +512,11 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
     fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) -> bool {
         let (kind, i) = leaf_parts(leaf);
         let kind = if SPHERES { Kind::Sphere } else { kind };
+        if kind == Kind::Instance {
+            let enter = F8::bits(self.entering::<F8>(entry));
+            self.instances(bvh, bvh.instance_packet(i), enter);
+            return false;
+        }
         // SAFETY (the AVX2 calls): `avx2` is true only when `Isa::detect`
         // found AVX2.
         #[cfg(target_arch = "x86_64")]
@@ -522,22 +527,14 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
                 Kind::Triangle => unsafe {
                     bundle_avx2::triangles(self, bvh.triangle_packet(i), entry)
                 },
-                Kind::Quad => unsafe { bundle_avx2::quads(self, bvh.quad_packet(i), entry) },
-                Kind::Instance => {
-                    let enter = F8::bits(self.entering::<F8>(entry));
-                    self.instances(bvh, bvh.instance_packet(i), enter)
-                }
+                _ => unsafe { bundle_avx2::quads(self, bvh.quad_packet(i), entry) },
             }
             return false;
         }
         match kind {
             Kind::Sphere => self.spheres::<F8>(bvh.sphere_packet(i), entry),
             Kind::Triangle => self.triangles::<F8>(bvh.triangle_packet(i), entry),
-            Kind::Quad => self.quads::<F8>(bvh.quad_packet(i), entry),
-            Kind::Instance => {
-                let enter = F8::bits(self.entering::<F8>(entry));
-                self.instances(bvh, bvh.instance_packet(i), enter)
-            }
+            _ => self.quads::<F8>(bvh.quad_packet(i), entry),
         }
         false
     }

@@ -80,8 +80,8 @@ impl Primitive {
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
         match self {
             Primitive::Sphere(s) => s.hit(ray, interval),
-            Primitive::Triangle(t) => t.hit(ray, interval.min, interval.max),
-            Primitive::Quad(q) => q.hit(ray, interval.min, interval.max),
+            Primitive::Triangle(t) => t.hit(ray, interval),
+            Primitive::Quad(q) => q.hit(ray, interval),
             Primitive::Instance { .. } => None,
         }
     }

@@ -8,7 +8,7 @@
 //! α and β in [0, 1], and (α, β) is also its texture coordinate.
 
 use crate::lanes::{Mask, Real};
-use crate::math::{Point3, Vec3};
+use crate::math::{Interval, Point3, Vec3};
 use crate::ray::{Ray, RayLanes};
 
 /// Rays closer to parallel with the plane than this (|n·B| for a unit
@@ -66,10 +66,10 @@ impl Quad {
     }
 
     /// The distance along unit `ray` to the quad, if it is hit strictly
-    /// between `t_min` and `t_max`.
-    pub fn hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<f32> {
-        let (t, valid) = intersect(&RayLanes::from_ray(ray, t_min), &self.lanes());
-        (valid && t < t_max).then_some(t)
+    /// inside `interval`.
+    pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
+        let (t, valid) = intersect(&RayLanes::splat(ray, interval.min), &self.lanes());
+        (valid && t < interval.max).then_some(t)
     }
 
     /// The quad's (α, β) coordinates of a point of its plane.
@@ -162,14 +162,16 @@ mod tests {
     fn hits_inside_at_the_right_distance_and_coordinates() {
         let q = floor();
         let ray = Ray::new(Vec3::new(0.5, 3.0, 0.0), -Vec3::Y);
-        assert_eq!(q.hit(&ray, 0.001, f32::INFINITY), Some(3.0));
+        assert_eq!(q.hit(&ray, Interval::new(0.001, f32::INFINITY)), Some(3.0));
         assert_eq!(q.coordinates(ray.at(3.0)), (0.75, 0.5));
         // From below (the back face) too.
         let up = Ray::new(Vec3::new(0.5, -2.0, 0.0), Vec3::Y);
-        assert_eq!(q.hit(&up, 0.001, f32::INFINITY), Some(2.0));
+        assert_eq!(q.hit(&up, Interval::new(0.001, f32::INFINITY)), Some(2.0));
         let slanted_dir = Vec3::new(1.0, -1.0, 0.0).normalize();
         let slanted = Ray::new(Vec3::new(-1.0, 1.0, 0.0), slanted_dir);
-        let t = q.hit(&slanted, 0.0, f32::INFINITY).expect("hits");
+        let t = q
+            .hit(&slanted, Interval::new(0.0, f32::INFINITY))
+            .expect("hits");
         assert!((t - 2f32.sqrt()).abs() < 1e-6);
     }
 
@@ -184,16 +186,20 @@ mod tests {
             (5.0, 5.0),
         ] {
             let ray = Ray::new(Vec3::new(x, 1.0, z), -Vec3::Y);
-            assert_eq!(q.hit(&ray, 0.0, f32::INFINITY), None, "({x}, {z})");
+            assert_eq!(
+                q.hit(&ray, Interval::new(0.0, f32::INFINITY)),
+                None,
+                "({x}, {z})"
+            );
         }
         // On the edge x = 1: inside (the interval is closed).
         let edge = Ray::new(Vec3::new(1.0, 1.0, 0.0), -Vec3::Y);
-        assert_eq!(q.hit(&edge, 0.0, f32::INFINITY), Some(1.0));
+        assert_eq!(q.hit(&edge, Interval::new(0.0, f32::INFINITY)), Some(1.0));
         let parallel = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::X);
-        assert_eq!(q.hit(&parallel, 0.0, f32::INFINITY), None);
+        assert_eq!(q.hit(&parallel, Interval::new(0.0, f32::INFINITY)), None);
         let ray = Ray::new(Vec3::new(0.0, 3.0, 0.0), -Vec3::Y);
-        assert_eq!(q.hit(&ray, 0.0, 2.5), None);
-        assert_eq!(q.hit(&ray, 3.0, 5.0), None);
+        assert_eq!(q.hit(&ray, Interval::new(0.0, 2.5)), None);
+        assert_eq!(q.hit(&ray, Interval::new(3.0, 5.0)), None);
     }
 
     #[test]

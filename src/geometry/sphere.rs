@@ -34,7 +34,7 @@ impl Sphere {
             "ray direction {} is not unit length",
             ray.direction
         );
-        let (t, valid) = intersect(&RayLanes::from_ray(ray, interval.min), &self.lanes());
+        let (t, valid) = intersect(&RayLanes::splat(ray, interval.min), &self.lanes());
         (valid && t < interval.max).then_some(t)
     }
 

@@ -27,7 +27,7 @@
 //! claims the vertex.
 
 use crate::lanes::{Mask, Real};
-use crate::math::{Point3, Vec3};
+use crate::math::{Interval, Point3, Vec3};
 use crate::ray::Ray;
 
 /// A triangle given by its three vertices, counter-clockwise seen from the
@@ -59,12 +59,12 @@ impl Triangle {
     }
 
     /// The distance along `ray` (unit or not) to the triangle, if it is hit
-    /// strictly between `t_min` and `t_max`.
-    pub fn hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<f32> {
+    /// strictly inside `interval`.
+    pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<f32> {
         let axes = TriangleRay::axes_of(ray.direction);
-        let r = TriangleRay::new(ray, axes, t_min);
+        let r = TriangleRay::new(ray, axes, interval.min);
         let (t, valid) = intersect(&r, &self.lanes(&axes));
-        (valid && t < t_max).then_some(t)
+        (valid && t < interval.max).then_some(t)
     }
 
     /// The triangle as one lane of [`intersect`], in the ray's axes.
@@ -216,13 +216,15 @@ mod tests {
     fn ray_through_the_inside_hits_at_the_right_distance() {
         let t = unit_right_triangle();
         let ray = Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z);
-        assert_eq!(t.hit(&ray, 0.0, f32::INFINITY), Some(2.0));
+        assert_eq!(t.hit(&ray, Interval::new(0.0, f32::INFINITY)), Some(2.0));
         // From behind: back faces are hit too.
         let back = Ray::new(Vec3::new(0.25, 0.25, -3.0), Vec3::Z);
-        assert_eq!(t.hit(&back, 0.0, f32::INFINITY), Some(3.0));
+        assert_eq!(t.hit(&back, Interval::new(0.0, f32::INFINITY)), Some(3.0));
         // A slanted, non-unit direction: t is in units of the direction.
         let slanted = Ray::new(Vec3::new(0.0, 0.0, 4.0), Vec3::new(0.25, 0.25, -4.0));
-        let got = t.hit(&slanted, 0.0, f32::INFINITY).expect("hits");
+        let got = t
+            .hit(&slanted, Interval::new(0.0, f32::INFINITY))
+            .expect("hits");
         assert!((got - 1.0).abs() < 1e-6, "t = {got}");
     }
 
@@ -231,7 +233,11 @@ mod tests {
         let t = unit_right_triangle();
         for (x, y) in [(0.6, 0.6), (-0.1, 0.5), (0.5, -0.1), (1.1, 0.0), (2.0, 2.0)] {
             let ray = Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
-            assert_eq!(t.hit(&ray, 0.0, f32::INFINITY), None, "at ({x}, {y})");
+            assert_eq!(
+                t.hit(&ray, Interval::new(0.0, f32::INFINITY)),
+                None,
+                "at ({x}, {y})"
+            );
         }
     }
 
@@ -240,16 +246,19 @@ mod tests {
         let t = unit_right_triangle();
         // In the triangle's plane, and parallel above it.
         let inside_plane = Ray::new(Vec3::new(-1.0, 0.25, 0.0), Vec3::X);
-        assert_eq!(t.hit(&inside_plane, 0.0, f32::INFINITY), None);
+        assert_eq!(
+            t.hit(&inside_plane, Interval::new(0.0, f32::INFINITY)),
+            None
+        );
         let above = Ray::new(Vec3::new(-1.0, 0.25, 1.0), Vec3::X);
-        assert_eq!(t.hit(&above, 0.0, f32::INFINITY), None);
+        assert_eq!(t.hit(&above, Interval::new(0.0, f32::INFINITY)), None);
         // Behind the origin, or beyond t_max, or at exactly t_min.
         let ray = Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z);
-        assert_eq!(t.hit(&ray, 0.0, 1.5), None);
-        assert_eq!(t.hit(&ray, 2.0, 5.0), None);
-        assert_eq!(t.hit(&ray, 2.5, 5.0), None);
+        assert_eq!(t.hit(&ray, Interval::new(0.0, 1.5)), None);
+        assert_eq!(t.hit(&ray, Interval::new(2.0, 5.0)), None);
+        assert_eq!(t.hit(&ray, Interval::new(2.5, 5.0)), None);
         let away = Ray::new(Vec3::new(0.25, 0.25, 2.0), Vec3::Z);
-        assert_eq!(t.hit(&away, 0.0, f32::INFINITY), None);
+        assert_eq!(t.hit(&away, Interval::new(0.0, f32::INFINITY)), None);
     }
 
     #[test]
@@ -264,7 +273,7 @@ mod tests {
                 let ray = Ray::new(Vec3::new(s, s, -dir.z), dir);
                 let hits = [first, second]
                     .iter()
-                    .filter(|t| t.hit(&ray, 0.0, f32::INFINITY).is_some())
+                    .filter(|t| t.hit(&ray, Interval::new(0.0, f32::INFINITY)).is_some())
                     .count();
                 assert_eq!(hits, 1, "diagonal point {s}, direction {dir}");
             }
@@ -295,7 +304,7 @@ mod tests {
                 let ray = Ray::new(-dir, dir);
                 let hits = fan
                     .iter()
-                    .filter(|t| t.hit(&ray, 0.0, f32::INFINITY).is_some())
+                    .filter(|t| t.hit(&ray, Interval::new(0.0, f32::INFINITY)).is_some())
                     .count();
                 assert_eq!(hits, 1, "flip {flip}, direction {dir}");
             }

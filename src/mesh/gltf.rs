@@ -17,7 +17,7 @@
 //! (it can slice out of bounds or misread on a bad file), so every accessor is
 //! checked against its buffer view and buffer before it is read.
 
-use super::{read_file, MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
+use super::{MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -25,8 +25,8 @@ use gltf::mesh::{Mode, Semantic};
 use std::path::Path;
 
 /// Loads a `.gltf` or `.glb` file.
-pub(super) fn load(path: &Path) -> Result<Model, MeshError> {
-    let bytes = read_file(path)?;
+/// `bytes` are the file's content.
+pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let err = |msg: String| MeshError::new(path, None, msg);
     check_glb_header(&bytes).map_err(err)?;
     let invalid = |e: gltf::Error| err(format!("invalid glTF: {e}"));

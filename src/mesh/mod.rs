@@ -206,6 +206,10 @@ pub struct Model {
     /// glTF primitives of point or line modes, which have no surface and are
     /// skipped (triangle strips and fans are converted to triangles).
     pub skipped_primitives: usize,
+    /// CRC-32 of the file's bytes, as read (a scene's identity holds it).
+    pub file_crc: u32,
+    /// The file's length in bytes, as read.
+    pub file_len: u64,
 }
 
 impl Model {
@@ -310,18 +314,27 @@ pub fn load(path: &Path) -> Result<Model, MeshError> {
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("obj") => obj::load(path),
-        Some("gltf") | Some("glb") => gltf::load(path),
-        _ => Err(MeshError::new(
-            path,
-            None,
-            format!(
-                "unsupported mesh format; the supported extensions are {}",
-                SUPPORTED_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
-            ),
-        )),
-    }
+    let format = match ext.as_deref() {
+        Some("obj") => obj::load,
+        Some("gltf") | Some("glb") => gltf::load,
+        _ => {
+            return Err(MeshError::new(
+                path,
+                None,
+                format!(
+                    "unsupported mesh format; the supported extensions are {}",
+                    SUPPORTED_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
+                ),
+            ))
+        }
+    };
+    let bytes = read_file(path)?;
+    let (file_crc, file_len) = (crc32fast::hash(&bytes), bytes.len() as u64);
+    Ok(Model {
+        file_crc,
+        file_len,
+        ..format(path, bytes)?
+    })
 }
 
 /// Reads a whole file, with a clear error for a missing file or a directory.

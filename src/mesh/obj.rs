@@ -12,15 +12,15 @@
 //! identity instance; `usemtl` switches only the per-triangle material.
 //! Line (`l`) and point (`p`) elements have no surface and are ignored.
 
-use super::{read_file, MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use super::{MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
 use glam::Mat4;
 use std::borrow::Cow;
 use std::cell::RefCell;
 use std::path::Path;
 
 /// Loads an OBJ file and the MTL files it names.
-pub(super) fn load(path: &Path) -> Result<Model, MeshError> {
-    let bytes = read_file(path)?;
+/// `bytes` are the file's content.
+pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let text = utf8(path, &bytes)?;
     let text = check_faces(path, text)?;
 

@@ -130,7 +130,8 @@ impl Scene {
         } = objects;
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
-        let scene = Scene {
+        stats.geometry_bytes = world.memory_bytes() as u64;
+        Ok(Scene {
             settings,
             camera,
             background,
@@ -139,22 +140,6 @@ impl Scene {
             sources,
             stats,
             world,
-        };
-        let mesh_bytes: usize = scene
-            .world
-            .top
-            .meshes
-            .iter()
-            .chain(scene.world.groups.iter().flat_map(|g| &g.shapes.meshes))
-            .map(|m| m.data.heap_bytes())
-            .sum();
-        let geometry_bytes = (mesh_bytes + scene.bvh_memory_bytes()) as u64;
-        Ok(Scene {
-            stats: SceneStats {
-                geometry_bytes,
-                ..scene.stats
-            },
-            ..scene
         })
     }
 }
@@ -284,10 +269,8 @@ impl<'a> Objects<'a> {
                     None => {
                         // Stretched unevenly: an ellipsoid, traced as the
                         // sphere in its own space.
-                        let shapes = Shapes {
-                            spheres: vec![Surface::new(&sphere, m)],
-                            ..Shapes::default()
-                        };
+                        let mut shapes = Shapes::default();
+                        shapes.spheres.push(Surface::new(&sphere, m));
                         self.groups.push(Group::new(shapes));
                         self.instances
                             .push((self.groups.len() as u32 - 1, transform, None));
@@ -376,11 +359,10 @@ impl<'a> Objects<'a> {
         }
         let fail = |message: String| invalid(format!("objects[{i}].file"), message);
         let model = mesh::load(&path).map_err(|e| fail(e.to_string()))?;
-        let bytes = std::fs::read(&path).map_err(|e| fail(format!("{}: {e}", path.display())))?;
         self.sources.push(MeshSource {
             file: file.to_string(),
-            crc: crc32fast::hash(&bytes),
-            len: bytes.len() as u64,
+            crc: model.file_crc,
+            len: model.file_len,
         });
         self.stats.skipped_degenerate += model.skipped_degenerate as u64;
         let materials = vec![None; model.materials.len() + 1];
@@ -434,8 +416,7 @@ impl<'a> Objects<'a> {
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n;
                 self.top
-                    .meshes
-                    .push(place_mesh(mesh, &only.transform, only.object)?);
+                    .push_mesh(place_mesh(mesh, &only.transform, only.object)?);
             } else {
                 // Stored once with the file's materials; an instance whose
                 // object names a material uses it instead.
@@ -443,31 +424,16 @@ impl<'a> Objects<'a> {
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n * placed.len() as u64;
+                let group = Group::new(Shapes::of_mesh(mesh));
                 // Each placement must stay within f32, as a mesh placed once
-                // must: the corners of the mesh's bounds, placed.
-                let (lo, hi) = mesh.data.positions.iter().fold(
-                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                    |(lo, hi), p| (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p))),
-                );
+                // must: its tree's box, placed.
                 for p in placed {
-                    let inside = (0..8).all(|c| {
-                        let pick = |k: usize, a: f32, b: f32| if c & (1 << k) == 0 { a } else { b };
-                        let corner = Vec3::new(
-                            pick(0, lo.x, hi.x),
-                            pick(1, lo.y, hi.y),
-                            pick(2, lo.z, hi.z),
-                        );
-                        p.transform.point(corner).is_finite()
-                    });
-                    if !inside {
+                    let placed_box = p.transform.bounds(&group.bvh.bounds());
+                    if !(placed_box.min.is_finite() && placed_box.max.is_finite()) {
                         return Err(out_of_range(p.object));
                     }
                 }
-                let shapes = Shapes {
-                    meshes: vec![mesh],
-                    ..Shapes::default()
-                };
-                self.groups.push(Group::new(shapes));
+                self.groups.push(group);
                 let group = self.groups.len() as u32 - 1;
                 self.instances
                     .extend(placed.iter().map(|p| (group, p.transform, p.material)));
@@ -573,7 +539,7 @@ fn box_faces(min: Vec3, max: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
         (Vec3::new(max.x, min.y, min.z), -dx, dy), // back (−z)
         (Vec3::new(min.x, min.y, min.z), dz, dy),  // left (−x)
         (Vec3::new(min.x, max.y, max.z), dx, -dz), // top (+y)
-        (Vec3::new(min.x, min.y, min.z), dz, dx),  // bottom (−y)
+        (Vec3::new(min.x, min.y, min.z), dx, dz),  // bottom (−y)
     ]
 }
 
@@ -739,4 +705,31 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
             })
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_faces_point_out_of_the_box() {
+        let (min, max) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 1.0, 5.0));
+        let center = 0.5 * (min + max);
+        let mut seen = Vec::new();
+        for (q, u, v) in box_faces(min, max) {
+            let n = u.cross(v).normalize();
+            let face_center = q + 0.5 * (u + v);
+            assert!(
+                n.dot(face_center - center) > 0.0,
+                "face at {face_center} has normal {n}"
+            );
+            seen.push(n);
+        }
+        // One face per direction ±x, ±y, ±z.
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            for sign in [1.0, -1.0] {
+                assert!(seen.iter().any(|n| (*n - sign * axis).length() < 1e-6));
+            }
+        }
+    }
 }

@@ -262,13 +262,7 @@ impl Scene {
     /// Bytes of memory held by the acceleration structure (the scene's tree
     /// and the trees of its instanced meshes).
     pub fn bvh_memory_bytes(&self) -> usize {
-        self.world.bvh.memory_bytes()
-            + self
-                .world
-                .groups
-                .iter()
-                .map(|g| g.bvh.memory_bytes())
-                .sum::<usize>()
+        self.world.bvh_memory_bytes()
     }
 }
 

@@ -66,7 +66,10 @@ impl Mesh {
 pub(crate) struct Shapes {
     pub(crate) spheres: Vec<Surface>,
     pub(crate) quads: Vec<(Quad, u32)>,
-    pub(crate) meshes: Vec<Mesh>,
+    meshes: Vec<Mesh>,
+    /// Per mesh, the number of triangles of it and the meshes before it:
+    /// where its triangles end among the triangle items.
+    mesh_end: Vec<usize>,
 }
 
 /// What item `index` of a tree is.
@@ -78,6 +81,20 @@ enum Item {
 }
 
 impl Shapes {
+    /// Shapes holding `mesh` alone.
+    pub(crate) fn of_mesh(mesh: Mesh) -> Shapes {
+        let mut shapes = Shapes::default();
+        shapes.push_mesh(mesh);
+        shapes
+    }
+
+    /// Adds a mesh after those already there.
+    pub(crate) fn push_mesh(&mut self, mesh: Mesh) {
+        let start = self.mesh_end.last().copied().unwrap_or(0);
+        self.mesh_end.push(start + mesh.data.triangles.len());
+        self.meshes.push(mesh);
+    }
+
     /// The tree's items, in their numbering.
     pub(crate) fn primitives(&self) -> Vec<Primitive> {
         let mut items: Vec<Primitive> = self
@@ -103,29 +120,16 @@ impl Shapes {
             return Item::Quad(index);
         }
         index -= self.quads.len();
-        for (m, mesh) in self.meshes.iter().enumerate() {
-            let n = mesh.data.triangles.len();
-            if index < n {
-                return Item::Triangle(m, index);
-            }
-            index -= n;
+        // The first mesh ending after `index`.
+        let m = self.mesh_end.partition_point(|&end| end <= index);
+        match self.meshes.get(m) {
+            Some(mesh) => Item::Triangle(m, index + mesh.data.triangles.len() - self.mesh_end[m]),
+            None => Item::Instance(index - self.mesh_end.last().copied().unwrap_or(0)),
         }
-        Item::Instance(index)
-    }
-
-    /// The number of items before the instances.
-    pub(crate) fn len(&self) -> usize {
-        self.spheres.len()
-            + self.quads.len()
-            + self
-                .meshes
-                .iter()
-                .map(|m| m.data.triangles.len())
-                .sum::<usize>()
     }
 
     /// The record of a hit on item `index` at distance `t` of `ray`, in the
-    /// space the shapes are stored in; `None` for an instance.
+    /// space the shapes are stored in; for an instance, its number instead.
     #[inline(always)]
     fn record(&self, ray: &Ray, t: f32, index: u32, error_scale: f32) -> Result<HitRecord, usize> {
         Ok(match self.item(index as usize) {
@@ -189,8 +193,9 @@ fn triangle_record(
 ) -> HitRecord {
     let tri = mesh.triangle(k);
     let [a, b, c] = tri.vertices;
-    let geometric = tri.area_normal().normalize();
-    let b_ = barycentrics(&tri, ray.at(t));
+    let area_normal = tri.area_normal();
+    let geometric = area_normal.normalize();
+    let b_ = barycentrics(&tri, area_normal, ray.at(t));
     let point = b_[0] * a + b_[1] * b + b_[2] * c;
     let (normal, front_face) = face_normal(ray, geometric);
     let idx = mesh.data.triangles[k].map(|i| i as usize);
@@ -199,15 +204,7 @@ fn triangle_record(
             let n = b_[0] * Vec3::from(ns[idx[0]])
                 + b_[1] * Vec3::from(ns[idx[1]])
                 + b_[2] * Vec3::from(ns[idx[2]]);
-            let n = n.normalize_or_zero();
-            // Towards the side the geometric normal faces.
-            if n == Vec3::ZERO {
-                normal
-            } else if n.dot(normal) < 0.0 {
-                -n
-            } else {
-                n
-            }
+            facing(n.normalize_or_zero(), normal)
         }
         None => normal,
     };
@@ -235,11 +232,23 @@ fn triangle_record(
     }
 }
 
+/// Unit shading normal `n` turned to the side the geometric `normal` faces;
+/// `normal` itself when `n` is zero (vertex normals that cancel).
+fn facing(n: Vec3, normal: Vec3) -> Vec3 {
+    if n == Vec3::ZERO {
+        normal
+    } else if n.dot(normal) < 0.0 {
+        -n
+    } else {
+        n
+    }
+}
+
 /// The barycentric coordinates of `p` (near the triangle's plane) in
-/// `tri`, from the areas of the sub-triangles, clamped to the triangle.
-fn barycentrics(tri: &Triangle, p: Point3) -> [f32; 3] {
+/// `tri`, whose [`Triangle::area_normal`] is `n`, from the areas of the
+/// sub-triangles, clamped to the triangle.
+fn barycentrics(tri: &Triangle, n: Vec3, p: Point3) -> [f32; 3] {
     let [a, b, c] = tri.vertices;
-    let n = tri.area_normal();
     let n2 = n.length_squared();
     let b1 = (p - a).cross(c - a).dot(n) / n2;
     let b2 = (b - a).cross(p - a).dot(n) / n2;
@@ -257,23 +266,34 @@ pub(crate) struct Group {
 }
 
 impl Group {
+    /// The shapes with their tree.
     pub(crate) fn new(shapes: Shapes) -> Group {
         let bvh = Arc::new(Bvh::new(&shapes.primitives()));
         Group { shapes, bvh }
     }
 }
 
+/// What the record of a hit in an instance needs beyond the instance.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    /// The group placed.
+    group: u32,
+    /// The material replacing the group's own, if any.
+    material: Option<u32>,
+    /// The transform's linear part's Frobenius norm: at most how much it
+    /// stretches the object's rounding.
+    stretch: f32,
+}
+
 /// The compiled shapes of a scene.
 #[derive(Clone, Debug)]
 pub(crate) struct World {
     pub(crate) bvh: Bvh,
-    pub(crate) top: Shapes,
-    pub(crate) groups: Vec<Group>,
-    /// Per instance: its group.
-    pub(crate) instance_group: Vec<u32>,
-    /// Per instance: the material replacing its shapes' own, if any.
-    pub(crate) instance_material: Vec<Option<u32>>,
-    pub(crate) error_scale: f32,
+    top: Shapes,
+    groups: Vec<Group>,
+    /// Per instance of `bvh`.
+    placed: Vec<Placed>,
+    error_scale: f32,
 }
 
 impl World {
@@ -286,13 +306,12 @@ impl World {
         error_scale: f32,
     ) -> World {
         let mut items = top.primitives();
-        let first = items.len() as u32;
-        let placed: Vec<Instance> = instances
+        let trees: Vec<Instance> = instances
             .iter()
             .map(|(g, transform, _)| Instance::new(*transform, groups[*g as usize].bvh.clone()))
             .collect();
         items.extend(
-            placed
+            trees
                 .iter()
                 .enumerate()
                 .map(|(i, inst)| Primitive::Instance {
@@ -300,16 +319,45 @@ impl World {
                     index: i as u32,
                 }),
         );
-        debug_assert_eq!(first as usize, top.len());
-        let bvh = Bvh::with_instances(&items, placed);
+        let placed = instances
+            .iter()
+            .map(|&(group, transform, material)| Placed {
+                group,
+                material,
+                stretch: [Vec3::X, Vec3::Y, Vec3::Z]
+                    .map(|e| transform.vector(e).length_squared())
+                    .iter()
+                    .sum::<f32>()
+                    .sqrt(),
+            })
+            .collect();
         World {
-            bvh,
+            bvh: Bvh::with_instances(&items, trees),
             top,
             groups,
-            instance_group: instances.iter().map(|(g, ..)| *g).collect(),
-            instance_material: instances.iter().map(|(_, _, m)| *m).collect(),
+            placed,
             error_scale,
         }
+    }
+
+    /// Bytes held by the meshes and the trees.
+    pub(crate) fn memory_bytes(&self) -> usize {
+        let shapes = std::iter::once(&self.top).chain(self.groups.iter().map(|g| &g.shapes));
+        let meshes: usize = shapes
+            .flat_map(|s| &s.meshes)
+            .map(|m| m.data.heap_bytes())
+            .sum();
+        meshes + self.bvh_memory_bytes()
+    }
+
+    /// Bytes held by the scene's tree and the trees of its groups.
+    pub(crate) fn bvh_memory_bytes(&self) -> usize {
+        self.bvh.memory_bytes()
+            + self
+                .groups
+                .iter()
+                .map(|g| g.bvh.memory_bytes())
+                .sum::<usize>()
     }
 
     /// The full record of a hit the tree found.
@@ -323,9 +371,9 @@ impl World {
 
     #[inline(never)]
     fn instance_record(&self, ray: &Ray, hit: Hit, i: usize) -> HitRecord {
-        let instance = &self.bvh.instances()[i];
-        let group = &self.groups[self.instance_group[i] as usize];
-        let transform = &instance.transform;
+        let placed = self.placed[i];
+        let transform = &self.bvh.instances()[i].transform;
+        let group = &self.groups[placed.group as usize];
         let (object_ray, scale) = transform.to_object_ray(ray);
         let inner = group
             .shapes
@@ -338,20 +386,11 @@ impl World {
         };
         let point = transform.point(inner.point);
         let (normal, front_face) = face_normal(ray, transform.normal(outward));
-        let mut shading_normal = transform.normal(inner.shading_normal);
-        if shading_normal.dot(normal) < 0.0 {
-            shading_normal = -shading_normal;
-        }
-        if !inner.is_smooth() {
-            shading_normal = normal;
-        }
-        // The transform stretches the object's rounding by at most its
-        // linear part's Frobenius norm.
-        let stretch = [Vec3::X, Vec3::Y, Vec3::Z]
-            .map(|e| transform.vector(e).length_squared())
-            .iter()
-            .sum::<f32>()
-            .sqrt();
+        let shading_normal = if inner.is_smooth() {
+            facing(transform.normal(inner.shading_normal), normal)
+        } else {
+            normal
+        };
         HitRecord {
             point,
             normal,
@@ -359,9 +398,10 @@ impl World {
             uv: inner.uv,
             t: hit.t,
             front_face,
-            material: self.instance_material[i].unwrap_or(inner.material),
+            material: placed.material.unwrap_or(inner.material),
             object: hit.index,
-            error: inner.error * stretch * 4.0 + point.abs().max_element() * self.error_scale,
+            error: inner.error * placed.stretch * 4.0
+                + point.abs().max_element() * self.error_scale,
         }
     }
 }
