@@ -2,8 +2,8 @@
 //! ([`trace_path`]), and the same for a group of camera rays of one pixel
 //! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
+use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
-use crate::geometry::HitRecord;
 use crate::math::{Color, Interval};
 use crate::ray::Ray;
 use crate::rng::Rng;
@@ -47,16 +47,11 @@ enum Step {
 /// background lights it). The surface's material absorbs the path or
 /// scatters it, multiplying `throughput` by its attenuation.
 #[inline(always)]
-fn step(
-    scene: &Scene,
-    ray: &Ray,
-    hit: Option<HitRecord>,
-    throughput: &mut Color,
-    rng: &mut Rng,
-) -> Step {
+fn step(scene: &Scene, ray: &Ray, hit: Option<Hit>, throughput: &mut Color, rng: &mut Rng) -> Step {
     let Some(hit) = hit else {
         return Step::Done(*throughput * scene.background.color(ray.direction));
     };
+    let hit = scene.record(ray, hit);
     let material = &scene.materials[hit.material as usize];
     let Some(scatter) = material.scatter(ray.direction, &hit, rng) else {
         return Step::Done(Color::ZERO);
@@ -81,7 +76,7 @@ pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) ->
     let mut throughput = Color::ONE;
     for _ in 0..scene.settings.max_depth {
         *rays += 1;
-        let hit = scene.hit(&ray, range);
+        let hit = scene.intersect(&ray, range);
         match step(scene, &ray, hit, &mut throughput, rng) {
             Step::Continue(next) => ray = next,
             Step::Done(colour) => return colour,
@@ -151,12 +146,12 @@ fn find_hits(
     live: &[u8],
     reference: Option<&Ray>,
     range: Interval,
-    hits: &mut [Option<HitRecord>; PATHS],
+    hits: &mut [Option<Hit>; PATHS],
 ) {
     for group in live.chunks(LANES) {
         if group.len() < MIN_BUNDLE {
             for &i in group {
-                hits[i as usize] = scene.hit(&rays[i as usize], range);
+                hits[i as usize] = scene.intersect(&rays[i as usize], range);
             }
             continue;
         }

@@ -13,6 +13,7 @@ mod world;
 pub use desc::SceneDesc;
 
 use crate::camera::{Camera, CameraError};
+use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::{HitRecord, RayBundle, Sphere};
 use crate::material::Material;
@@ -214,8 +215,23 @@ impl Scene {
     /// have unit length.
     #[inline(always)]
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
-        let hit = self.world.bvh.hit(ray, interval)?;
-        Some(self.world.record(ray, hit))
+        let hit = self.intersect(ray, interval)?;
+        Some(self.record(ray, hit))
+    }
+
+    /// Which primitive `ray` hits first within `interval`, and where along
+    /// the ray, without working out the surface there ([`Scene::record`]
+    /// does); the ray's direction must have unit length.
+    #[inline(always)]
+    pub fn intersect(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
+        self.world.bvh.hit(ray, interval)
+    }
+
+    /// The surface where `ray` meets `hit` (found by [`Scene::intersect`] or
+    /// [`Scene::hit_bundle`] for this ray): point, normals, material, ….
+    #[inline(always)]
+    pub fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
+        self.world.record(ray, hit)
     }
 
     /// Whether `ray` hits anything within `interval` (a shadow ray's
@@ -226,9 +242,10 @@ impl Scene {
     }
 
     /// The nearest hit within `interval` of each ray `rays[lanes[k]]` (1 to
-    /// [`LANES`] of them), as [`Scene::hit`] would find it for each ray
-    /// alone, in the order of `lanes`; `reference` is a ray close to all of
-    /// them (see [`RayBundle`]). Entries beyond `lanes.len()` are `None`.
+    /// [`LANES`] of them), as [`Scene::intersect`] would find it for each
+    /// ray alone, in the order of `lanes`; `reference` is a ray close to all
+    /// of them (see [`RayBundle`]). Entries beyond `lanes.len()` are `None`.
+    /// The surfaces are left to [`Scene::record`], for the paths that need them.
     #[inline(always)]
     pub fn hit_bundle(
         &self,
@@ -236,16 +253,10 @@ impl Scene {
         lanes: &[u8],
         reference: &Ray,
         interval: Interval,
-    ) -> [Option<HitRecord>; LANES] {
-        let hits = self
-            .world
+    ) -> [Option<Hit>; LANES] {
+        self.world
             .bvh
-            .hit_bundle(&RayBundle::gather(rays, lanes), reference, interval);
-        let mut records = [None; LANES];
-        for (k, &i) in lanes.iter().enumerate() {
-            records[k] = hits[k].map(|hit| self.world.record(&rays[usize::from(i)], hit));
-        }
-        records
+            .hit_bundle(&RayBundle::gather(rays, lanes), reference, interval)
     }
 
     /// The radius of the sphere a hit record's `object` names, if it is a

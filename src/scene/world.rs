@@ -72,12 +72,15 @@ pub(crate) struct Shapes {
     mesh_end: Vec<usize>,
 }
 
-/// What item `index` of a tree is.
-enum Item {
+/// Which shape item `index` of a tree is (an instance is told apart by
+/// [`Shapes::locate`] before, so that a record is built in place rather
+/// than wrapped).
+#[derive(Clone, Copy)]
+enum Shape {
     Sphere(usize),
     Quad(usize),
+    /// Mesh, triangle in it.
     Triangle(usize, usize),
-    Instance(usize),
 }
 
 impl Shapes {
@@ -111,29 +114,34 @@ impl Shapes {
         items
     }
 
-    fn item(&self, mut index: usize) -> Item {
+    /// The shape item `index` is, or the number of the instance it is.
+    #[inline(always)]
+    fn locate(&self, mut index: usize) -> Result<Shape, usize> {
         if index < self.spheres.len() {
-            return Item::Sphere(index);
+            return Ok(Shape::Sphere(index));
         }
         index -= self.spheres.len();
         if index < self.quads.len() {
-            return Item::Quad(index);
+            return Ok(Shape::Quad(index));
         }
         index -= self.quads.len();
         // The first mesh ending after `index`.
         let m = self.mesh_end.partition_point(|&end| end <= index);
         match self.meshes.get(m) {
-            Some(mesh) => Item::Triangle(m, index + mesh.data.triangles.len() - self.mesh_end[m]),
-            None => Item::Instance(index - self.mesh_end.last().copied().unwrap_or(0)),
+            Some(mesh) => Ok(Shape::Triangle(
+                m,
+                index + mesh.data.triangles.len() - self.mesh_end[m],
+            )),
+            None => Err(index - self.mesh_end.last().copied().unwrap_or(0)),
         }
     }
 
-    /// The record of a hit on item `index` at distance `t` of `ray`, in the
-    /// space the shapes are stored in; for an instance, its number instead.
+    /// The record of a hit on `shape` (item `index`) at distance `t` of
+    /// `ray`, in the space the shapes are stored in.
     #[inline(always)]
-    fn record(&self, ray: &Ray, t: f32, index: u32, error_scale: f32) -> Result<HitRecord, usize> {
-        Ok(match self.item(index as usize) {
-            Item::Sphere(k) => {
+    fn record(&self, ray: &Ray, t: f32, shape: Shape, index: u32, error_scale: f32) -> HitRecord {
+        match shape {
+            Shape::Sphere(k) => {
                 let surface = &self.spheres[k];
                 let point = ray.at(t);
                 let outward = (point - surface.center) * surface.inverse_radius;
@@ -152,7 +160,7 @@ impl Shapes {
                     error: (point.abs().max_element() + surface.radius) * error_scale,
                 }
             }
-            Item::Quad(k) => {
+            Shape::Quad(k) => {
                 let (quad, material) = &self.quads[k];
                 // On the plane: the ray's rounding along its length removed.
                 let p = ray.at(t);
@@ -171,12 +179,11 @@ impl Shapes {
                     error: (point.abs().max_element() + quad.d.abs()) * error_scale,
                 }
             }
-            Item::Triangle(m, k) => {
+            Shape::Triangle(m, k) => {
                 let mesh = &self.meshes[m];
                 triangle_record(ray, t, mesh, k, index, error_scale)
             }
-            Item::Instance(i) => return Err(i),
-        })
+        }
     }
 }
 
@@ -363,8 +370,10 @@ impl World {
     /// The full record of a hit the tree found.
     #[inline(always)]
     pub(crate) fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
-        match self.top.record(ray, hit.t, hit.index, self.error_scale) {
-            Ok(record) => record,
+        match self.top.locate(hit.index as usize) {
+            Ok(shape) => self
+                .top
+                .record(ray, hit.t, shape, hit.index, self.error_scale),
             Err(i) => self.instance_record(ray, hit, i),
         }
     }
@@ -375,10 +384,14 @@ impl World {
         let transform = &self.bvh.instances()[i].transform;
         let group = &self.groups[placed.group as usize];
         let (object_ray, scale) = transform.to_object_ray(ray);
-        let inner = group
+        let shape = group
             .shapes
-            .record(&object_ray, hit.t * scale, hit.sub, self.error_scale)
+            .locate(hit.sub as usize)
             .expect("instances hold no instances");
+        let inner =
+            group
+                .shapes
+                .record(&object_ray, hit.t * scale, shape, hit.sub, self.error_scale);
         let outward = if inner.front_face {
             inner.normal
         } else {
