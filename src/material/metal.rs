@@ -28,7 +28,7 @@ pub fn reflect(v: Vec3, n: Vec3) -> Vec3 {
 impl Metal {
     /// Reflects the unit `direction` at `hit`; rays fuzzed below the surface
     /// are absorbed.
-    #[inline]
+    #[inline(always)]
     pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
         let mut reflected = reflect(direction, hit.shading_normal);
         if self.fuzz > 0.0 {
