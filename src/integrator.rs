@@ -93,8 +93,9 @@ pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) ->
 /// of a round can be traced as bundles (see
 /// [`RayBundle`](crate::geometry::RayBundle)): a single ray's traversal
 /// waits on one test after another, while a bundle keeps the processor busy
-/// with eight. `reference` (the pixel's central ray) orders the visit of the
-/// first round's bundles; later rounds use a ray of the bundle.
+/// with eight (in scenes of spheres only: [`Scene::bundles_pay_off`]).
+/// `reference` (the pixel's central ray) orders the visit of the first
+/// round's bundles; later rounds use a ray of the bundle.
 #[inline(always)]
 pub fn trace_paths(
     scene: &Scene,
@@ -138,7 +139,8 @@ pub fn trace_paths(
 }
 
 /// Sets `hits[i]` to the hit of `rays[i]` for every path `i` of `live`:
-/// eight at a time as bundles, the few left over one by one.
+/// eight at a time as bundles where they pay off, the few left over (and
+/// every ray elsewhere) one by one.
 #[inline(always)]
 fn find_hits(
     scene: &Scene,
@@ -148,8 +150,9 @@ fn find_hits(
     range: Interval,
     hits: &mut [Option<Hit>; PATHS],
 ) {
+    let bundles = scene.bundles_pay_off();
     for group in live.chunks(LANES) {
-        if group.len() < MIN_BUNDLE {
+        if group.len() < MIN_BUNDLE || !bundles {
             for &i in group {
                 hits[i as usize] = scene.intersect(&rays[i as usize], range);
             }

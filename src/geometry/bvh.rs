@@ -340,9 +340,13 @@ impl Bvh {
         (query.closest, query.best, query.sub)
     }
 
-    /// Whether every leaf holds spheres.
+    /// Whether every leaf holds spheres (including a tree of nothing).
+    /// Bundles ([`Bvh::hit_bundle`]) pay off only on such trees: a leaf's
+    /// eight primitives are cheap to test for eight rays at once. On a mesh,
+    /// where the rays of a bundle soon reach different leaves and a triangle
+    /// costs more, single rays were measured twice as fast.
     #[inline(always)]
-    pub(super) fn spheres_only(&self) -> bool {
+    pub fn spheres_only(&self) -> bool {
         self.spheres_only
     }
 

@@ -150,7 +150,8 @@ impl Bvh {
     /// the bundle's order (`None` beyond its length). Each distance is the
     /// one [`Bvh::hit`] finds for that ray. `reference` orders the visit of
     /// children (see the module documentation); any ray close to the
-    /// bundle's rays makes a good reference.
+    /// bundle's rays makes a good reference. Faster than single rays on
+    /// trees of spheres only (see [`Bvh::spheres_only`]).
     #[inline(always)]
     pub fn hit_bundle(
         &self,

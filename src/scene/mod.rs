@@ -259,6 +259,13 @@ impl Scene {
             .hit_bundle(&RayBundle::gather(rays, lanes), reference, interval)
     }
 
+    /// Whether rays are worth tracing as bundles ([`Scene::hit_bundle`]):
+    /// in scenes of spheres only (see [`Bvh::spheres_only`](crate::geometry::Bvh::spheres_only)).
+    #[inline(always)]
+    pub fn bundles_pay_off(&self) -> bool {
+        self.world.bvh.spheres_only()
+    }
+
     /// The radius of the sphere a hit record's `object` names, if it is a
     /// sphere placed directly in the world.
     pub fn sphere_radius(&self, object: u32) -> Option<f32> {
