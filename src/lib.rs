@@ -13,7 +13,7 @@
 //!   intersection kernel exists once.
 //! - [`material`]: diffuse (four bounce models, two attenuation forms),
 //!   metal, dielectric.
-//! - [`mesh`]: triangle meshes and their materials from OBJ and glTF files.
+//! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampling`] and [`rng`]: random directions and seeded random numbers.
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.

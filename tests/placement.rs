@@ -473,3 +473,45 @@ fn renders_with_meshes_are_bit_identical_across_threads_and_passes() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The bunny read from a binary PLY file (written here from the OBJ's
+/// vertices and faces) renders bit for bit as the bunny read from the OBJ.
+#[test]
+fn a_mesh_renders_the_same_from_obj_and_ply() {
+    let dir = scratch_dir("ply");
+    let model = lumen::mesh::load(&bunny_obj()).unwrap();
+    let mesh = &model.meshes[0];
+    let mut ply = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\n\
+         property float y\nproperty float z\nelement face {}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        mesh.positions.len(),
+        mesh.triangles.len()
+    )
+    .into_bytes();
+    for p in &mesh.positions {
+        p.iter().for_each(|c| ply.extend(c.to_le_bytes()));
+    }
+    for t in &mesh.triangles {
+        ply.push(3);
+        t.iter().for_each(|&i| ply.extend((i as i32).to_le_bytes()));
+    }
+    std::fs::write(dir.join("bunny.ply"), ply).unwrap();
+    std::fs::copy(bunny_obj(), dir.join("bunny.obj")).unwrap();
+    let film = |file: &str| {
+        let text = format!(
+            "{HEAD}\n[[objects]]\ntype = \"mesh\"\nfile = \"{file}\"\nmaterial = \"red\"\n\
+             transform = [{{ scale = 0.15 }}, {{ translate = [0, -1.5, -4] }}]\n"
+        );
+        let scene = compile_file(&dir, "scene.toml", &text);
+        assert_eq!(scene.stats.triangles, 3674, "{file}");
+        render(&scene, &|_| {}).0
+    };
+    let (obj, ply) = (film("bunny.obj"), film("bunny.ply"));
+    assert!(
+        obj.linear().iter().any(|c| c.x > 2.0 * c.y),
+        "the bunny is not in view"
+    );
+    assert!(obj == ply, "the PLY bunny renders differently");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

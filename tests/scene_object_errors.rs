@@ -138,6 +138,30 @@ fn cases() -> Vec<Case> {
         )
         .with("c.glb", corrupt),
         case(
+            "ply-bad-value",
+            mesh("v.ply"),
+            "file = \"v.ply\"",
+            &["objects[1].file", "v.ply:10:", "malformed PLY"],
+        )
+        .with(
+            "v.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 x\n1 0 0\n0 1 0\n3 0 1 2\n",
+        ),
+        case(
+            "ply-index",
+            mesh("i.ply"),
+            "file = \"i.ply\"",
+            &["objects[1].file", "i.ply", "vertex index 3 out of range"],
+        )
+        .with(
+            "i.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+        ),
+        case(
             "gltf-missing-buffer",
             mesh("b.gltf"),
             "file = \"b.gltf\"",
@@ -160,10 +184,11 @@ fn cases() -> Vec<Case> {
         .with("d.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n"),
         case(
             "unsupported",
-            mesh("m.ply"),
-            "file = \"m.ply\"",
-            &["objects[1].file", "m.ply", ".obj"],
-        ),
+            mesh("m.stl"),
+            "file = \"m.stl\"",
+            &["objects[1].file", "m.stl", ".obj, .gltf, .glb, .ply"],
+        )
+        .with("m.stl", "solid s\nendsolid s\n"),
         case(
             "nan",
             transformed("{ translate = [0, nan, 0] }"),

@@ -1,10 +1,12 @@
-//! Triangle meshes from files: Wavefront OBJ (with its MTL materials) and
-//! glTF 2.0 (`.gltf` with external or embedded buffers, and binary `.glb`).
+//! Triangle meshes from files: Wavefront OBJ (with its MTL materials),
+//! glTF 2.0 (`.gltf` with external or embedded buffers, and binary `.glb`)
+//! and Stanford PLY (ASCII or binary).
 //!
 //! [`load`] picks the loader by extension and returns a [`Model`]: indexed
 //! [`TriangleMesh`]es, their [`MeshMaterial`]s and the [`Model::instances`]
 //! that place each mesh. Every problem with a file is a [`MeshError`] naming
-//! the file (and the line, for OBJ and MTL); no input makes the loaders panic.
+//! the file (and the line, for OBJ, MTL and ASCII PLY); no input makes the
+//! loaders panic.
 //!
 //! Memory: a triangle costs its three `u32` indices and one `u32` material
 //! index, 16 bytes; a vertex costs 12 bytes of position, plus 12 of normal and
@@ -20,6 +22,7 @@
 
 mod gltf;
 mod obj;
+mod ply;
 
 use crate::material::{Dielectric, Diffuse, Material, Metal};
 use crate::math::Color;
@@ -304,11 +307,11 @@ impl fmt::Display for MeshError {
 }
 
 /// The file extensions [`load`] accepts.
-pub const SUPPORTED_EXTENSIONS: [&str; 3] = ["obj", "gltf", "glb"];
+pub const SUPPORTED_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ply"];
 
 /// Loads a mesh file, choosing the format by extension (case-insensitive):
 /// `.obj` (with the MTL files it names; a missing MTL file only means no
-/// materials), `.gltf` or `.glb`.
+/// materials), `.gltf`, `.glb` or `.ply` (no materials).
 pub fn load(path: &Path) -> Result<Model, MeshError> {
     let ext = path
         .extension()
@@ -317,6 +320,7 @@ pub fn load(path: &Path) -> Result<Model, MeshError> {
     let format = match ext.as_deref() {
         Some("obj") => obj::load,
         Some("gltf") | Some("glb") => gltf::load,
+        Some("ply") => ply::load,
         _ => {
             return Err(MeshError::new(
                 path,
@@ -351,5 +355,7 @@ fn read_file(path: &Path) -> Result<Vec<u8>, MeshError> {
     })
 }
 
+#[cfg(test)]
+mod ply_tests;
 #[cfg(test)]
 mod tests;

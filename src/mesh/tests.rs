@@ -11,10 +11,10 @@ fn asset(name: &str) -> PathBuf {
 }
 
 /// A fresh directory under the system temporary directory, removed on drop.
-struct TempDir(PathBuf);
+pub(super) struct TempDir(pub(super) PathBuf);
 
 impl TempDir {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         static NEXT: AtomicUsize = AtomicUsize::new(0);
         let dir = std::env::temp_dir().join(format!(
             "lumen-mesh-test-{}-{}",
@@ -25,7 +25,7 @@ impl TempDir {
         Self(dir)
     }
 
-    fn write(&self, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
+    pub(super) fn write(&self, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
         let path = self.0.join(name);
         std::fs::write(&path, contents).unwrap();
         path
@@ -841,7 +841,7 @@ fn truncated_or_corrupt_glb_is_refused() {
 
 /// Loads `bytes` as `name` in `dir`; a panic fails the test, and an error
 /// must name the file.
-fn load_mutant(dir: &TempDir, name: &str, bytes: &[u8]) -> bool {
+pub(super) fn load_mutant(dir: &TempDir, name: &str, bytes: &[u8]) -> bool {
     let path = dir.write(name, bytes);
     match load(&path) {
         Ok(m) => {
@@ -861,7 +861,7 @@ fn load_mutant(dir: &TempDir, name: &str, bytes: &[u8]) -> bool {
 /// One random change: flip bits of a byte, overwrite a byte with one that
 /// matters to the format, truncate, or delete or duplicate a line.
 /// Half the changes fall in the first `head` bytes (a GLB's JSON chunk).
-fn mutate(rng: &mut crate::rng::Rng, bytes: &mut Vec<u8>, head: usize) {
+pub(super) fn mutate(rng: &mut crate::rng::Rng, bytes: &mut Vec<u8>, head: usize) {
     let n = bytes.len().max(1);
     let span = if rng.next_u32() % 2 == 0 {
         n.min(head)
