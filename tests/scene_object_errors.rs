@@ -67,6 +67,15 @@ impl Case {
     }
 }
 
+/// An ASCII PLY file of three vertices and one face, whose values (nine
+/// header lines, then one line per vertex and the face) are `body`.
+fn ascii_triangle_ply(body: &str) -> String {
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+     property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        .to_string()
+        + body
+}
+
 fn glb() -> Vec<u8> {
     std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/bunny.glb")).unwrap()
 }
@@ -145,9 +154,7 @@ fn cases() -> Vec<Case> {
         )
         .with(
             "v.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
-             end_header\n0 0 x\n1 0 0\n0 1 0\n3 0 1 2\n",
+            ascii_triangle_ply("0 0 x\n1 0 0\n0 1 0\n3 0 1 2\n"),
         ),
         case(
             "ply-index",
@@ -157,9 +164,7 @@ fn cases() -> Vec<Case> {
         )
         .with(
             "i.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
-             end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            ascii_triangle_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
         ),
         case(
             "gltf-missing-buffer",

@@ -276,7 +276,7 @@ impl Mesh {
             what()
         );
         assert!(
-            brute.len() % 2 == 0,
+            brute.len().is_multiple_of(2),
             "{}: {} crossings (odd) of the unit ray, {}: {:?}",
             self.name,
             brute.len(),
@@ -493,7 +493,7 @@ fn check_aimed(
     let hits = mesh.hits(ray);
     tally.total_hits += hits.len();
     assert!(
-        hits.len() % 2 == 0,
+        hits.len().is_multiple_of(2),
         "{}: {} crossings (odd) along the ray, {}: {:?}",
         mesh.name,
         hits.len(),

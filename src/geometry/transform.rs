@@ -554,7 +554,7 @@ mod tests {
                 },
                 2 => Scale([0; 3].map(|_| {
                     let s = range(rng, 0.5, 2.0);
-                    if rng.next_u32() % 2 == 0 {
+                    if rng.next_u32().is_multiple_of(2) {
                         s
                     } else {
                         -s

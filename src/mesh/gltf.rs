@@ -428,7 +428,7 @@ fn convert_mesh(
         };
         match primitive.mode() {
             Mode::Triangles => {
-                if indices.len() % 3 != 0 {
+                if !indices.len().is_multiple_of(3) {
                     return Err(in_primitive(format!(
                         "{} indices, not a multiple of 3",
                         indices.len()

@@ -616,11 +616,11 @@ fn gltf_external_buffer_and_glb_container() {
 /// Packs a JSON document and a binary chunk into GLB.
 fn make_glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let total = 12 + 8 + j.len() + 8 + b.len();
@@ -863,7 +863,7 @@ pub(super) fn load_mutant(dir: &TempDir, name: &str, bytes: &[u8]) -> bool {
 /// Half the changes fall in the first `head` bytes (a GLB's JSON chunk).
 pub(super) fn mutate(rng: &mut crate::rng::Rng, bytes: &mut Vec<u8>, head: usize) {
     let n = bytes.len().max(1);
-    let span = if rng.next_u32() % 2 == 0 {
+    let span = if rng.next_u32().is_multiple_of(2) {
         n.min(head)
     } else {
         n
