@@ -126,10 +126,10 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let Some(vertices) = vertices else {
         return Err(MeshError::new(path, None, "no `vertex` element"));
     };
-    let mesh = build_mesh(&vertices, &faces).map_err(|why| MeshError::new(path, None, why))?;
-    let skipped_degenerate = mesh.1;
+    let (mesh, skipped_degenerate) =
+        build_mesh(&vertices, &faces).map_err(|why| MeshError::new(path, None, why))?;
     Model {
-        meshes: vec![mesh.0],
+        meshes: vec![mesh],
         materials: Vec::new(),
         instances: vec![(0, Mat4::IDENTITY)],
         skipped_degenerate,
