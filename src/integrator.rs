@@ -150,9 +150,14 @@ fn find_hits(
     range: Interval,
     hits: &mut [Option<Hit>; PATHS],
 ) {
-    let bundles = scene.bundles_pay_off();
+    // Where bundles do not pay off, no group is large enough for one.
+    let min_bundle = if scene.bundles_pay_off() {
+        MIN_BUNDLE
+    } else {
+        usize::MAX
+    };
     for group in live.chunks(LANES) {
-        if group.len() < MIN_BUNDLE || !bundles {
+        if group.len() < min_bundle {
             for &i in group {
                 hits[i as usize] = scene.intersect(&rays[i as usize], range);
             }

@@ -2,6 +2,9 @@
 //! mangled by random edits, give either a scene or an error message. A
 //! bounded number of cases keeps this to seconds in the normal test suite.
 
+mod common;
+
+use common::scratch_dir;
 use lumen::render::render;
 use lumen::scene::file::{Format, SceneFile};
 use lumen::scene::Overrides;
@@ -202,8 +205,7 @@ proptest! {
 fn placed_seed(format: Format) -> String {
     static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
     let dir = DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("lumen-fuzz-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch_dir("fuzz");
         std::fs::write(
             dir.join("t.obj"),
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nf 1//1 3//1 2//1\nf 1//1 2//1 4//1\nf 1//1 4//1 3//1\nf 2//1 3//1 4//1\n",

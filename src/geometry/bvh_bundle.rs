@@ -305,30 +305,43 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
     }
 
     /// Tests every ray of the bundle that enters the leaf's box at `entry`
-    /// against the spheres of `p` one by one, on lanes `R`, with the kernel
-    /// the single-ray packet test runs (so the same distances). The
-    /// triangle and quad tests below do the same for their kinds; each kind
-    /// is its own function so that the AVX2 version of each stays small
-    /// enough to be inlined into the render loop.
+    /// against the primitives `index` of a packet one by one, on lanes `R`:
+    /// `test(s)` gives the distances of the rays to primitive `s`, with the
+    /// kernel the single-ray packet test runs (so the same distances).
     #[inline(always)]
-    fn spheres<R: Wide>(&mut self, p: &SpherePacket, entry: &Lanes) {
+    fn one_by_one<R: Wide>(
+        &mut self,
+        index: &[u32; 8],
+        entry: &Lanes,
+        test: impl Fn(usize) -> (R, R::Mask),
+    ) {
         let enter = self.entering::<R>(entry);
-        let ray = self.ray_lanes::<R>();
         let mut closest = R::from_array(self.closest);
-        for s in 0..LANES {
-            if p.index[s] == NO_CHILD {
+        for (s, &primitive) in index.iter().enumerate() {
+            if primitive == NO_CHILD {
                 break;
             }
-            let (t, valid) = sphere::intersect_with::<R, false>(&ray, &p.splat(s));
-            self.found(&mut closest, t, valid, enter, p.index[s]);
+            let (t, valid) = test(s);
+            self.found(&mut closest, t, valid, enter, primitive);
         }
         self.closest = closest.to_array();
     }
 
+    /// The spheres of `p` against the bundle (see [`Self::one_by_one`]).
+    /// Each kind is its own function so that the AVX2 version of each stays
+    /// small enough to be inlined into the render loop.
+    #[inline(always)]
+    fn spheres<R: Wide>(&mut self, p: &SpherePacket, entry: &Lanes) {
+        let ray = self.ray_lanes::<R>();
+        self.one_by_one(&p.index, entry, |s| {
+            sphere::intersect_with::<R, false>(&ray, &p.splat(s))
+        });
+    }
+
+    /// The triangles of `p` against the bundle, each triangle's vertices
+    /// permuted into every ray's own axes.
     #[inline(always)]
     fn triangles<R: Wide>(&mut self, p: &TrianglePacket, entry: &Lanes) {
-        let enter = self.entering::<R>(entry);
-        let mut closest = R::from_array(self.closest);
         let triangle = TriangleRay {
             origin: map3(&self.triangle.origin, R::from_array),
             shear: map3(&self.triangle.shear, R::from_array),
@@ -337,10 +350,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
         let is_axis = map3(&self.is_axis, |[x, y]| {
             (R::mask_from_bits(x), R::mask_from_bits(y))
         });
-        for s in 0..LANES {
-            if p.index[s] == NO_CHILD {
-                break;
-            }
+        self.one_by_one(&p.index, entry, |s| {
             // Vertex `v` in every lane's own axes.
             let permuted = |v: &[[f32; LANES]; 3]| {
                 let (x, y, z) = (R::splat(v[0][s]), R::splat(v[1][s]), R::splat(v[2][s]));
@@ -355,25 +365,15 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
                     permuted(&p.vertices[2]),
                 ],
             };
-            let (t, valid) = triangle::intersect(&triangle, &tri);
-            self.found(&mut closest, t, valid, enter, p.index[s]);
-        }
-        self.closest = closest.to_array();
+            triangle::intersect(&triangle, &tri)
+        });
     }
 
+    /// The quads of `p` against the bundle.
     #[inline(always)]
     fn quads<R: Wide>(&mut self, p: &QuadPacket, entry: &Lanes) {
-        let enter = self.entering::<R>(entry);
         let ray = self.ray_lanes::<R>();
-        let mut closest = R::from_array(self.closest);
-        for s in 0..LANES {
-            if p.index[s] == NO_CHILD {
-                break;
-            }
-            let (t, valid) = quad::intersect(&ray, &p.splat(s));
-            self.found(&mut closest, t, valid, enter, p.index[s]);
-        }
-        self.closest = closest.to_array();
+        self.one_by_one(&p.index, entry, |s| quad::intersect(&ray, &p.splat(s)));
     }
 }
 

@@ -17,7 +17,7 @@
 //! (it can slice out of bounds or misread on a bad file), so every accessor is
 //! checked against its buffer view and buffer before it is read.
 
-use super::{MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
+use super::{fan, MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -448,11 +448,7 @@ fn convert_mesh(
                     });
                 }
             }
-            _ => {
-                for w in indices.get(1..).unwrap_or(&[]).windows(2) {
-                    add([indices[0], w[0], w[1]]);
-                }
-            }
+            _ => fan(&indices).for_each(add),
         }
     }
     if all_normals && normals.len() == out.positions.len() {

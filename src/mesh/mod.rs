@@ -112,6 +112,17 @@ impl TriangleMesh {
     }
 }
 
+/// The triangles of a convex polygon (or a glTF triangle fan) fanned from
+/// its first vertex: (v₀, v₁, v₂), (v₀, v₂, v₃), …; none for fewer than three
+/// vertices.
+fn fan(polygon: &[u32]) -> impl Iterator<Item = [u32; 3]> + '_ {
+    polygon
+        .get(1..)
+        .unwrap_or(&[])
+        .windows(2)
+        .map(|w| [polygon[0], w[0], w[1]])
+}
+
 /// A material as a file describes it, in the terms of glTF's
 /// metallic-roughness model; [`MeshMaterial::to_material`] maps it onto one of
 /// lumen's materials.

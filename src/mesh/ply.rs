@@ -8,7 +8,7 @@
 //! edges, scanner data) are read past. PLY has no materials: its triangles
 //! take the scene's material, or the default grey.
 
-use super::{MeshError, Model, TriangleMesh, NO_MATERIAL};
+use super::{fan, MeshError, Model, TriangleMesh, NO_MATERIAL};
 use glam::Mat4;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{Encoding, Property, PropertyAccess, PropertyAccessResult};
@@ -199,8 +199,7 @@ fn build_mesh(vertices: &[Vertex], faces: &[Face]) -> Result<(TriangleMesh, usiz
                 "face {f}: vertex index {bad} out of range (the file has {count} vertices)"
             ));
         }
-        for k in 1..indices.len() - 1 {
-            let triangle = [indices[0], indices[k], indices[k + 1]];
+        for triangle in fan(indices) {
             if !mesh.push_triangle(triangle, NO_MATERIAL) {
                 skipped += 1;
             }

@@ -128,10 +128,10 @@ impl Shapes {
         // The first mesh ending after `index`.
         let m = self.mesh_end.partition_point(|&end| end <= index);
         match self.meshes.get(m) {
-            Some(mesh) => Ok(Shape::Triangle(
-                m,
-                index + mesh.data.triangles.len() - self.mesh_end[m],
-            )),
+            Some(mesh) => {
+                let first = self.mesh_end[m] - mesh.data.triangles.len();
+                Ok(Shape::Triangle(m, index - first))
+            }
             None => Err(index - self.mesh_end.last().copied().unwrap_or(0)),
         }
     }
