@@ -9,7 +9,7 @@
 
 use crate::math::{Point3, Vec3};
 use crate::ray::Ray;
-use crate::rng::Rng;
+use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use thiserror::Error;
 
@@ -166,15 +166,15 @@ impl Camera {
     }
 
     /// The ray through pixel `(x, y)` at sub-pixel offset `(dx, dy)` ∈ [-0.5, 0.5)²
-    /// from the pixel centre, leaving the lens at a random point.
+    /// from the pixel centre, leaving the lens at a point drawn from `sampler`.
     #[inline]
-    pub fn ray(&self, x: u32, y: u32, dx: f32, dy: f32, rng: &mut Rng) -> Ray {
+    pub fn ray(&self, x: u32, y: u32, dx: f32, dy: f32, sampler: &mut impl Sampler) -> Ray {
         let target =
             self.pixel00 + (x as f32 + dx) * self.pixel_du + (y as f32 + dy) * self.pixel_dv;
         let origin = if self.defocus_u == Vec3::ZERO {
             self.center
         } else {
-            let p = sampling::in_unit_disk(rng);
+            let p = sampling::in_unit_disk(sampler, Dim::Lens);
             self.center + p.x * self.defocus_u + p.y * self.defocus_v
         };
         Ray::new(origin, (target - origin).normalize())
@@ -184,6 +184,7 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
 
     fn settings() -> CameraSettings {
         CameraSettings {

@@ -6,7 +6,7 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::math::{Color, Interval};
 use crate::ray::Ray;
-use crate::rng::Rng;
+use crate::sampler::Sampler;
 use crate::scene::{Scene, Shading};
 
 /// Paths traced side by side by [`trace_paths`].
@@ -20,9 +20,9 @@ const MIN_BUNDLE: usize = 4;
 ///
 /// `rays` is increased by the number of ray segments traced (for statistics).
 #[inline]
-pub fn radiance(scene: &Scene, ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color {
+pub fn radiance(scene: &Scene, ray: Ray, sampler: &mut impl Sampler, rays: &mut u64) -> Color {
     match scene.settings.shading {
-        Shading::Path => trace_path(scene, ray, rng, rays),
+        Shading::Path => trace_path(scene, ray, sampler, rays),
         shading => first_hit_view(scene, ray, shading, rays),
     }
 }
@@ -43,17 +43,26 @@ enum Step {
     Done(Color),
 }
 
-/// The end of one segment of a path: `ray` met `hit` (or nothing, and the
-/// background lights it). The surface's material absorbs the path or
-/// scatters it, multiplying `throughput` by its attenuation.
+/// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
+/// `hit` (or nothing, and the background lights it). The surface's material
+/// absorbs the path or scatters it (bounce `depth`), multiplying
+/// `throughput` by its attenuation.
 #[inline(always)]
-fn step(scene: &Scene, ray: &Ray, hit: Option<Hit>, throughput: &mut Color, rng: &mut Rng) -> Step {
+fn step(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    throughput: &mut Color,
+    sampler: &mut impl Sampler,
+) -> Step {
     let Some(hit) = hit else {
         return Step::Done(*throughput * scene.background.color(ray.direction));
     };
     let hit = scene.record(ray, hit);
     let material = &scene.materials[hit.material as usize];
-    let Some(scatter) = material.scatter(ray.direction, &hit, rng) else {
+    sampler.start_bounce(depth);
+    let Some(scatter) = material.scatter(ray.direction, &hit, sampler) else {
         return Step::Done(Color::ZERO);
     };
     *throughput *= scatter.attenuation;
@@ -71,13 +80,18 @@ fn step(scene: &Scene, ray: &Ray, hit: Option<Hit>, throughput: &mut Color, rng:
 /// the background (which lights it), is absorbed (black), or reaches
 /// `max_depth` segments (black: it never found light in time).
 #[inline(always)]
-pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) -> Color {
+pub fn trace_path(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut impl Sampler,
+    rays: &mut u64,
+) -> Color {
     let range = hit_range(scene);
     let mut throughput = Color::ONE;
-    for _ in 0..scene.settings.max_depth {
+    for depth in 0..scene.settings.max_depth {
         *rays += 1;
         let hit = scene.intersect(&ray, range);
-        match step(scene, &ray, hit, &mut throughput, rng) {
+        match step(scene, &ray, hit, depth, &mut throughput, sampler) {
             Step::Continue(next) => ray = next,
             Step::Done(colour) => return colour,
         }
@@ -86,8 +100,8 @@ pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) ->
 }
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
-/// each with its own generator: `colours[i]` gets exactly what
-/// `trace_path(scene, rays[i], &mut rngs[i], ..)` returns.
+/// each with its own sampler: `colours[i]` gets exactly what
+/// `trace_path(scene, rays[i], &mut samplers[i], ..)` returns.
 ///
 /// The paths advance together, one segment each per round, so that the rays
 /// of a round can be traced as bundles (see
@@ -97,16 +111,16 @@ pub fn trace_path(scene: &Scene, mut ray: Ray, rng: &mut Rng, rays: &mut u64) ->
 /// `reference` (the pixel's central ray) orders the visit of the first
 /// round's bundles; later rounds use a ray of the bundle.
 #[inline(always)]
-pub fn trace_paths(
+pub fn trace_paths<S: Sampler>(
     scene: &Scene,
     rays: &mut [Ray],
-    rngs: &mut [Rng],
+    samplers: &mut [S],
     reference: &Ray,
     colours: &mut [Color],
     traced: &mut u64,
 ) {
     let n = rays.len();
-    assert!(n <= PATHS && rngs.len() == n && colours.len() == n);
+    assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
     // Paths still going after `max_depth` segments stay black.
     colours.fill(Color::ZERO);
     let range = hit_range(scene);
@@ -122,7 +136,8 @@ pub fn trace_paths(
         let mut still = 0;
         for k in 0..n_live {
             let i = live[k] as usize;
-            match step(scene, &rays[i], hits[i], &mut throughput[i], &mut rngs[i]) {
+            let sampler = &mut samplers[i];
+            match step(scene, &rays[i], hits[i], round, &mut throughput[i], sampler) {
                 Step::Continue(next) => {
                     rays[i] = next;
                     live[still] = i as u8;
@@ -196,15 +211,18 @@ pub(crate) fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &m
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampler::{PixelSampler, SamplerKind};
     use crate::scene::builtin;
 
     /// Side by side, every path must come out exactly as it does alone: the
     /// same colour bits and the same number of segments, whatever the group
-    /// size and depth limit, on scenes with every material.
+    /// size and depth limit, on scenes with every material and with every
+    /// sampler.
     #[test]
     fn paths_side_by_side_equal_paths_one_at_a_time() {
         let names = ["cover", "glass-hollow", "metal-fuzz-0.5", "bounce-cube"];
-        for name in names {
+        let kinds = [SamplerKind::Independent, SamplerKind::Sobol];
+        for (name, kind) in names.iter().flat_map(|n| kinds.map(|k| (n, k))) {
             let mut desc = builtin::find(name).expect("built-in").desc();
             desc.render.width = 24;
             for max_depth in [1, 2, 3, 50] {
@@ -214,18 +232,18 @@ mod tests {
                 for (pixel, n) in [(0u32, 1usize), (5, 3), (100, 8), (200, 13), (300, PATHS)] {
                     let (x, y) = (pixel % 24, (pixel / 24).min(height - 1));
                     let mut rays = Vec::new();
-                    let mut rngs = Vec::new();
-                    for sample in 0..n as u64 {
-                        let mut rng = Rng::for_sample(7, u64::from(pixel), sample);
-                        let (dx, dy) = (rng.next_f32() - 0.5, rng.next_f32() - 0.5);
-                        rays.push(scene.camera.ray(x, y, dx, dy, &mut rng));
-                        rngs.push(rng);
+                    let mut samplers = Vec::new();
+                    let pixel_sampler = PixelSampler::new(kind, 7, u64::from(pixel), 64);
+                    for sample in 0..n as u32 {
+                        let (mut sampler, (dx, dy)) = pixel_sampler.start(sample);
+                        rays.push(scene.camera.ray(x, y, dx, dy, &mut sampler));
+                        samplers.push(sampler);
                     }
                     let mut alone_rays = 0;
                     let alone: Vec<Color> = rays
                         .iter()
-                        .zip(rngs.clone())
-                        .map(|(&ray, mut rng)| trace_path(&scene, ray, &mut rng, &mut alone_rays))
+                        .zip(samplers.clone())
+                        .map(|(&ray, mut s)| trace_path(&scene, ray, &mut s, &mut alone_rays))
                         .collect();
                     let mut together = vec![Color::ZERO; n];
                     let mut together_rays = 0;
@@ -233,7 +251,7 @@ mod tests {
                     trace_paths(
                         &scene,
                         &mut rays,
-                        &mut rngs,
+                        &mut samplers,
                         &reference,
                         &mut together,
                         &mut together_rays,
@@ -246,7 +264,7 @@ mod tests {
                     assert_eq!(
                         bits(&together),
                         bits(&alone),
-                        "{name}, depth {max_depth}, {n} paths"
+                        "{name}, {kind:?}, depth {max_depth}, {n} paths"
                     );
                     assert_eq!(
                         together_rays, alone_rays,

@@ -15,7 +15,9 @@
 //!   metal, dielectric.
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
-//! - [`sampling`] and [`rng`]: random directions and seeded random numbers.
+//! - [`sampler`]: the numbers behind every random decision of a path
+//!   (independent, stratified, Owen-scrambled Sobol); [`sampling`]: random
+//!   points and directions made from them; [`rng`]: seeded random numbers.
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.
 //! - [`film`] and [`output`]: accumulation, gamma, tone mapping, image files.
 //! - [`progressive`] and [`checkpoint`]: rendering in passes that can be
@@ -57,5 +59,6 @@ pub mod progressive;
 pub mod ray;
 pub mod render;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;

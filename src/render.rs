@@ -5,8 +5,8 @@ use crate::integrator::{first_hit_view, trace_paths, PATHS};
 use crate::isa::Isa;
 use crate::math::{Color, Vec3};
 use crate::ray::Ray;
-use crate::rng::Rng;
-use crate::scene::{Sampling, Scene, Shading};
+use crate::sampler::{PixelSample, PixelSampler};
+use crate::scene::{Scene, Shading};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Duration;
@@ -41,83 +41,10 @@ impl RenderStats {
     }
 }
 
-/// The sub-pixel offset in [-0.5, 0.5)² of sample `index` of `spp`.
-///
-/// - Random: uniform over the pixel.
-/// - Centre: the pixel's centre, every time (the notes' single ray a pixel).
-/// - Stratified: the first k² samples (k = ⌊√spp⌋) fall one in each cell of
-///   a k×k grid over the pixel, uniform within its cell; any remaining
-///   samples are uniform over the pixel. Which cell a sample index gets is a
-///   permutation drawn by `pixel_key` (see [`stratum`]), so that the samples
-///   of an unfinished render (a pass, a stop) are spread over the pixel
-///   rather than all in its first rows of cells.
-#[inline]
-pub fn pixel_offset(
-    sampling: Sampling,
-    index: u32,
-    spp: u32,
-    pixel_key: u64,
-    rng: &mut Rng,
-) -> (f32, f32) {
-    if sampling == Sampling::Center {
-        return (0.0, 0.0);
-    }
-    let (jx, jy) = (rng.next_f32(), rng.next_f32());
-    if sampling == Sampling::Stratified {
-        let k = (spp as f64).sqrt() as u32;
-        if index < k * k {
-            let cell_index = stratum(index, k * k, pixel_key);
-            let inv = 1.0 / k as f32;
-            let (cx, cy) = ((cell_index % k) as f32, (cell_index / k) as f32);
-            // In f32, (c + j)·(1/k) rounds to 1 when j is the largest value
-            // below 1 in the last cell: keep it below 1 so the offset stays < 0.5.
-            let below_one = 1.0 - f32::EPSILON / 2.0;
-            let cell = |c: f32, j: f32| ((c + j) * inv).min(below_one) - 0.5;
-            return (cell(cx, jx), cell(cy, jy));
-        }
-    }
-    (jx - 0.5, jy - 0.5)
-}
-
-/// The key of a pixel's stratum permutation, from the render seed and the
-/// pixel index.
-#[inline]
-pub fn pixel_key(seed: u64, pixel: u64) -> u64 {
-    crate::rng::mix64(seed ^ crate::rng::mix64(pixel ^ 0x5354_5241_5441))
-}
-
-/// The grid cell, in `0..cells`, of stratified sample `index < cells`: a
-/// permutation of the indices chosen by `key`.
-///
-/// A keyed bijection of the `b`-bit integers (xor, multiplications by odd
-/// constants and xor-shifts are each invertible modulo 2^b) is applied until
-/// the value falls below `cells` ("cycle walking", which keeps it a
-/// bijection of `0..cells`), then rotated by a keyed amount, so that for a
-/// random key every index is equally likely to get every cell.
-#[inline]
-pub fn stratum(index: u32, cells: u32, key: u64) -> u32 {
-    debug_assert!(index < cells);
-    let mask = cells.next_power_of_two() - 1;
-    let (k0, k1) = (key as u32, (key >> 32) as u32);
-    let mut i = index;
-    loop {
-        i ^= k0 & mask;
-        i = i.wrapping_mul(0x2C1B_3C6D) & mask;
-        i ^= i >> 3;
-        i = i.wrapping_add(k0 >> 16) & mask;
-        i = i.wrapping_mul(0x297A_2D39) & mask;
-        i ^= i >> 2;
-        if i < cells {
-            break;
-        }
-    }
-    ((u64::from(i) + u64::from(k1)) % u64::from(cells)) as u32
-}
-
 /// Adds samples `samples` (a range of sample indices, each in
 /// `0..samples_per_pixel`) of every pixel to `film`, in parallel over rows.
 ///
-/// Each sample draws its random numbers from its own generator, seeded by the
+/// Each sample draws its random numbers from its own sampler, addressed by the
 /// scene seed, the pixel and the sample index, and each pixel adds its samples
 /// in index order: the film is bit-identical whatever the thread count, and
 /// rendering `0..a` then `a..b` gives the same film as `0..b`.
@@ -219,14 +146,14 @@ fn render_row_generic(
     // Path tracing runs a pixel's samples side by side (`trace_paths`); the
     // debugging views trace one ray at a time.
     let side_by_side = s.shading == Shading::Path;
-    // A pixel's camera rays, their generators and colours, filled for each
+    // A pixel's camera rays, their samplers and colours, filled for each
     // group of samples.
     let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PATHS];
-    let mut rngs = [const { Rng::placeholder() }; PATHS];
+    let mut samplers = [const { PixelSample::placeholder() }; PATHS];
     let mut colours = [Color::ZERO; PATHS];
     for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
         let pixel = u64::from(y) * width as u64 + x as u64;
-        let key = pixel_key(s.seed, pixel);
+        let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
         let mut add = |c: Color| {
             stats.samples += 1;
             if !accumulate(sum, count, c) {
@@ -235,7 +162,7 @@ fn render_row_generic(
         };
         if !side_by_side {
             for index in samples.clone() {
-                let (ray, _) = camera_sample(scene, x as u32, y, pixel, key, index);
+                let (ray, _) = camera_sample(scene, x as u32, y, &pixel_sampler, index);
                 add(first_hit_view(scene, ray, s.shading, &mut stats.rays));
             }
             continue;
@@ -244,13 +171,14 @@ fn render_row_generic(
         let mut start = samples.start;
         while start < samples.end {
             let n = (samples.end - start).min(PATHS as u32) as usize;
-            for (i, (ray, rng)) in rays.iter_mut().zip(&mut rngs).take(n).enumerate() {
-                (*ray, *rng) = camera_sample(scene, x as u32, y, pixel, key, start + i as u32);
+            for (i, (ray, sampler)) in rays.iter_mut().zip(&mut samplers).take(n).enumerate() {
+                (*ray, *sampler) =
+                    camera_sample(scene, x as u32, y, &pixel_sampler, start + i as u32);
             }
             trace_paths(
                 scene,
                 &mut rays[..n],
-                &mut rngs[..n],
+                &mut samplers[..n],
                 &reference,
                 &mut colours[..n],
                 &mut stats.rays,
@@ -265,15 +193,19 @@ fn render_row_generic(
     stats
 }
 
-/// The camera ray of sample `index` of pixel `(x, y)` (number `pixel`, with
-/// stratum key `key`), and the generator that goes on to serve its path.
+/// The camera ray of sample `index` of pixel `(x, y)`, whose sampler is
+/// `pixel_sampler`, and the sampler that goes on to serve its path.
 #[inline(always)]
-fn camera_sample(scene: &Scene, x: u32, y: u32, pixel: u64, key: u64, index: u32) -> (Ray, Rng) {
-    let s = &scene.settings;
-    let mut rng = Rng::for_sample(s.seed, pixel, u64::from(index));
-    let (dx, dy) = pixel_offset(s.sampling, index, s.samples_per_pixel, key, &mut rng);
-    let ray = scene.camera.ray(x, y, dx, dy, &mut rng);
-    (ray, rng)
+fn camera_sample(
+    scene: &Scene,
+    x: u32,
+    y: u32,
+    pixel_sampler: &PixelSampler,
+    index: u32,
+) -> (Ray, PixelSample) {
+    let (mut sampler, (dx, dy)) = pixel_sampler.start(index);
+    let ray = scene.camera.ray(x, y, dx, dy, &mut sampler);
+    (ray, sampler)
 }
 
 /// Adds one sample's colour to a pixel's sum and count, unless it is NaN or
@@ -302,22 +234,29 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderSt
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::builtin;
+    use crate::scene::{builtin, Sampling};
 
     #[test]
     fn every_instruction_set_version_renders_the_same_bits() {
-        let mut desc = builtin::cover();
-        desc.render.width = 48;
-        // Enough samples for bundles of every size in every round.
-        desc.render.samples_per_pixel = 37;
-        let scene = Scene::from_desc(&desc).expect("the cover compiles");
+        for sampler in [Sampling::Independent, Sampling::Sobol] {
+            let mut desc = builtin::cover();
+            desc.render.width = 48;
+            desc.render.sampler = sampler;
+            // Enough samples for bundles of every size in every round.
+            desc.render.samples_per_pixel = 37;
+            let scene = Scene::from_desc(&desc).expect("the cover compiles");
+            same_bits_on_every_instruction_set(&scene);
+        }
+    }
+
+    fn same_bits_on_every_instruction_set(scene: &Scene) {
         let width = scene.settings.width as usize;
         let isa = Isa::detect();
         for y in 0..scene.settings.height {
             let mut base = (vec![[0.0f64; 3]; width], vec![0u32; width]);
             let mut best = base.clone();
-            let a = render_row(Isa::Baseline, &scene, y, 0..37, &mut base.0, &mut base.1);
-            let b = render_row(isa, &scene, y, 0..37, &mut best.0, &mut best.1);
+            let a = render_row(Isa::Baseline, scene, y, 0..37, &mut base.0, &mut base.1);
+            let b = render_row(isa, scene, y, 0..37, &mut best.0, &mut best.1);
             assert_eq!(a, b, "row {y}: counts differ between baseline and {isa:?}");
             let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(

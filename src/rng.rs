@@ -71,6 +71,13 @@ impl Rng {
         (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
 
+    /// Two uniform `f32`s in `[0, 1)`, in the order drawn.
+    #[inline]
+    pub fn next_2d(&mut self) -> [f32; 2] {
+        let u = self.next_f32();
+        [u, self.next_f32()]
+    }
+
     /// A uniform `f32` in `[min, max)`.
     #[inline]
     pub fn range_f32(&mut self, min: f32, max: f32) -> f32 {

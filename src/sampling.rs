@@ -1,34 +1,44 @@
 //! Random points and directions: the building blocks of antialiasing, diffuse
 //! bounces, fuzzy metal and defocus blur.
+//!
+//! Directions are made from uniform numbers by a warp where one exists
+//! ([`unit_vector`]); the notes' rejection methods draw from a sampler until
+//! a point is accepted, as the notes do.
 
 use crate::math::Vec3;
-use crate::rng::Rng;
+use crate::sampler::{Dim, Sampler};
 use std::f32::consts::FRAC_PI_2;
 
-/// A uniformly distributed point inside the unit sphere (rejection sampling).
+/// `u` in [0, 1) mapped to [-1, 1).
+#[inline(always)]
+fn signed(u: f32) -> f32 {
+    -1.0 + 2.0 * u
+}
+
+/// A uniformly distributed point inside the unit sphere (rejection sampling
+/// from the cube [-1, 1)³, as in the notes), drawn for a bounce.
 #[inline]
-pub fn in_unit_sphere(rng: &mut Rng) -> Vec3 {
+pub fn in_unit_sphere(sampler: &mut impl Sampler) -> Vec3 {
     loop {
-        let p = Vec3::new(
-            rng.range_f32(-1.0, 1.0),
-            rng.range_f32(-1.0, 1.0),
-            rng.range_f32(-1.0, 1.0),
-        );
+        let [x, y] = sampler.get_2d(Dim::Bsdf);
+        let z = sampler.get_1d(Dim::BsdfExtra);
+        let p = Vec3::new(signed(x), signed(y), signed(z));
         if p.length_squared() < 1.0 {
             return p;
         }
     }
 }
 
-/// A uniformly distributed direction: a point on the surface of the unit sphere.
+/// A uniformly distributed direction (a point on the surface of the unit
+/// sphere) from `u` uniform in [0, 1)².
 ///
 /// Built from a uniform height `z` and azimuth `φ` (Archimedes' hat-box
 /// theorem), which needs no rejection loop.
 #[inline]
-pub fn unit_vector(rng: &mut Rng) -> Vec3 {
-    let z = 1.0 - 2.0 * rng.next_f32();
+pub fn unit_vector(u: [f32; 2]) -> Vec3 {
+    let z = 1.0 - 2.0 * u[0];
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = sin_cos_turns(rng.next_f32());
+    let (s, c) = sin_cos_turns(u[1]);
     Vec3::new(r * c, r * s, z)
 }
 
@@ -63,10 +73,11 @@ fn sin_cos_turns(u: f32) -> (f32, f32) {
     )
 }
 
-/// A uniformly distributed direction in the hemisphere around `normal`.
+/// A uniformly distributed direction in the hemisphere around `normal`,
+/// from `u` uniform in [0, 1)².
 #[inline]
-pub fn on_hemisphere(rng: &mut Rng, normal: Vec3) -> Vec3 {
-    let v = unit_vector(rng);
+pub fn on_hemisphere(u: [f32; 2], normal: Vec3) -> Vec3 {
+    let v = unit_vector(u);
     if v.dot(normal) >= 0.0 {
         v
     } else {
@@ -77,12 +88,11 @@ pub fn on_hemisphere(rng: &mut Rng, normal: Vec3) -> Vec3 {
 /// A uniformly distributed point on the surface of the cube `[-1, 1]³`.
 ///
 /// All six faces have the same area, so a face is chosen uniformly and a point
-/// uniformly within it.
+/// uniformly within it; drawn for a bounce.
 #[inline]
-pub fn on_cube_surface(rng: &mut Rng) -> Vec3 {
-    let face = (rng.next_u32() % 6) as usize;
-    let a = rng.range_f32(-1.0, 1.0);
-    let b = rng.range_f32(-1.0, 1.0);
+pub fn on_cube_surface(sampler: &mut impl Sampler) -> Vec3 {
+    let face = sampler.get_below(Dim::BsdfExtra, 6) as usize;
+    let [a, b] = sampler.get_2d(Dim::Bsdf).map(signed);
     let sign = if face < 3 { 1.0 } else { -1.0 };
     match face % 3 {
         0 => Vec3::new(sign, a, b),
@@ -91,11 +101,13 @@ pub fn on_cube_surface(rng: &mut Rng) -> Vec3 {
     }
 }
 
-/// A uniformly distributed point in the unit disk of the `z = 0` plane.
+/// A uniformly distributed point in the unit disk of the `z = 0` plane
+/// (rejection sampling from the square, as in the notes), drawn for `dim`.
 #[inline]
-pub fn in_unit_disk(rng: &mut Rng) -> Vec3 {
+pub fn in_unit_disk(sampler: &mut impl Sampler, dim: Dim) -> Vec3 {
     loop {
-        let p = Vec3::new(rng.range_f32(-1.0, 1.0), rng.range_f32(-1.0, 1.0), 0.0);
+        let [x, y] = sampler.get_2d(dim);
+        let p = Vec3::new(signed(x), signed(y), 0.0);
         if p.length_squared() < 1.0 {
             return p;
         }

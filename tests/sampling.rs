@@ -3,9 +3,14 @@
 mod common;
 
 use common::{assert_agree, builtin_scene, pixel_stats};
-use lumen::render::{pixel_key, pixel_offset, render, stratum};
-use lumen::rng::Rng;
+use lumen::render::render;
+use lumen::sampler::{pixel_key, stratum, PixelSampler};
 use lumen::scene::Sampling;
+
+/// The offset from the pixel's centre of sample `index` of `spp` of `pixel`.
+fn pixel_offset(kind: Sampling, seed: u64, pixel: u64, index: u32, spp: u32) -> (f32, f32) {
+    PixelSampler::new(kind, seed, pixel, spp).start(index).1
+}
 
 /// Tolerance on stratum boundaries: the offset is computed in f32, so a
 /// sample drawn at the very end of its cell may round onto the boundary.
@@ -18,9 +23,8 @@ fn stratified_samples_fill_every_stratum_exactly_once() {
         for pixel in 0..2000u64 {
             let mut seen = vec![0u32; (k * k) as usize];
             for index in 0..spp {
-                let mut rng = Rng::for_sample(1, pixel, u64::from(index));
                 let key = pixel_key(1, pixel);
-                let (dx, dy) = pixel_offset(Sampling::Stratified, index, spp, key, &mut rng);
+                let (dx, dy) = pixel_offset(Sampling::Stratified, 1, pixel, index, spp);
                 assert!((-0.5..0.5).contains(&dx) && (-0.5..0.5).contains(&dy));
                 if index >= k * k {
                     continue; // the samples beyond k² are uniform
@@ -77,8 +81,7 @@ fn strata_are_permutations_and_every_prefix_is_spread_over_the_pixel() {
     let mut first_cells = vec![0u64; 16];
     for pixel in 0..n {
         let key = pixel_key(9, pixel);
-        let mut rng = Rng::for_sample(9, pixel, 0);
-        let (dx, dy) = pixel_offset(Sampling::Stratified, 0, spp, key, &mut rng);
+        let (dx, dy) = pixel_offset(Sampling::Stratified, 9, pixel, 0, spp);
         sx += f64::from(dx);
         sy += f64::from(dy);
         first_cells[stratum(0, 16, key) as usize] += 1;
@@ -110,12 +113,7 @@ fn strata_are_permutations_and_every_prefix_is_spread_over_the_pixel() {
 #[test]
 fn centre_sampling_always_hits_the_pixel_centre() {
     for index in 0..8 {
-        let mut rng = Rng::for_sample(3, 7, index);
-        let key = pixel_key(3, 7);
-        assert_eq!(
-            pixel_offset(Sampling::Center, index as u32, 8, key, &mut rng),
-            (0.0, 0.0)
-        );
+        assert_eq!(pixel_offset(Sampling::Center, 3, 7, index, 8), (0.0, 0.0));
     }
 }
 
@@ -125,12 +123,10 @@ fn offsets_stay_below_half_even_at_the_end_of_the_last_stratum() {
     // (1 + 0.99999994)·0.5, which rounds to 1 in f32: the offset must still be
     // below 0.5. Enough samples are drawn that this value occurs several
     // times (it has probability 2⁻²⁴ per draw).
-    for sampling in [Sampling::Stratified, Sampling::Random] {
+    for sampling in [Sampling::Stratified, Sampling::Independent] {
         let mut max = f32::MIN;
         for pixel in 0..(1u64 << 24) {
-            let index = 3;
-            let mut rng = Rng::for_sample(0, pixel, index);
-            let (dx, dy) = pixel_offset(sampling, index as u32, 4, pixel_key(0, pixel), &mut rng);
+            let (dx, dy) = pixel_offset(sampling, 0, pixel, 3, 4);
             max = max.max(dx).max(dy);
         }
         assert!(max < 0.5, "{sampling:?}: offset {max}");
@@ -147,8 +143,7 @@ fn random_offsets_are_uniform_over_the_pixel() {
     let n = 200_000u64;
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for i in 0..n {
-        let mut rng = Rng::for_sample(2, i, 0);
-        let (dx, _) = pixel_offset(Sampling::Random, 0, 16, pixel_key(2, i), &mut rng);
+        let (dx, _) = pixel_offset(Sampling::Independent, 2, i, 0, 16);
         s += f64::from(dx);
         s2 += f64::from(dx) * f64::from(dx);
     }

@@ -4,7 +4,7 @@
 use lumen::render::render;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::file::{export, Format, SceneFile};
-use lumen::scene::{Overrides, Scene};
+use lumen::scene::{Overrides, Sampling, Scene};
 use std::path::{Path, PathBuf};
 
 fn examples_dir() -> PathBuf {
@@ -153,10 +153,12 @@ fn overrides_replace_the_files_settings() {
         samples_per_pixel: Some(3),
         max_depth: Some(5),
         seed: Some(11),
+        sampler: Some(Sampling::Stratified),
     };
     let s = file.compile(&o).unwrap().settings;
     assert_eq!((s.width, s.height), (40, 20), "height keeps the proportion");
     assert_eq!((s.samples_per_pixel, s.max_depth, s.seed), (3, 5, 11));
+    assert_eq!(s.sampler, Sampling::Stratified);
 }
 
 /// `SceneDesc` also derives serde's `Deserialize` for library users; it must

@@ -151,7 +151,7 @@ fn exercise(text: String, format: Format) {
                 width: Some(4),
                 samples_per_pixel: Some(1),
                 max_depth: Some(3),
-                seed: None,
+                ..Overrides::default()
             };
             match file.compile(&tiny) {
                 Err(e) => {

@@ -15,6 +15,7 @@ use lumen::material::{Attenuation, BounceModel, Diffuse, Metal};
 use lumen::math::{Color, Vec3};
 use lumen::rng::Rng;
 use lumen::scene::desc::{AttenuationDesc, BounceDesc, MaterialDesc};
+use lumen::scene::{Sampling, Scene};
 
 const W: u32 = 48;
 const H: u32 = 32;
@@ -138,9 +139,17 @@ fn scale_and_absorb_renders_converge_to_the_same_image() {
 
 /// Asserts that a furnace image has mean 1 within `K` standard errors (exactly
 /// 1 when no sample differs from 1), and that the sphere was really hit.
+/// With every sampler.
 fn assert_white(what: &str, material: MaterialDesc, depth: u32) {
-    let scene = furnace(material, W, H, 32, depth);
-    let stats = pixel_stats(&scene);
+    for sampler in [Sampling::Sobol, Sampling::Independent] {
+        let mut scene = furnace(material.clone(), W, H, 32, depth);
+        scene.settings.sampler = sampler;
+        assert_white_with(&format!("{what}, {sampler:?}"), &scene);
+    }
+}
+
+fn assert_white_with(what: &str, scene: &Scene) {
+    let stats = pixel_stats(scene);
     for c in 0..3 {
         let (mean, se) = stats.image(c);
         assert!(

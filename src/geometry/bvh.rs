@@ -1040,7 +1040,7 @@ mod tests {
             // Half in random directions, half aimed into the scene.
             let origin = point(rng, 30.0);
             let direction = if k % 2 == 0 {
-                crate::sampling::unit_vector(rng)
+                crate::sampling::unit_vector(rng.next_2d())
             } else {
                 (point(rng, 10.0) - origin).normalize()
             };
@@ -1127,7 +1127,7 @@ mod tests {
         let bvh = Bvh::new(&prims);
         let mut hits = 0;
         for _ in 0..4_000 {
-            let d = crate::sampling::unit_vector(&mut rng);
+            let d = crate::sampling::unit_vector(rng.next_2d());
             let ray = Ray::new(point(&mut rng, 6.0), d);
             let interval = Interval::new(0.001, rng.range_f32(0.5, 20.0));
             let lanes = RayLanes::<F8>::splat(&ray, interval.min);

@@ -625,7 +625,7 @@ mod tests {
                         let target = toward + crate::sampling::in_unit_sphere(&mut rng) * 0.05;
                         Ray::new(o, (target - o).normalize())
                     } else {
-                        Ray::new(origin, crate::sampling::unit_vector(&mut rng))
+                        Ray::new(origin, crate::sampling::unit_vector(rng.next_2d()))
                     }
                 })
                 .collect();

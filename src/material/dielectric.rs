@@ -4,7 +4,7 @@
 use super::{reflect, Scatter};
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
-use crate::rng::Rng;
+use crate::sampler::{Dim, Sampler};
 
 /// A clear refracting material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,7 +49,12 @@ pub fn reflectance(cosine: f32, eta_ratio: f32) -> f32 {
 impl Dielectric {
     /// Reflects or refracts the unit `direction` at `hit`; never absorbs.
     #[inline]
-    pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+    pub fn scatter(
+        &self,
+        direction: Vec3,
+        hit: &HitRecord,
+        sampler: &mut impl Sampler,
+    ) -> Option<Scatter> {
         let eta_ratio = if hit.front_face {
             1.0 / self.ior
         } else {
@@ -58,7 +63,10 @@ impl Dielectric {
         let cos_theta = (-direction).dot(hit.shading_normal).min(1.0);
         let refracted = refract(direction, hit.shading_normal, eta_ratio);
         let direction = match refracted {
-            Some(r) if self.refract_only || reflectance(cos_theta, eta_ratio) <= rng.next_f32() => {
+            Some(r)
+                if self.refract_only
+                    || reflectance(cos_theta, eta_ratio) <= sampler.get_1d(Dim::BsdfChoice) =>
+            {
                 r.normalize()
             }
             // The normal (P − C)/R is unit only to within ~1e-4 on small

@@ -4,7 +4,7 @@
 use super::Scatter;
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
-use crate::rng::Rng;
+use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 
 /// How a diffuse bounce chooses its direction.
@@ -57,12 +57,12 @@ impl Diffuse {
 
     /// Scatters at `hit`; `None` when the ray is absorbed.
     #[inline(always)]
-    pub fn scatter(&self, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+    pub fn scatter(&self, hit: &HitRecord, sampler: &mut impl Sampler) -> Option<Scatter> {
         let attenuation = match self.attenuation {
             Attenuation::Scale => self.albedo,
             Attenuation::Absorb => {
                 let p = self.albedo.max_element();
-                if !(p > 0.0) || rng.next_f32() >= p {
+                if !(p > 0.0) || sampler.get_1d(Dim::BsdfChoice) >= p {
                     return None;
                 }
                 self.albedo / p
@@ -70,19 +70,23 @@ impl Diffuse {
         };
         Some(Scatter {
             attenuation,
-            direction: hit.reflected_above(bounce_direction(self.bounce, hit.shading_normal, rng)),
+            direction: hit.reflected_above(bounce_direction(
+                self.bounce,
+                hit.shading_normal,
+                sampler,
+            )),
         })
     }
 }
 
 /// A unit bounce direction around unit `normal` following `model`.
 #[inline(always)]
-pub fn bounce_direction(model: BounceModel, normal: Vec3, rng: &mut Rng) -> Vec3 {
+pub fn bounce_direction(model: BounceModel, normal: Vec3, sampler: &mut impl Sampler) -> Vec3 {
     let d = match model {
-        BounceModel::Cube => normal + sampling::on_cube_surface(rng),
-        BounceModel::SphereVolume => normal + sampling::in_unit_sphere(rng),
-        BounceModel::Lambertian => normal + sampling::unit_vector(rng),
-        BounceModel::Hemisphere => sampling::on_hemisphere(rng, normal),
+        BounceModel::Cube => normal + sampling::on_cube_surface(sampler),
+        BounceModel::SphereVolume => normal + sampling::in_unit_sphere(sampler),
+        BounceModel::Lambertian => normal + sampling::unit_vector(sampler.get_2d(Dim::Bsdf)),
+        BounceModel::Hemisphere => sampling::on_hemisphere(sampler.get_2d(Dim::Bsdf), normal),
     };
     // A sample opposite the normal cancels it. For N + u with unit u, the exact
     // cosθ of the result is |d|/2, while f32 cancellation tilts a short d by

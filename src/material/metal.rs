@@ -3,7 +3,7 @@
 use super::Scatter;
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
-use crate::rng::Rng;
+use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 
 /// A reflective metal surface.
@@ -29,10 +29,16 @@ impl Metal {
     /// Reflects the unit `direction` at `hit`; rays fuzzed below the surface
     /// are absorbed.
     #[inline(always)]
-    pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+    pub fn scatter(
+        &self,
+        direction: Vec3,
+        hit: &HitRecord,
+        sampler: &mut impl Sampler,
+    ) -> Option<Scatter> {
         let mut reflected = reflect(direction, hit.shading_normal);
         if self.fuzz > 0.0 {
-            reflected = reflected.normalize() + self.fuzz * sampling::unit_vector(rng);
+            reflected = reflected.normalize()
+                + self.fuzz * sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
         }
         if reflected.dot(hit.shading_normal) <= 0.0 {
             return None;

@@ -13,7 +13,7 @@ pub use metal::{reflect, Metal};
 
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
-use crate::rng::Rng;
+use crate::sampler::Sampler;
 
 /// A surface material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,11 +39,16 @@ impl Material {
     /// Scatters a ray arriving along unit `direction` at `hit`; `None` means
     /// the ray is absorbed.
     #[inline(always)]
-    pub fn scatter(&self, direction: Vec3, hit: &HitRecord, rng: &mut Rng) -> Option<Scatter> {
+    pub fn scatter(
+        &self,
+        direction: Vec3,
+        hit: &HitRecord,
+        sampler: &mut impl Sampler,
+    ) -> Option<Scatter> {
         match self {
-            Material::Diffuse(m) => m.scatter(hit, rng),
-            Material::Metal(m) => m.scatter(direction, hit, rng),
-            Material::Dielectric(m) => m.scatter(direction, hit, rng),
+            Material::Diffuse(m) => m.scatter(hit, sampler),
+            Material::Metal(m) => m.scatter(direction, hit, sampler),
+            Material::Dielectric(m) => m.scatter(direction, hit, sampler),
         }
     }
 }

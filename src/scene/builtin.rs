@@ -137,10 +137,10 @@ fn render(spp: u32, gamma: f64) -> RenderDesc {
     RenderDesc {
         samples_per_pixel: spp,
         gamma,
-        sampling: if spp == 1 {
+        sampler: if spp == 1 {
             SamplingDesc::Center
         } else {
-            SamplingDesc::Random
+            SamplingDesc::Independent
         },
         ..RenderDesc::default()
     }
@@ -371,7 +371,7 @@ pub fn cover_with_grid(half: i32) -> SceneDesc {
         width: 1200,
         samples_per_pixel: 500,
         max_depth: 50,
-        sampling: SamplingDesc::Random,
+        sampler: SamplingDesc::Independent,
         ..RenderDesc::default()
     })
     .material("ground", lambertian([0.5, 0.5, 0.5]))

@@ -652,7 +652,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         samples_per_pixel: r.samples_per_pixel,
         max_depth: r.max_depth,
         seed: r.seed,
-        sampling: r.sampling,
+        sampler: r.sampler,
         gamma: r.gamma as f32,
         epsilon: r.epsilon as f32,
         shading: r.shading,

@@ -348,10 +348,12 @@ fn objects(n: &Node) -> Result<Vec<ObjectDesc>> {
         .collect()
 }
 
-const SAMPLINGS: &[(&str, SamplingDesc)] = &[
-    ("random", SamplingDesc::Random),
+const SAMPLERS: &[(&str, SamplingDesc)] = &[
+    ("sobol", SamplingDesc::Sobol),
+    ("independent", SamplingDesc::Independent),
     ("stratified", SamplingDesc::Stratified),
     ("center", SamplingDesc::Center),
+    ("random", SamplingDesc::Independent),
 ];
 
 const SHADINGS: &[(&str, ShadingDesc)] = &[
@@ -374,6 +376,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "samples_per_pixel",
             "max_depth",
             "seed",
+            "sampler",
             "sampling",
             "gamma",
             "epsilon",
@@ -394,15 +397,28 @@ fn render(node: &Node) -> Result<RenderDesc> {
         seed: t
             .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
             .unwrap_or(d.seed),
-        sampling: t
-            .optional("sampling", |n, p| keyword(n, p, SAMPLINGS))?
-            .unwrap_or(d.sampling),
+        sampler: sampler(&t)?.unwrap_or(d.sampler),
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
         epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),
         shading: t
             .optional("shading", |n, p| keyword(n, p, SHADINGS))?
             .unwrap_or(d.shading),
     })
+}
+
+/// The render's sampler: `sampler`, or `sampling` as older scene files
+/// name it, not both.
+fn sampler(t: &Table) -> Result<Option<SamplingDesc>> {
+    let read = |n: &Node, p: &str| keyword(n, p, SAMPLERS);
+    match (t.get("sampler"), t.get("sampling")) {
+        (Some(_), Some(old)) => Err(error(
+            &t.path("sampling"),
+            &old.span,
+            "give `sampler` or its older name `sampling`, not both".to_string(),
+        )),
+        (None, Some(_)) => t.optional("sampling", read),
+        _ => t.optional("sampler", read),
+    }
 }
 
 fn camera(node: &Node) -> Result<CameraDesc> {

@@ -53,8 +53,10 @@ pub struct RenderDesc {
     pub max_depth: u32,
     /// Seed of every random choice of the render.
     pub seed: u64,
-    /// Where in the pixel samples are placed.
-    pub sampling: SamplingDesc,
+    /// Where the numbers of every random decision come from, the position
+    /// in the pixel first (`sampling` in older scene files).
+    #[serde(alias = "sampling")]
+    pub sampler: SamplingDesc,
     /// Display gamma: output = linear^(1/gamma). 1 disables the correction.
     pub gamma: f64,
     /// Smallest ray parameter accepted as a hit; 0 shows shadow acne.
@@ -72,7 +74,7 @@ impl Default for RenderDesc {
             samples_per_pixel: 100,
             max_depth: 50,
             seed: 0,
-            sampling: SamplingDesc::Random,
+            sampler: SamplingDesc::Sobol,
             gamma: 2.0,
             epsilon: 0.001,
             shading: ShadingDesc::Path,
@@ -80,18 +82,23 @@ impl Default for RenderDesc {
     }
 }
 
-/// Placement of samples within a pixel.
+/// The sampler: where the numbers of a render's random decisions come from
+/// (see [`crate::sampler`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SamplingDesc {
-    /// A uniformly random point of the pixel for every sample.
-    Random,
-    /// One random point in each cell of a √N×√N grid (the remaining samples,
-    /// when N is not square, are random).
+    /// Independent random numbers: a uniformly random point of the pixel
+    /// for every sample (`"random"` in older scene files).
+    #[serde(alias = "random")]
+    Independent,
+    /// Independent, but one point of the pixel in each cell of a √N×√N grid
+    /// (the remaining samples, when N is not square, are random).
     Stratified,
-    /// The pixel's centre for every sample: no antialiasing (the notes'
-    /// one-sample figures).
+    /// Independent, but the pixel's centre for every sample: no
+    /// antialiasing (the notes' one-sample figures).
     Center,
+    /// Owen-scrambled Sobol points for every decision: the default.
+    Sobol,
 }
 
 /// What the colour of a camera ray shows.

@@ -19,14 +19,23 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// The candidate closest to `name`, if it is close enough to be a plausible
 /// misspelling: at most a third of the longer name's length away (and at
 /// least 2 edits are always allowed), so that `radus` suggests `radius` but
-/// `colour` does not suggest `ior`. A shortened name (`samples` for
-/// `samples_per_pixel`) also counts, when no candidate is closer by edits.
+/// `colour` does not suggest `ior`. A name that is the first words of a
+/// candidate (`samples` for `samples_per_pixel`) suggests it before any
+/// other (`sampler` is a single edit away, but less likely meant); a shorter
+/// start of a name counts when no candidate is close by edits.
 pub fn closest<'a, I>(name: &str, candidates: I) -> Option<&'a str>
 where
     I: IntoIterator<Item = &'a str>,
 {
     let lower = name.to_lowercase();
     let candidates: Vec<&str> = candidates.into_iter().collect();
+    let first_words = format!("{lower}_");
+    if let Some(c) = candidates
+        .iter()
+        .find(|c| c.to_lowercase().starts_with(&first_words))
+    {
+        return Some(c);
+    }
     let by_edits = candidates
         .iter()
         .map(|&c| (edit_distance(&lower, &c.to_lowercase()), c))

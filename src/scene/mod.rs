@@ -153,8 +153,8 @@ pub struct Settings {
     pub max_depth: u32,
     /// Seed of the render.
     pub seed: u64,
-    /// Sample placement.
-    pub sampling: Sampling,
+    /// Where the render's random numbers come from.
+    pub sampler: Sampling,
     /// Display gamma.
     pub gamma: f32,
     /// Shadow-acne epsilon: smallest accepted hit distance.
@@ -306,6 +306,8 @@ pub struct Overrides {
     pub max_depth: Option<u32>,
     /// Random seed.
     pub seed: Option<u64>,
+    /// The sampler.
+    pub sampler: Option<Sampling>,
 }
 
 impl Overrides {
@@ -328,6 +330,9 @@ impl Overrides {
         }
         if let Some(s) = self.seed {
             r.seed = s;
+        }
+        if let Some(s) = self.sampler {
+            r.sampler = s;
         }
     }
 }

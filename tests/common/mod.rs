@@ -19,8 +19,8 @@ pub fn builtin_desc(name: &str, width: u32, spp: u32, seed: u64) -> SceneDesc {
     Overrides {
         width: Some(width),
         samples_per_pixel: Some(spp),
-        max_depth: None,
         seed: Some(seed),
+        ..Overrides::default()
     }
     .apply(&mut desc);
     desc

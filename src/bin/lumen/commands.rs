@@ -5,6 +5,7 @@ use anyhow::{anyhow, Result};
 use lumen::bench;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
+use lumen::scene::Sampling;
 use std::path::Path;
 use std::time::Instant;
 
@@ -143,6 +144,60 @@ pub(crate) fn instances_command(counts: &[usize], spp: u32, runs: u32) -> Result
             m.rays_per_second() / 1e6,
             m.samples_per_second() / 1e6
         )?;
+    }
+    Ok(())
+}
+
+pub(crate) fn efficiency_command(
+    spp: u32,
+    runs: u32,
+    only: Option<&str>,
+    samplers: &[Sampling],
+) -> Result<()> {
+    let workloads: Vec<_> = bench::efficiency::workloads()
+        .into_iter()
+        .filter(|(name, _)| only.is_none_or(|o| *name == o))
+        .collect();
+    if workloads.is_empty() {
+        let names: Vec<_> = bench::efficiency::workloads()
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        return Err(anyhow!(
+            "no efficiency workload named '{}'; they are {}",
+            only.unwrap_or(""),
+            names.join(", ")
+        ));
+    }
+    outln!(
+        "lumen bench --efficiency: {}, {spp} spp, seeds 1 and 2, median of {runs} runs each",
+        machine()
+    )?;
+    outln!(
+        "{:<22} {:<12} {:>10} {:>12} {:>12} {:>9}",
+        "workload",
+        "sampler",
+        "median s",
+        "variance",
+        "efficiency",
+        "relative"
+    )?;
+    for (name, desc) in workloads {
+        let mut first = None;
+        for &sampler in samplers {
+            let e = bench::efficiency::measure(&desc, sampler, spp, runs as usize)
+                .map_err(|e| anyhow!("{name}: {e}"))?;
+            let base = *first.get_or_insert(e.efficiency());
+            outln!(
+                "{:<22} {:<12} {:>10.3} {:>12.4e} {:>12.4e} {:>8.2}x",
+                name,
+                format!("{sampler:?}").to_lowercase(),
+                e.seconds,
+                e.variance,
+                e.efficiency(),
+                e.efficiency() / base
+            )?;
+        }
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
-use lumen::scene::Overrides;
+use lumen::scene::{Overrides, Sampling};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -78,10 +78,19 @@ enum Command {
         /// With --instances: only this many instances.
         #[arg(long, value_name = "N", requires = "instances", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
         instance_count: Option<u64>,
-        /// Run only the standard workload of this name (cover-400x225,
-        /// three-spheres-400x225, bunny-235k-400x400).
+        /// Run only the workload of this name (cover-400x225,
+        /// three-spheres-400x225, bunny-235k-400x400; with --efficiency,
+        /// sky-spheres-400x225, bunny-235k-400x400).
         #[arg(long, value_name = "NAME", conflicts_with_all = ["scaling", "field", "instances"])]
         workload: Option<String>,
+        /// Instead of throughput, measure efficiency, 1 / (variance × time):
+        /// each workload rendered with two seeds by each sampler (or only
+        /// by --sampler).
+        #[arg(long, conflicts_with_all = ["scaling", "field", "instances"])]
+        efficiency: bool,
+        /// With --efficiency: only this sampler.
+        #[arg(long, value_enum, requires = "efficiency")]
+        sampler: Option<SamplerArg>,
     },
 }
 
@@ -98,6 +107,30 @@ enum ScenesCommand {
         #[arg(long, value_enum, default_value_t = FormatArg::Toml)]
         format: FormatArg,
     },
+}
+
+/// The samplers, as `--sampler` names them.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum SamplerArg {
+    /// Owen-scrambled Sobol points: the least noise for the samples.
+    Sobol,
+    /// Independent random numbers.
+    Independent,
+    /// Independent, with the pixel's samples stratified over a √N×√N grid.
+    Stratified,
+    /// Independent, with every sample through the pixel's centre.
+    Center,
+}
+
+impl From<SamplerArg> for Sampling {
+    fn from(s: SamplerArg) -> Self {
+        match s {
+            SamplerArg::Sobol => Sampling::Sobol,
+            SamplerArg::Independent => Sampling::Independent,
+            SamplerArg::Stratified => Sampling::Stratified,
+            SamplerArg::Center => Sampling::Center,
+        }
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -120,6 +153,10 @@ struct SettingArgs {
     /// Random seed.
     #[arg(long)]
     seed: Option<u64>,
+    /// Where the random numbers come from [default: the scene's; `sobol`
+    /// unless it says otherwise].
+    #[arg(long, value_enum)]
+    sampler: Option<SamplerArg>,
     /// Worker threads (default: one per core). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
     threads: Option<u32>,
@@ -153,6 +190,7 @@ impl SettingArgs {
             samples_per_pixel: self.spp,
             max_depth: self.depth,
             seed: self.seed,
+            sampler: self.sampler.map(Sampling::from),
         }
     }
 }
@@ -180,7 +218,9 @@ mod render;
 mod scenes;
 mod signals;
 
-use commands::{bench_command, gallery_command, instances_command, scaling_command};
+use commands::{
+    bench_command, efficiency_command, gallery_command, instances_command, scaling_command,
+};
 use render::render_command;
 use scenes::export_command;
 
@@ -236,8 +276,17 @@ fn run(cli: Cli) -> Result<ExitCode> {
             instances,
             instance_count,
             workload,
+            efficiency,
+            sampler,
         } => {
             with_threads(threads, || {
+                if efficiency {
+                    let samplers = match sampler {
+                        Some(s) => vec![Sampling::from(s)],
+                        None => vec![Sampling::Independent, Sampling::Stratified, Sampling::Sobol],
+                    };
+                    return efficiency_command(spp, runs, workload.as_deref(), &samplers);
+                }
                 if instances {
                     let counts = match instance_count {
                         Some(n) => vec![n as usize],

@@ -1,5 +1,7 @@
 //! Throughput benchmarks on fixed workloads: `lumen bench`.
 
+pub mod efficiency;
+
 use crate::render::{render, RenderStats};
 use crate::rng::Rng;
 use crate::scene::builtin;

@@ -1,0 +1,112 @@
+//! Efficiency: how soon a render is clean, not only how fast it traces.
+//!
+//! The efficiency of an estimator is 1 / (variance × time): twice as
+//! efficient means the same noise in half the time. A workload is rendered
+//! with two seeds; the mean over pixels and channels of (A − B)² / 2 is the
+//! per-pixel variance of one render (A and B are independent estimates of
+//! the same image), and the time is the median time of a render.
+
+use super::{measure_scene, BUNNY_235K};
+use crate::film::Film;
+use crate::render::render;
+use crate::scene::builtin;
+use crate::scene::desc::{BackgroundDesc, MaterialDesc, SceneDesc};
+use crate::scene::{Sampling, Scene, SceneError};
+use std::time::Duration;
+
+/// The spheres of the efficiency benchmark: the cover's field at 400×225
+/// made diffuse and mirror under a white sky. Glass becomes a white mirror,
+/// fuzzy metal a sharp one, the sky a uniform white 1, and the lens a
+/// pinhole; depth 50. `scripts/peers/spheres-scene.toml` is this scene
+/// for the peer renderers.
+pub fn sky_spheres() -> SceneDesc {
+    let mut desc = builtin::cover();
+    desc.caption = "the cover's spheres, diffuse and mirror, under a white sky".into();
+    desc.render.width = 400;
+    desc.render.height = Some(225);
+    desc.render.max_depth = 50;
+    desc.camera.defocus_angle = 0.0;
+    desc.background = BackgroundDesc::Solid {
+        color: [1.0, 1.0, 1.0],
+    };
+    for material in desc.materials.values_mut() {
+        match material {
+            MaterialDesc::Dielectric { .. } => {
+                *material = MaterialDesc::Metal {
+                    albedo: [1.0, 1.0, 1.0],
+                    fuzz: 0.0,
+                }
+            }
+            MaterialDesc::Metal { fuzz, .. } => *fuzz = 0.0,
+            MaterialDesc::Diffuse { .. } => {}
+        }
+    }
+    desc
+}
+
+/// The efficiency workloads: [`sky_spheres`], and the mesh workload.
+pub fn workloads() -> Vec<(&'static str, SceneDesc)> {
+    vec![
+        ("sky-spheres-400x225", sky_spheres()),
+        ("bunny-235k-400x400", super::bunny_scene(BUNNY_235K)),
+    ]
+}
+
+/// One workload's efficiency with one sampler.
+#[derive(Clone, Debug)]
+pub struct Efficiency {
+    /// Median time of one render.
+    pub seconds: f64,
+    /// Mean per-pixel variance of one render (linear radiance, per channel).
+    pub variance: f64,
+}
+
+impl Efficiency {
+    /// 1 / (variance × seconds).
+    pub fn efficiency(&self) -> f64 {
+        1.0 / (self.variance * self.seconds)
+    }
+}
+
+/// Renders `desc` with `sampler` at `spp`, with seeds 1 and 2, each `runs`
+/// times after a warm-up, and returns its efficiency.
+pub fn measure(
+    desc: &SceneDesc,
+    sampler: Sampling,
+    spp: u32,
+    runs: usize,
+) -> Result<Efficiency, SceneError> {
+    let mut films = Vec::new();
+    let mut times: Vec<Duration> = Vec::new();
+    for seed in [1, 2] {
+        let mut desc = desc.clone();
+        desc.render.sampler = sampler;
+        desc.render.samples_per_pixel = spp;
+        desc.render.seed = seed;
+        let scene = Scene::from_desc(&desc)?;
+        times.extend(measure_scene("efficiency", &scene, runs).runs);
+        films.push(render(&scene, &|_| {}).0);
+    }
+    times.sort();
+    Ok(Efficiency {
+        seconds: times[times.len() / 2].as_secs_f64(),
+        variance: variance_between(&films[0], &films[1]),
+    })
+}
+
+/// The per-pixel variance of one of two independent renders `a` and `b` of
+/// the same image: the mean over pixels and channels of (A − B)² / 2.
+pub fn variance_between(a: &Film, b: &Film) -> f64 {
+    assert_eq!(
+        (a.width(), a.height()),
+        (b.width(), b.height()),
+        "films of different sizes"
+    );
+    let sum: f64 = a
+        .pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| f64::from((p - q).length_squared()))
+        .sum();
+    let n = f64::from(a.width()) * f64::from(a.height());
+    sum / (2.0 * 3.0 * n)
+}
