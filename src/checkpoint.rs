@@ -7,14 +7,14 @@
 //! checkpoint only if its own description is the same, so that the image is
 //! bit-identical to one rendered without a stop.
 //!
-//! # File format (version 1)
+//! # File format (version 2)
 //!
 //! All integers little-endian.
 //!
 //! | bytes | content |
 //! | --- | --- |
 //! | 8 | magic `LUMENCKP` |
-//! | 4 | format version (1) |
+//! | 4 | format version (2) |
 //! | 8 | payload length *n* |
 //! | 4 | CRC-32 of the payload |
 //! | *n* | payload |
@@ -22,7 +22,11 @@
 //! The payload: the renderer identity and the description (each as a u32 length
 //! and UTF-8 bytes), samples per pixel done (u32), width and height (u32),
 //! samples, rays and dropped samples (u64 each), then every pixel's three
-//! `f64` sums and finally every pixel's `u32` count, row-major, top row first.
+//! `f64` sums and every pixel's `u32` count (pixels row-major, top row
+//! first), and last a byte saying whether the render samples adaptively (1)
+//! or not (0), followed, if it does, by the same sums and counts for the
+//! samples of odd index and a byte a pixel: 1 while the pixel is still being
+//! sampled, 0 once it stopped.
 
 use crate::film::Film;
 use crate::output::{self, OutputError};
@@ -35,13 +39,13 @@ use thiserror::Error;
 /// First bytes of every checkpoint file.
 pub const MAGIC: &[u8; 8] = b"LUMENCKP";
 /// The format version this lumen writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// Identifies the code that computes samples: the crate version and a
 /// revision of the sample computation. Any change that alters the value of a
 /// sample (random stream, sampling, intersection arithmetic, materials) must
 /// bump the revision, so that a checkpoint written before it is refused
 /// rather than mixed with different samples.
-pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.6");
+pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.7");
 /// Extension added to an output path to name its default checkpoint.
 pub const EXTENSION: &str = "lumen-ckpt";
 
@@ -62,6 +66,8 @@ pub struct Checkpoint {
     pub stats: RenderStats,
     /// The accumulated samples.
     pub film: Film,
+    /// With adaptive sampling, which pixels are still being sampled.
+    pub active: Option<Vec<bool>>,
 }
 
 /// A checkpoint that cannot be read or does not belong to this render.
@@ -170,6 +176,8 @@ pub struct CheckpointView<'a> {
     pub stats: RenderStats,
     /// The accumulated samples.
     pub film: &'a Film,
+    /// With adaptive sampling, which pixels are still being sampled.
+    pub active: Option<&'a [bool]>,
 }
 
 impl CheckpointView<'_> {
@@ -186,23 +194,17 @@ impl CheckpointView<'_> {
         for v in [self.stats.samples, self.stats.rays, self.stats.dropped] {
             sink(&v.to_le_bytes())?;
         }
-        let (sums, counts) = self.film.raw();
-        let mut buf = Vec::with_capacity(4096 * 24);
-        for chunk in sums.chunks(4096) {
-            buf.clear();
-            for v in chunk.iter().flatten() {
-                buf.extend_from_slice(&v.to_le_bytes());
+        write_sums_and_counts(self.film.raw(), sink)?;
+        match self.active {
+            // Adaptive: the halves' sums and counts, and the pixels' flags.
+            Some(active) if self.film.has_halves() => {
+                sink(&[1])?;
+                write_sums_and_counts(self.film.raw_odd(), sink)?;
+                let flags: Vec<u8> = active.iter().map(|&a| u8::from(a)).collect();
+                sink(&flags)
             }
-            sink(&buf)?;
+            _ => sink(&[0]),
         }
-        for chunk in counts.chunks(4096) {
-            buf.clear();
-            for c in chunk {
-                buf.extend_from_slice(&c.to_le_bytes());
-            }
-            sink(&buf)?;
-        }
-        Ok(())
     }
 
     /// Writes the checkpoint, header included, to `out`: one pass over the
@@ -252,6 +254,7 @@ impl Checkpoint {
             spp_done: self.spp_done,
             stats: self.stats,
             film: &self.film,
+            active: self.active.as_deref(),
         }
     }
 
@@ -314,28 +317,44 @@ impl Checkpoint {
             dropped: stat()?,
         };
         let n = width as usize * height as usize;
-        if r.0.len() as u64 != n as u64 * 28 {
+        let rest = r.0.len() as u64;
+        let adaptive = if rest == n as u64 * 28 + 1 {
+            false
+        } else if rest == n as u64 * 57 + 1 {
+            true
+        } else {
             return Err("pixel data does not match the image size");
-        }
-        let (sum_bytes, count_bytes) = r.0.split_at(n * 24);
-        let sums = sum_bytes
-            .chunks_exact(24)
-            .map(|p| {
-                let f = |i: usize| f64::from_le_bytes(p[i..i + 8].try_into().expect("8 bytes"));
-                [f(0), f(8), f(16)]
-            })
-            .collect();
-        let counts = count_bytes
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect();
+        };
+        let (whole, rest) = r.0.split_at(n * 28);
+        let (sums, counts) = sums_and_counts(whole, n);
         let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
+        let (film, active) = match (adaptive, rest) {
+            (false, [0]) => (film, None),
+            (true, [1, rest @ ..]) => {
+                let (odd, flags) = rest.split_at(n * 28);
+                let (odd_sums, odd_counts) = sums_and_counts(odd, n);
+                let film = film
+                    .with_odd(odd_sums, odd_counts)
+                    .ok_or("bad pixel data of the samples of odd index")?;
+                let active = flags
+                    .iter()
+                    .map(|&b| match b {
+                        0 => Ok(false),
+                        1 => Ok(true),
+                        _ => Err("bad adaptive sampling flags"),
+                    })
+                    .collect::<Result<Vec<bool>, _>>()?;
+                (film, Some(active))
+            }
+            _ => return Err("bad adaptive sampling flags"),
+        };
         Ok(Self {
             renderer_id,
             description,
             spp_done,
             stats,
             film,
+            active,
         })
     }
 
@@ -461,6 +480,48 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
     out.join(", ")
 }
 
+/// Feeds every pixel's three `f64` sums and then every pixel's `u32` count
+/// to `sink`, a few thousand pixels at a time.
+fn write_sums_and_counts(
+    (sums, counts): (&[[f64; 3]], &[u32]),
+    sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let mut buf = Vec::with_capacity(4096 * 24);
+    for chunk in sums.chunks(4096) {
+        buf.clear();
+        for v in chunk.iter().flatten() {
+            buf.extend_from_slice(&v.to_le_bytes());
+        }
+        sink(&buf)?;
+    }
+    for chunk in counts.chunks(4096) {
+        buf.clear();
+        for c in chunk {
+            buf.extend_from_slice(&c.to_le_bytes());
+        }
+        sink(&buf)?;
+    }
+    Ok(())
+}
+
+/// The `n` pixels' three `f64` sums and then their `u32` counts, decoded
+/// from `bytes` (28 bytes a pixel).
+fn sums_and_counts(bytes: &[u8], n: usize) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let (sum_bytes, count_bytes) = bytes.split_at(n * 24);
+    let sums = sum_bytes
+        .chunks_exact(24)
+        .map(|p| {
+            let f = |i: usize| f64::from_le_bytes(p[i..i + 8].try_into().expect("8 bytes"));
+            [f(0), f(8), f(16)]
+        })
+        .collect();
+    let counts = count_bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
+        .collect();
+    (sums, counts)
+}
+
 /// A cursor over little-endian bytes.
 struct Reader<'a>(&'a [u8]);
 
@@ -511,6 +572,7 @@ mod tests {
                 dropped: 2,
             },
             film: Film::from_raw(8, h, sums, counts).unwrap(),
+            active: None,
         };
         (desc, ckpt)
     }
@@ -522,6 +584,29 @@ mod tests {
         let back = Checkpoint::decode(&ckpt.encode(), p).unwrap();
         assert_eq!(back, ckpt);
         back.check_matches(&desc, p).unwrap();
+        // With adaptive sampling's flags too.
+        let n = ckpt.film.len();
+        let adaptive = Checkpoint {
+            active: Some((0..n).map(|i| i % 3 == 0).collect()),
+            film: ckpt
+                .film
+                .clone()
+                .with_odd(
+                    vec![[0.25, 1.0, -2.0]; n],
+                    (0..n as u32).map(|c| c / 2).collect(),
+                )
+                .unwrap(),
+            ..ckpt
+        };
+        let bytes = adaptive.encode();
+        assert_eq!(Checkpoint::decode(&bytes, p).unwrap(), adaptive);
+        // A flag other than 0 or 1 is refused, even with a valid checksum.
+        let mut bad = Checkpoint::decode(&bytes, p).unwrap().encode();
+        *bad.last_mut().unwrap() = 2;
+        let crc = crc32fast::hash(&bad[HEADER_LEN..]);
+        bad[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
+        let e = Checkpoint::decode(&bad, p).unwrap_err().to_string();
+        assert!(e.contains("adaptive sampling flags"), "{e}");
     }
 
     #[test]

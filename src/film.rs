@@ -16,6 +16,49 @@ pub struct Film {
     sums: Vec<[f64; 3]>,
     /// Number of finite samples in each pixel.
     counts: Vec<u32>,
+    /// The same for the samples of odd index only, in a film that keeps
+    /// them ([`Film::with_halves`]; empty otherwise): with the whole, two
+    /// independent half estimates of each pixel, whose difference measures
+    /// its noise (see [`crate::adaptive`]).
+    odd_sums: Vec<[f64; 3]>,
+    odd_counts: Vec<u32>,
+}
+
+/// One row of a film, to add samples to (see [`Film::rows_mut`]).
+pub struct RowMut<'a> {
+    /// Sums of the finite samples of each pixel.
+    pub sums: &'a mut [[f64; 3]],
+    /// Numbers of finite samples.
+    pub counts: &'a mut [u32],
+    /// Sums of the finite samples of odd index (empty in a film that does
+    /// not keep them).
+    pub odd_sums: &'a mut [[f64; 3]],
+    /// Numbers of finite samples of odd index (empty likewise).
+    pub odd_counts: &'a mut [u32],
+}
+
+impl RowMut<'_> {
+    /// Adds sample `index` of pixel `x`, of colour `c`, unless it is NaN or
+    /// infinite: such a sample is left out and `false` is returned so the
+    /// caller can count it.
+    #[inline]
+    pub fn add(&mut self, x: usize, index: u32, c: Color) -> bool {
+        if !c.is_finite() {
+            return false;
+        }
+        let c = [f64::from(c.x), f64::from(c.y), f64::from(c.z)];
+        for (s, v) in self.sums[x].iter_mut().zip(c) {
+            *s += v;
+        }
+        self.counts[x] += 1;
+        if index % 2 == 1 && !self.odd_counts.is_empty() {
+            for (s, v) in self.odd_sums[x].iter_mut().zip(c) {
+                *s += v;
+            }
+            self.odd_counts[x] += 1;
+        }
+        true
+    }
 }
 
 impl Film {
@@ -27,6 +70,19 @@ impl Film {
             height,
             sums: vec![[0.0; 3]; n],
             counts: vec![0; n],
+            odd_sums: Vec::new(),
+            odd_counts: Vec::new(),
+        }
+    }
+
+    /// A black film that also keeps the sums of each pixel's samples of odd
+    /// index, for adaptive sampling's error estimate ([`Film::halves`]).
+    pub fn with_halves(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            odd_sums: vec![[0.0; 3]; n],
+            odd_counts: vec![0; n],
+            ..Self::new(width, height)
         }
     }
 
@@ -40,16 +96,39 @@ impl Film {
         self.height
     }
 
-    /// Mutable access to the rows, for parallel rendering: each item is one
-    /// row's sums and counts.
-    pub fn rows_mut(
-        &mut self,
-    ) -> impl rayon::iter::IndexedParallelIterator<Item = (&mut [[f64; 3]], &mut [u32])> {
+    /// Mutable access to the rows, for parallel rendering.
+    pub fn rows_mut(&mut self) -> impl rayon::iter::IndexedParallelIterator<Item = RowMut<'_>> {
+        use rayon::iter::Either;
         use rayon::prelude::*;
         let w = self.width as usize;
-        self.sums
+        let whole = self
+            .sums
             .par_chunks_mut(w)
-            .zip(self.counts.par_chunks_mut(w))
+            .zip(self.counts.par_chunks_mut(w));
+        if self.odd_counts.is_empty() {
+            return Either::Left(whole.map(|(sums, counts)| RowMut {
+                sums,
+                counts,
+                odd_sums: &mut [],
+                odd_counts: &mut [],
+            }));
+        }
+        Either::Right(
+            whole
+                .zip(self.odd_sums.par_chunks_mut(w))
+                .zip(self.odd_counts.par_chunks_mut(w))
+                .map(|(((sums, counts), odd_sums), odd_counts)| RowMut {
+                    sums,
+                    counts,
+                    odd_sums,
+                    odd_counts,
+                }),
+        )
+    }
+
+    /// Whether the film keeps the sums of the samples of odd index.
+    pub fn has_halves(&self) -> bool {
+        !self.odd_counts.is_empty()
     }
 
     /// Makes this film a copy of `other` (of the same size) without
@@ -59,6 +138,8 @@ impl Film {
         self.height = other.height;
         self.sums.clone_from(&other.sums);
         self.counts.clone_from(&other.counts);
+        self.odd_sums.clone_from(&other.odd_sums);
+        self.odd_counts.clone_from(&other.odd_counts);
     }
 
     /// The raw per-pixel sums and counts (for checkpoints).
@@ -66,7 +147,14 @@ impl Film {
         (&self.sums, &self.counts)
     }
 
-    /// Rebuilds a film from raw sums and counts; `None` if the sizes disagree.
+    /// The raw per-pixel sums and counts of the samples of odd index (empty
+    /// in a film without halves).
+    pub fn raw_odd(&self) -> (&[[f64; 3]], &[u32]) {
+        (&self.odd_sums, &self.odd_counts)
+    }
+
+    /// Rebuilds a film from raw sums and counts, with no record of which
+    /// samples had odd indices; `None` if the sizes disagree.
     pub fn from_raw(
         width: u32,
         height: u32,
@@ -79,7 +167,51 @@ impl Film {
             height,
             sums,
             counts,
+            odd_sums: Vec::new(),
+            odd_counts: Vec::new(),
         })
+    }
+
+    /// This film with the sums and counts of its samples of odd index;
+    /// `None` if their sizes disagree with the film's or an odd count
+    /// exceeds its pixel's count.
+    pub fn with_odd(self, odd_sums: Vec<[f64; 3]>, odd_counts: Vec<u32>) -> Option<Self> {
+        let n = self.sums.len();
+        let fits = odd_sums.len() == n
+            && odd_counts.len() == n
+            && odd_counts.iter().zip(&self.counts).all(|(o, c)| o <= c);
+        fits.then_some(Self {
+            odd_sums,
+            odd_counts,
+            ..self
+        })
+    }
+
+    /// The two half estimates of pixel `i` (row-major): the mean of its
+    /// samples of even index and of odd index, if the film keeps them and
+    /// each half has a sample.
+    pub fn halves(&self, i: usize) -> Option<(Color, Color)> {
+        let (n, odd) = (self.counts[i], *self.odd_counts.get(i)?);
+        if odd == 0 || odd == n {
+            return None;
+        }
+        let even_sum = [0, 1, 2].map(|c| self.sums[i][c] - self.odd_sums[i][c]);
+        Some((mean(&even_sum, n - odd), mean(&self.odd_sums[i], odd)))
+    }
+
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        self.sums.len()
+    }
+
+    /// Whether the film has no pixels.
+    pub fn is_empty(&self) -> bool {
+        self.sums.is_empty()
+    }
+
+    /// The mean linear colour of pixel `i` (row-major); black if it has no samples.
+    pub fn mean(&self, i: usize) -> Color {
+        mean(&self.sums[i], self.counts[i])
     }
 
     /// The mean linear colour of pixel `(x, y)`; black if it has no samples.

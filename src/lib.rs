@@ -21,7 +21,8 @@
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.
 //! - [`film`] and [`output`]: accumulation, gamma, tone mapping, image files.
 //! - [`progressive`] and [`checkpoint`]: rendering in passes that can be
-//!   stopped, saved and resumed, within a time budget.
+//!   stopped, saved and resumed, within a time budget; [`adaptive`]: pixels
+//!   that stop once clean.
 //! - [`scene`]: scene descriptions, the built-in scenes, and the compiled scene.
 //! - [`gallery`] and [`bench`](mod@bench): all the notes' figures at once; throughput.
 //!
@@ -42,6 +43,7 @@
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod adaptive;
 pub mod bench;
 pub mod camera;
 pub mod checkpoint;

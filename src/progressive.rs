@@ -37,7 +37,7 @@
 
 use crate::checkpoint::{identity_text, Checkpoint, CheckpointError, CheckpointView};
 use crate::film::Film;
-use crate::render::{render_samples_cancellable, RenderStats};
+use crate::render::{render_pixels, RenderStats};
 use crate::scene::{Scene, SceneDesc, SceneError};
 use std::ops::Range;
 use std::path::Path;
@@ -103,6 +103,8 @@ pub struct Session {
     backup: Film,
     stats: RenderStats,
     spp_done: u32,
+    /// With adaptive sampling, the pixels still being sampled.
+    active: Option<Vec<bool>>,
 }
 
 /// A session that cannot be started.
@@ -160,7 +162,12 @@ impl Session {
     /// A new render of `desc` already compiled into `scene` (which must be
     /// `Scene::from_desc(desc)`): spares building the scene twice.
     pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Self {
-        let film = Film::new(scene.settings.width, scene.settings.height);
+        let (w, h) = (scene.settings.width, scene.settings.height);
+        let film = match scene.settings.noise_target {
+            Some(_) => Film::with_halves(w, h),
+            None => Film::new(w, h),
+        };
+        let active = scene.settings.noise_target.map(|_| vec![true; film.len()]);
         Self {
             description: identity_text(desc, &scene.sources),
             scene,
@@ -168,6 +175,7 @@ impl Session {
             backup: Film::new(0, 0),
             stats: RenderStats::default(),
             spp_done: 0,
+            active,
         }
     }
 
@@ -224,9 +232,16 @@ impl Session {
             ))
             .into());
         }
+        if checkpoint.active.is_some() != self.active.is_some() {
+            return Err(malformed(
+                "its adaptive sampling state does not match the render's".into(),
+            )
+            .into());
+        }
         self.film = checkpoint.film;
         self.stats = checkpoint.stats;
         self.spp_done = checkpoint.spp_done;
+        self.active = checkpoint.active;
         Ok(self)
     }
 
@@ -255,9 +270,23 @@ impl Session {
         self.scene.settings.samples_per_pixel
     }
 
-    /// Whether every sample is rendered.
+    /// Whether every sample is rendered (with adaptive sampling: every
+    /// sample of the pixels that have not stopped).
     pub fn is_complete(&self) -> bool {
-        self.spp_done >= self.spp_total()
+        self.spp_done >= self.spp_total() || self.active_pixels() == Some(0)
+    }
+
+    /// With adaptive sampling, the number of pixels still being sampled.
+    pub fn active_pixels(&self) -> Option<usize> {
+        self.active
+            .as_ref()
+            .map(|a| a.iter().filter(|&&on| on).count())
+    }
+
+    /// With adaptive sampling, which pixels are still being sampled
+    /// (row-major).
+    pub fn active(&self) -> Option<&[bool]> {
+        self.active.as_deref()
     }
 
     /// The state to save so that a later run can continue this one.
@@ -268,6 +297,7 @@ impl Session {
             spp_done: self.spp_done,
             stats: self.stats,
             film: &self.film,
+            active: self.active.as_deref(),
         }
     }
 
@@ -285,18 +315,24 @@ impl Session {
         // keep the film as it was to put it back.
         self.backup.copy_from(&self.film);
         let start = Instant::now();
-        let result = render_samples_cancellable(
+        let result = render_pixels(
             &self.scene,
             &mut self.film,
             samples.clone(),
+            self.active.as_deref(),
             progress,
             should_stop,
         );
-        let duration = start.elapsed();
         match result {
             Some(stats) => {
                 self.stats.add(stats);
                 self.spp_done = samples.end;
+                if let (Some(active), Some(target)) =
+                    (&mut self.active, self.scene.settings.noise_target)
+                {
+                    crate::adaptive::update(&self.film, active, target, self.spp_done);
+                }
+                let duration = start.elapsed();
                 Some((samples, duration, stats))
             }
             None => {
@@ -441,6 +477,58 @@ mod tests {
         assert_eq!(run.reason, StopReason::Complete);
         assert_eq!(second.film(), &reference);
         assert_eq!(second.stats(), ref_stats);
+    }
+
+    #[test]
+    fn adaptive_passes_and_resume_equal_one_run_whatever_the_threads() {
+        let mut desc = small_desc();
+        desc.render.samples_per_pixel = 96;
+        desc.render.sampler = crate::scene::Sampling::Sobol;
+        desc.render.noise_target = Some(0.05);
+        let stop = AtomicBool::new(false);
+        let run_all = |threads: usize| {
+            let mut session = Session::new(&desc).unwrap();
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| session.run(&stop, None, &|_| {}, &mut |_, _| Ok::<(), ()>(())))
+                .unwrap();
+            session
+        };
+        let whole = run_all(1);
+        let active = whole.active_pixels().unwrap();
+        let pixels = whole.film().len();
+        assert!(
+            active < pixels && whole.stats().samples < pixels as u64 * 96,
+            "no pixel stopped ({active} of {pixels} active)"
+        );
+        let other = run_all(2);
+        assert_eq!(other.film(), whole.film());
+        assert_eq!(other.active(), whole.active());
+        // Stopped after the sixth pass (past the minimum: some pixels have
+        // stopped), saved, resumed.
+        let mut first = Session::new(&desc).unwrap();
+        first
+            .run(&stop, None, &|_| {}, &mut |_, r| {
+                if r.number == 6 {
+                    stop.store(true, Ordering::SeqCst);
+                }
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+        assert!(first.spp_done() >= crate::adaptive::MIN_SAMPLES);
+        assert!(first.active_pixels().unwrap() < pixels, "none stopped yet");
+        let path = Path::new("mem");
+        let ckpt = Checkpoint::decode(&first.checkpoint().encode(), path).unwrap();
+        let mut second = Session::resume(&desc, ckpt, path).unwrap();
+        stop.store(false, Ordering::SeqCst);
+        second
+            .run(&stop, None, &|_| {}, &mut |_, _| Ok::<(), ()>(()))
+            .unwrap();
+        assert_eq!(second.film(), whole.film());
+        assert_eq!(second.active(), whole.active());
+        assert_eq!(second.stats(), whole.stats());
     }
 
     #[test]

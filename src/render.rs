@@ -1,6 +1,6 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
-use crate::film::Film;
+use crate::film::{Film, RowMut};
 use crate::integrator::{first_hit_view, trace_paths, PATHS};
 use crate::isa::Isa;
 use crate::math::{Color, Vec3};
@@ -71,17 +71,36 @@ pub fn render_samples_cancellable(
     progress: &(dyn Fn(u64) + Sync),
     should_stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<RenderStats> {
-    let width = film.width();
-    let row_samples = u64::from(width) * u64::from(samples.len() as u32);
+    render_pixels(scene, film, samples, None, progress, should_stop)
+}
+
+/// [`render_samples_cancellable`] for the pixels whose entry in `active`
+/// (row-major, one per pixel) is `true` only, or for every pixel when
+/// `active` is `None`; `progress` counts the samples of those pixels.
+pub fn render_pixels(
+    scene: &Scene,
+    film: &mut Film,
+    samples: Range<u32>,
+    active: Option<&[bool]>,
+    progress: &(dyn Fn(u64) + Sync),
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Option<RenderStats> {
+    let width = film.width() as usize;
+    let per_pixel = u64::from(samples.len() as u32);
+    if let Some(active) = active {
+        assert_eq!(active.len(), film.len(), "one flag per pixel");
+    }
     let isa = Isa::detect();
     film.rows_mut()
         .enumerate()
-        .map(|(y, (sums, counts))| {
+        .map(|(y, row)| {
             if should_stop() {
                 return None;
             }
-            let stats = render_row(isa, scene, y as u32, samples.clone(), sums, counts);
-            progress(row_samples);
+            let active = active.map(|a| &a[y * width..(y + 1) * width]);
+            let stats = render_row(isa, scene, y as u32, samples.clone(), row, active);
+            let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
+            progress(pixels as u64 * per_pixel);
             Some(stats)
         })
         .reduce(
@@ -94,15 +113,16 @@ pub fn render_samples_cancellable(
         )
 }
 
-/// Renders samples `samples` of every pixel of row `y` with the code compiled
-/// for `isa` (which must be supported: use [`Isa::detect`]).
+/// Renders samples `samples` of every pixel of row `y` (of those whose
+/// `active` flag is set, if given) with the code compiled for `isa` (which
+/// must be supported: use [`Isa::detect`]).
 fn render_row(
     isa: Isa,
     scene: &Scene,
     y: u32,
     samples: Range<u32>,
-    sums: &mut [[f64; 3]],
-    counts: &mut [u32],
+    row: RowMut,
+    active: Option<&[bool]>,
 ) -> RenderStats {
     match isa {
         #[cfg(target_arch = "x86_64")]
@@ -111,10 +131,10 @@ fn render_row(
             // processor has every feature `render_row_avx2` is compiled for.
             #[allow(unsafe_code)]
             unsafe {
-                render_row_avx2(scene, y, samples, sums, counts)
+                render_row_avx2(scene, y, samples, row, active)
             }
         }
-        _ => render_row_generic(scene, y, samples, sums, counts),
+        _ => render_row_generic(scene, y, samples, row, active),
     }
 }
 
@@ -125,10 +145,10 @@ unsafe fn render_row_avx2(
     scene: &Scene,
     y: u32,
     samples: Range<u32>,
-    sums: &mut [[f64; 3]],
-    counts: &mut [u32],
+    row: RowMut,
+    active: Option<&[bool]>,
 ) -> RenderStats {
-    render_row_generic(scene, y, samples, sums, counts)
+    render_row_generic(scene, y, samples, row, active)
 }
 
 /// The body of the row loop, inlined into each instruction-set version.
@@ -137,12 +157,12 @@ fn render_row_generic(
     scene: &Scene,
     y: u32,
     samples: Range<u32>,
-    sums: &mut [[f64; 3]],
-    counts: &mut [u32],
+    mut row: RowMut,
+    active: Option<&[bool]>,
 ) -> RenderStats {
     let s = &scene.settings;
     let mut stats = RenderStats::default();
-    let width = sums.len().min(counts.len());
+    let width = row.sums.len();
     // Path tracing runs a pixel's samples side by side (`trace_paths`); the
     // debugging views trace one ray at a time.
     let side_by_side = s.shading == Shading::Path;
@@ -151,19 +171,25 @@ fn render_row_generic(
     let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PATHS];
     let mut samplers = [const { PixelSample::placeholder() }; PATHS];
     let mut colours = [Color::ZERO; PATHS];
-    for (x, (sum, count)) in sums.iter_mut().zip(counts.iter_mut()).enumerate() {
+    for x in 0..width {
+        if active.is_some_and(|a| !a[x]) {
+            continue;
+        }
         let pixel = u64::from(y) * width as u64 + x as u64;
         let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
-        let mut add = |c: Color| {
+        let mut add = |index: u32, c: Color| {
             stats.samples += 1;
-            if !accumulate(sum, count, c) {
+            if !row.add(x, index, c) {
                 stats.dropped += 1;
             }
         };
         if !side_by_side {
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, x as u32, y, &pixel_sampler, index);
-                add(first_hit_view(scene, ray, s.shading, &mut stats.rays));
+                add(
+                    index,
+                    first_hit_view(scene, ray, s.shading, &mut stats.rays),
+                );
             }
             continue;
         }
@@ -184,8 +210,8 @@ fn render_row_generic(
                 &mut stats.rays,
             );
             // In sample order, as one at a time would add them.
-            for &c in &colours[..n] {
-                add(c);
+            for (i, &c) in colours[..n].iter().enumerate() {
+                add(start + i as u32, c);
             }
             start += n as u32;
         }
@@ -206,21 +232,6 @@ fn camera_sample(
     let (mut sampler, (dx, dy)) = pixel_sampler.start(index);
     let ray = scene.camera.ray(x, y, dx, dy, &mut sampler);
     (ray, sampler)
-}
-
-/// Adds one sample's colour to a pixel's sum and count, unless it is NaN or
-/// infinite: such a sample is left out and `false` is returned so the caller
-/// can count it.
-#[inline]
-fn accumulate(sum: &mut [f64; 3], count: &mut u32, c: Color) -> bool {
-    if !c.is_finite() {
-        return false;
-    }
-    sum[0] += f64::from(c.x);
-    sum[1] += f64::from(c.y);
-    sum[2] += f64::from(c.z);
-    *count += 1;
-    true
 }
 
 /// Renders the whole image at the scene's samples per pixel.
@@ -250,36 +261,53 @@ mod tests {
     }
 
     fn same_bits_on_every_instruction_set(scene: &Scene) {
-        let width = scene.settings.width as usize;
+        let width = scene.settings.width;
         let isa = Isa::detect();
         for y in 0..scene.settings.height {
-            let mut base = (vec![[0.0f64; 3]; width], vec![0u32; width]);
-            let mut best = base.clone();
-            let a = render_row(Isa::Baseline, scene, y, 0..37, &mut base.0, &mut base.1);
-            let b = render_row(isa, scene, y, 0..37, &mut best.0, &mut best.1);
+            let render_with = |isa| {
+                let mut film = Film::with_halves(width, 1);
+                let row = film.rows_mut().collect::<Vec<_>>().pop().unwrap();
+                let stats = render_row(isa, scene, y, 0..37, row, None);
+                (film, stats)
+            };
+            let (base, a) = render_with(Isa::Baseline);
+            let (best, b) = render_with(isa);
             assert_eq!(a, b, "row {y}: counts differ between baseline and {isa:?}");
-            let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(
-                bits(&base.0),
-                bits(&best.0),
+            let bits = |f: &Film| {
+                let (sums, counts) = f.raw();
+                let (odd, odd_counts) = f.raw_odd();
+                let bits = sums.iter().chain(odd).flatten().map(|x| x.to_bits());
+                (
+                    bits.collect::<Vec<_>>(),
+                    counts.to_vec(),
+                    odd_counts.to_vec(),
+                )
+            };
+            assert!(
+                bits(&base) == bits(&best),
                 "row {y}: baseline and {isa:?} differ"
             );
-            assert_eq!(base.1, best.1);
         }
     }
 
     #[test]
     fn non_finite_samples_are_dropped_and_finite_ones_added() {
-        let (mut sum, mut count) = ([0.0f64; 3], 0u32);
-        assert!(accumulate(&mut sum, &mut count, Color::new(0.25, 0.5, 2.0)));
-        for bad in [
-            Color::new(f32::NAN, 0.0, 0.0),
-            Color::new(0.0, f32::INFINITY, 0.0),
-            Color::new(0.0, 0.0, f32::NEG_INFINITY),
-        ] {
-            assert!(!accumulate(&mut sum, &mut count, bad));
+        let mut film = Film::with_halves(1, 1);
+        {
+            let mut row = film.rows_mut().collect::<Vec<_>>().pop().unwrap();
+            assert!(row.add(0, 0, Color::new(0.25, 0.5, 2.0)));
+            for bad in [
+                Color::new(f32::NAN, 0.0, 0.0),
+                Color::new(0.0, f32::INFINITY, 0.0),
+                Color::new(0.0, 0.0, f32::NEG_INFINITY),
+            ] {
+                assert!(!row.add(0, 1, bad));
+            }
+            assert!(row.add(0, 3, Color::new(0.25, 0.5, 2.0)));
+            assert!(row.add(0, 4, Color::new(1.0, 1.0, 1.0)));
         }
-        assert!(accumulate(&mut sum, &mut count, Color::new(0.25, 0.5, 2.0)));
-        assert_eq!((sum, count), ([0.5, 1.0, 4.0], 2));
+        assert_eq!(film.raw(), (&[[1.5, 2.0, 5.0]][..], &[3][..]));
+        // Only sample 3 has an odd index among those added.
+        assert_eq!(film.raw_odd(), (&[[0.25, 0.5, 2.0]][..], &[1][..]));
     }
 }

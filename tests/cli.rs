@@ -264,3 +264,29 @@ fn gallery_with_a_bad_value_fails_cleanly() {
     );
     assert!(!target.exists());
 }
+
+#[test]
+fn sampler_and_noise_target_flags_render_and_refuse_bad_values() {
+    let dir = scratch_dir("adaptive");
+    let out_path = dir.join("a.pfm");
+    let out_str = out_path.to_str().unwrap();
+    let args = [
+        "render", "cover", "-o", out_str, "--width", "48", "--spp", "64",
+    ];
+    let out = lumen(&[&args[..], &["--sampler", "sobol", "--noise-target", "0.05"]].concat());
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("pixels still sampling"), "{err}");
+    assert!(err.contains("on average, noise target 0.05"), "{err}");
+    assert_eq!(listing(&dir), ["a.pfm"], "no checkpoint left behind");
+    // The flag chooses the sampler: the image differs from the scene's own.
+    let sobol = std::fs::read(&out_path).unwrap();
+    let out = lumen(&[&args[..], &["--noise-target", "0.05"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_ne!(std::fs::read(&out_path).unwrap(), sobol);
+    let out = lumen(&[&args[..], &["--noise-target", "0"]].concat());
+    assert_fails(&out, &["render.noise_target", "above 0"]);
+    let out = lumen(&[&args[..], &["--sampler", "halton"]].concat());
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("sobol"), "{}", stderr(&out));
+}

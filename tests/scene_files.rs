@@ -154,11 +154,15 @@ fn overrides_replace_the_files_settings() {
         max_depth: Some(5),
         seed: Some(11),
         sampler: Some(Sampling::Stratified),
+        noise_target: Some(0.25),
     };
     let s = file.compile(&o).unwrap().settings;
     assert_eq!((s.width, s.height), (40, 20), "height keeps the proportion");
     assert_eq!((s.samples_per_pixel, s.max_depth, s.seed), (3, 5, 11));
-    assert_eq!(s.sampler, Sampling::Stratified);
+    assert_eq!(
+        (s.sampler, s.noise_target),
+        (Sampling::Stratified, Some(0.25))
+    );
 }
 
 /// `SceneDesc` also derives serde's `Deserialize` for library users; it must

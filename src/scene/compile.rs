@@ -646,9 +646,20 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
             format!("must not be negative, got {}", r.epsilon),
         ));
     }
+    let noise_target = match r.noise_target {
+        None => None,
+        Some(t) if t > 0.0 && t <= 1.0 && (t as f32) > 0.0 => Some(t as f32),
+        Some(t) => {
+            return Err(invalid(
+                "render.noise_target",
+                format!("must be a relative error above 0 and at most 1, got {t}"),
+            ))
+        }
+    };
     Ok(Settings {
         width: r.width,
         height,
+        noise_target,
         samples_per_pixel: r.samples_per_pixel,
         max_depth: r.max_depth,
         seed: r.seed,

@@ -378,6 +378,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "seed",
             "sampler",
             "sampling",
+            "noise_target",
             "gamma",
             "epsilon",
             "shading",
@@ -398,6 +399,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
             .unwrap_or(d.seed),
         sampler: sampler(&t)?.unwrap_or(d.sampler),
+        noise_target: t.optional("noise_target", float)?,
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
         epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),
         shading: t

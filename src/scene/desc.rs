@@ -57,6 +57,10 @@ pub struct RenderDesc {
     /// in the pixel first (`sampling` in older scene files).
     #[serde(alias = "sampling")]
     pub sampler: SamplingDesc,
+    /// Adaptive sampling: a pixel stops taking samples once its estimated
+    /// relative error is at most this; absent, every pixel takes them all.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_target: Option<f64>,
     /// Display gamma: output = linear^(1/gamma). 1 disables the correction.
     pub gamma: f64,
     /// Smallest ray parameter accepted as a hit; 0 shows shadow acne.
@@ -75,6 +79,7 @@ impl Default for RenderDesc {
             max_depth: 50,
             seed: 0,
             sampler: SamplingDesc::Sobol,
+            noise_target: None,
             gamma: 2.0,
             epsilon: 0.001,
             shading: ShadingDesc::Path,

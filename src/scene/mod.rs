@@ -155,6 +155,10 @@ pub struct Settings {
     pub seed: u64,
     /// Where the render's random numbers come from.
     pub sampler: Sampling,
+    /// Adaptive sampling: pixels stop once their estimated relative error
+    /// is at most this (see [`crate::adaptive`]); `None` samples every pixel
+    /// fully.
+    pub noise_target: Option<f32>,
     /// Display gamma.
     pub gamma: f32,
     /// Shadow-acne epsilon: smallest accepted hit distance.
@@ -308,6 +312,8 @@ pub struct Overrides {
     pub seed: Option<u64>,
     /// The sampler.
     pub sampler: Option<Sampling>,
+    /// The noise target of adaptive sampling.
+    pub noise_target: Option<f64>,
 }
 
 impl Overrides {
@@ -333,6 +339,9 @@ impl Overrides {
         }
         if let Some(s) = self.sampler {
             r.sampler = s;
+        }
+        if let Some(t) = self.noise_target {
+            r.noise_target = Some(t);
         }
     }
 }

@@ -157,6 +157,10 @@ struct SettingArgs {
     /// unless it says otherwise].
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// Adaptive sampling: stop sampling a pixel once its estimated relative
+    /// error is at most this (e.g. 0.01); --spp stays the upper bound.
+    #[arg(long, value_name = "ERROR")]
+    noise_target: Option<f64>,
     /// Worker threads (default: one per core). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
     threads: Option<u32>,
@@ -191,6 +195,7 @@ impl SettingArgs {
             max_depth: self.depth,
             seed: self.seed,
             sampler: self.sampler.map(Sampling::from),
+            noise_target: self.noise_target,
         }
     }
 }

@@ -139,8 +139,14 @@ pub(crate) fn render_command(
         (),
     > {
         bar.suspend(|| {
+            let adaptive = session.active_pixels().map_or(String::new(), |n| {
+                format!(
+                    ", {n} of {pixels} pixels still sampling ({:.1} spp on average)",
+                    session.stats().samples as f64 / pixels as f64
+                )
+            });
             eprintln!(
-                "pass {}: samples {}..{} in {:.3} s, {} of {} spp",
+                "pass {}: samples {}..{} in {:.3} s, {} of {} spp{adaptive}",
                 pass.number,
                 pass.samples.start,
                 pass.samples.end,
@@ -171,7 +177,15 @@ pub(crate) fn render_command(
                 }
                 _ => {}
             }
-            eprintln!("{name}: {total} spp written to {}", out.display());
+            let spp = match session.active_pixels() {
+                None => format!("{total} spp"),
+                Some(_) => format!(
+                    "up to {total} spp ({:.1} on average, noise target {})",
+                    session.stats().samples as f64 / pixels as f64,
+                    s.noise_target.unwrap_or_default()
+                ),
+            };
+            eprintln!("{name}: {spp} written to {}", out.display());
             ExitCode::SUCCESS
         }
         reason if held == 0 => {
