@@ -110,3 +110,72 @@ pub fn variance_between(a: &Film, b: &Film) -> f64 {
     let n = f64::from(a.width()) * f64::from(a.height());
     sum / (2.0 * 3.0 * n)
 }
+
+/// A render with and without adaptive sampling, measured against a
+/// reference (see [`measure_adaptive`]).
+#[derive(Clone, Debug)]
+pub struct AdaptivePoint {
+    /// Seconds of the render.
+    pub seconds: f64,
+    /// Camera samples taken.
+    pub samples: u64,
+    /// Root mean square of the pixels' relative errors against the reference.
+    pub rms_error: f64,
+    /// The 95th percentile of the pixels' relative errors.
+    pub p95_error: f64,
+}
+
+/// Renders `desc` at up to `spp` with `target` as its noise target and
+/// without one (seed 1 each), and a reference at 4 × `spp` (seed 2), and
+/// measures both renders' errors against it: relative errors as adaptive
+/// sampling estimates them (channel mean of |difference|, over the
+/// reference's channel mean, at least [`crate::adaptive::DARK`]).
+pub fn measure_adaptive(
+    desc: &SceneDesc,
+    target: f64,
+    spp: u32,
+) -> Result<[AdaptivePoint; 2], SceneError> {
+    use crate::progressive::Session;
+    use std::sync::atomic::AtomicBool;
+    use std::time::Instant;
+    let mut desc = desc.clone();
+    desc.render.samples_per_pixel = spp;
+    desc.render.seed = 1;
+    let mut reference = desc.clone();
+    reference.render.samples_per_pixel = 4 * spp;
+    reference.render.seed = 2;
+    reference.render.noise_target = None;
+    let reference = render(&Scene::from_desc(&reference)?, &|_| {}).0;
+    let mut points = Vec::new();
+    for noise_target in [Some(target), None] {
+        desc.render.noise_target = noise_target;
+        let mut session = Session::new(&desc).map_err(|e| match e {
+            crate::progressive::SessionError::Scene(e) => e,
+            other => unreachable!("a new session reads no checkpoint: {other}"),
+        })?;
+        let start = Instant::now();
+        session
+            .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {
+                Ok::<(), ()>(())
+            })
+            .expect("the pass callback never fails");
+        let seconds = start.elapsed().as_secs_f64();
+        let film = session.film();
+        let mut errors: Vec<f64> = (0..film.len())
+            .map(|i| {
+                let (a, r) = (film.mean(i), reference.mean(i));
+                let level = (r.element_sum() / 3.0).max(crate::adaptive::DARK);
+                f64::from((a - r).abs().element_sum() / 3.0 / level)
+            })
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        points.push(AdaptivePoint {
+            seconds,
+            samples: session.stats().samples,
+            rms_error: rms,
+            p95_error: errors[errors.len() * 95 / 100],
+        });
+    }
+    Ok([points[0].clone(), points[1].clone()])
+}

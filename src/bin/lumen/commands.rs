@@ -5,6 +5,7 @@ use anyhow::{anyhow, Result};
 use lumen::bench;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
+use lumen::scene::desc::SceneDesc;
 use lumen::scene::Sampling;
 use std::path::Path;
 use std::time::Instant;
@@ -148,27 +149,71 @@ pub(crate) fn instances_command(counts: &[usize], spp: u32, runs: u32) -> Result
     Ok(())
 }
 
-pub(crate) fn efficiency_command(
-    spp: u32,
-    runs: u32,
-    only: Option<&str>,
-    samplers: &[Sampling],
-) -> Result<()> {
-    let workloads: Vec<_> = bench::efficiency::workloads()
-        .into_iter()
+/// The efficiency workloads, or the one named `only`.
+fn efficiency_workloads(only: Option<&str>) -> Result<Vec<(&'static str, SceneDesc)>> {
+    let all = bench::efficiency::workloads();
+    let names: Vec<_> = all.iter().map(|(n, _)| *n).collect();
+    let chosen: Vec<_> = all
+        .iter()
         .filter(|(name, _)| only.is_none_or(|o| *name == o))
+        .cloned()
         .collect();
-    if workloads.is_empty() {
-        let names: Vec<_> = bench::efficiency::workloads()
-            .iter()
-            .map(|(n, _)| *n)
-            .collect();
+    if chosen.is_empty() {
         return Err(anyhow!(
             "no efficiency workload named '{}'; they are {}",
             only.unwrap_or(""),
             names.join(", ")
         ));
     }
+    Ok(chosen)
+}
+
+pub(crate) fn adaptive_command(target: f64, spp: u32, only: Option<&str>) -> Result<()> {
+    let workloads = efficiency_workloads(only)?;
+    outln!(
+        "lumen bench --adaptive {target}: {}, up to {spp} spp (sobol), errors against {} spp",
+        machine(),
+        4 * spp
+    )?;
+    outln!(
+        "{:<22} {:<10} {:>10} {:>10} {:>10} {:>10}",
+        "workload",
+        "noise",
+        "seconds",
+        "mean spp",
+        "rms error",
+        "95% error"
+    )?;
+    for (name, mut desc) in workloads {
+        desc.render.sampler = Sampling::Sobol;
+        let points = bench::efficiency::measure_adaptive(&desc, target, spp)
+            .map_err(|e| anyhow!("{name}: {e}"))?;
+        let pixels = f64::from(desc.render.width) * f64::from(desc.render.height.unwrap_or(1));
+        for (label, p) in [
+            (format!("{target}"), &points[0]),
+            ("none".into(), &points[1]),
+        ] {
+            outln!(
+                "{:<22} {:<10} {:>10.3} {:>10.1} {:>10.4} {:>10.4}",
+                name,
+                label,
+                p.seconds,
+                p.samples as f64 / pixels,
+                p.rms_error,
+                p.p95_error
+            )?;
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn efficiency_command(
+    spp: u32,
+    runs: u32,
+    only: Option<&str>,
+    samplers: &[Sampling],
+) -> Result<()> {
+    let workloads = efficiency_workloads(only)?;
     outln!(
         "lumen bench --efficiency: {}, {spp} spp, seeds 1 and 2, median of {runs} runs each",
         machine()

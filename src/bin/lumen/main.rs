@@ -91,6 +91,11 @@ enum Command {
         /// With --efficiency: only this sampler.
         #[arg(long, value_enum, requires = "efficiency")]
         sampler: Option<SamplerArg>,
+        /// Instead of throughput, render the efficiency workloads with this
+        /// noise target and without one (up to --spp, Sobol), and compare
+        /// their time and error against a reference of 4 × --spp.
+        #[arg(long, value_name = "ERROR", conflicts_with_all = ["scaling", "field", "instances", "efficiency"])]
+        adaptive: Option<f64>,
     },
 }
 
@@ -224,7 +229,8 @@ mod scenes;
 mod signals;
 
 use commands::{
-    bench_command, efficiency_command, gallery_command, instances_command, scaling_command,
+    adaptive_command, bench_command, efficiency_command, gallery_command, instances_command,
+    scaling_command,
 };
 use render::render_command;
 use scenes::export_command;
@@ -283,8 +289,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             workload,
             efficiency,
             sampler,
+            adaptive,
         } => {
             with_threads(threads, || {
+                if let Some(target) = adaptive {
+                    return adaptive_command(target, spp, workload.as_deref());
+                }
                 if efficiency {
                     let samplers = match sampler {
                         Some(s) => vec![Sampling::from(s)],
