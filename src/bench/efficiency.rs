@@ -179,3 +179,48 @@ pub fn measure_adaptive(
     }
     Ok([points[0].clone(), points[1].clone()])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sky_spheres_has_no_glass_no_fuzz_and_a_white_sky() {
+        let desc = sky_spheres();
+        assert!(desc.materials.values().all(|m| match m {
+            MaterialDesc::Metal { fuzz, .. } => *fuzz == 0.0,
+            MaterialDesc::Diffuse { .. } => true,
+            MaterialDesc::Dielectric { .. } => false,
+        }));
+        assert_eq!(
+            desc.background,
+            BackgroundDesc::Solid {
+                color: [1.0, 1.0, 1.0]
+            }
+        );
+        assert_eq!(desc.objects.len(), builtin::cover().objects.len());
+    }
+
+    #[test]
+    fn adaptive_measurement_takes_fewer_samples_and_measures_errors() {
+        let mut desc = sky_spheres();
+        desc.render.width = 32;
+        desc.render.height = Some(18);
+        desc.render.sampler = Sampling::Sobol;
+        let [adaptive, full] = measure_adaptive(&desc, 0.2, 64).unwrap();
+        assert_eq!(full.samples, 32 * 18 * 64);
+        assert!(adaptive.samples < full.samples, "{adaptive:?}");
+        for p in [&adaptive, &full] {
+            assert!(p.rms_error > 0.0 && p.rms_error.is_finite(), "{p:?}");
+            assert!(p.p95_error >= 0.0 && p.p95_error <= 10.0 * p.rms_error + 1.0);
+        }
+    }
+
+    #[test]
+    fn variance_between_two_films_is_half_their_mean_squared_difference() {
+        let a = Film::from_raw(2, 1, vec![[1.0; 3], [0.0; 3]], vec![1, 1]).unwrap();
+        let b = Film::from_raw(2, 1, vec![[3.0; 3], [0.0; 3]], vec![1, 1]).unwrap();
+        // Differences 2, 2, 2, 0, 0, 0: mean square 2, half of it 1.
+        assert_eq!(variance_between(&a, &b), 1.0);
+    }
+}
