@@ -187,3 +187,17 @@ fn serde_derive_and_the_scene_reader_agree_on_every_example() {
     }
     assert!(checked > BUILTINS.len());
 }
+
+/// The peers render `scripts/peers/spheres-scene.toml`; lumen's efficiency
+/// benchmark renders `sky_spheres()`: they must be the same scene.
+#[test]
+fn the_peers_spheres_scene_is_the_efficiency_workload() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peers/spheres-scene.toml");
+    let mut file = SceneFile::read(&path).unwrap().desc;
+    let mut ours = lumen::bench::efficiency::sky_spheres();
+    file.caption.clear();
+    ours.caption.clear();
+    ours.render.samples_per_pixel = file.render.samples_per_pixel;
+    ours.render.aspect_ratio = file.render.aspect_ratio;
+    assert_eq!(file, ours);
+}

@@ -18,7 +18,8 @@ The scene (must match lumen's bench scene exactly):
 - camera: perspective from (0, 8, 22) to (0, 4.5, 0), up +y, vertical field of
   view 40 degrees, 400 x 400, box pixel filter (lumen averages samples
   uniformly over the pixel's area).
-- integrator: `path`, max_depth 8, no Russian roulette.
+- integrator: `path`, max_depth 8, no Russian roulette (default; `--rr-depth 5`
+  is Mitsuba's own default).
 
 Depth convention. Mitsuba's documentation of `max_depth` (path integrator,
 and `Integrator::m_max_depth` in mitsuba/render/integrator.h): "A value of 1
@@ -32,6 +33,11 @@ most 8 ray segments, so the same number (8) is used here.
 `--check-depth` verifies the max_depth 1 end of it on the rendered scene.
 
 Russian roulette starts at `rr_depth`; setting it above max_depth turns it off.
+Samplers: independent, stratified, multijitter (both jittered), ldsampler.
+
+`--seeds A B --out-template DIR/x-{seed}.pfm` (used by efficiency.sh): build
+the scene, render once at A to warm up, then time one render per seed and
+write each image; one JSON line with the times and load averages.
 
 Output: `--out FILE.exr` writes the linear RGB float32 image (no tonemapping);
 `.pfm` is accepted too. `--time` builds the scene once, renders once to warm up
@@ -162,7 +168,7 @@ def read_glb(path):
 
 def build_scene(mi, mesh_path, sampler="independent", spp=16, seed=0,
                 floor_albedo=FLOOR_ALBEDO, max_depth=MAX_DEPTH, samples_per_pass=None,
-                verbose=True):
+                verbose=True, rr_depth=None):
     ScalarTransform4f = mi.ScalarTransform4f
     pos, tri = read_glb(mesh_path)
     lo, hi = pos.min(axis=0), pos.max(axis=0)
@@ -187,7 +193,9 @@ def build_scene(mi, mesh_path, sampler="independent", spp=16, seed=0,
     params.update()
     assert mesh.face_count() == len(tri) and mesh.vertex_count() == len(pos)
 
-    integrator = {"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100}
+    # rr_depth None: Russian roulette off (it starts above max_depth), as in lumen.
+    integrator = {"type": "path", "max_depth": max_depth,
+                  "rr_depth": max_depth + 100 if rr_depth is None else rr_depth}
     if samples_per_pass:
         integrator["samples_per_pass"] = samples_per_pass
     if sampler == "stratified" or sampler == "multijitter":
@@ -244,13 +252,51 @@ def write_image(mi, img, out):
     os.replace(tmp, out)
 
 
+def efficiency_mode(mi, dr, args, rr_depth, spp_pass):
+    """--seeds: build once, warm up at the first seed, time one render per
+    seed, write each image to --out-template; print one JSON line."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import peerlib
+    if not args.out_template or "{seed}" not in args.out_template:
+        print("mitsuba_bunny.py: --seeds needs --out-template with {seed}", file=sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    scene, ntri = build_scene(mi, args.mesh, args.sampler, args.spp, args.seeds[0],
+                              args.floor_albedo, args.max_depth, spp_pass, rr_depth=rr_depth)
+    t_build = time.perf_counter() - t0
+
+    def render(seed):
+        img = mi.render(scene, seed=seed)
+        dr.eval(img)
+        dr.sync_thread()
+        return img
+
+    result = {"renderer": "mitsuba", "version": mi.__version__, "variant": mi.variant(),
+              "scene": "bunny", "mesh": Path(args.mesh).name, "triangles": ntri,
+              "width": WIDTH, "height": HEIGHT,
+              "spp": scene.sensors()[0].sampler().sample_count(), "max_depth": args.max_depth,
+              "sampler": args.sampler, "rr_depth": args.rr_depth, "threads": dr.thread_count(),
+              "build_s": round(t_build, 3)}
+    result.update(peerlib.timed_renders(
+        render, args.seeds, lambda seed, img: write_image(mi, img, args.out_template.format(seed=seed))))
+    print(json.dumps(result))
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("mesh", nargs="?", default=str(REPO_ROOT / "assets" / "bunny_235k.glb"),
                     help="binary glTF mesh (default: assets/bunny_235k.glb of the repo)")
     ap.add_argument("--spp", type=int, default=16, help="samples per pixel (default 16)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--sampler", choices=["independent", "stratified", "multijitter"], default="independent")
+    ap.add_argument("--sampler", choices=["independent", "stratified", "multijitter", "ldsampler"],
+                    default="independent")
+    ap.add_argument("--rr-depth", default="off",
+                    help="Russian roulette from this depth (Mitsuba's default: 5); 'off' (default)")
+    ap.add_argument("--seeds", type=int, nargs="+",
+                    help="efficiency mode: warm up, then time one render per seed, writing "
+                         "--out-template (see efficiency.sh)")
+    ap.add_argument("--out-template", help="with --seeds: image path with {seed}, e.g. /tmp/m-{seed}.pfm")
     ap.add_argument("--threads", type=int, default=0, help="Mitsuba worker threads (default: all cores)")
     ap.add_argument("--out", help="output image, .exr (linear float RGB) or .pfm")
     ap.add_argument("--time", action="store_true", help="warm up, then time --runs renders")
@@ -292,9 +338,13 @@ def main(argv=None):
         print(json.dumps({"check_depth": "ok" if ok else "fail", "values": vals.tolist()[:10]}))
         return 0 if ok else 1
 
+    rr_depth = None if args.rr_depth == "off" else int(args.rr_depth)
+    if args.seeds:
+        return efficiency_mode(mi, dr, args, rr_depth, spp_pass)
+
     t0 = time.perf_counter()
     scene, ntri = build_scene(mi, args.mesh, args.sampler, args.spp, args.seed,
-                              args.floor_albedo, args.max_depth, spp_pass)
+                              args.floor_albedo, args.max_depth, spp_pass, rr_depth=rr_depth)
     t_build = time.perf_counter() - t0
     spp_used = scene.sensors()[0].sampler().sample_count()
     if spp_used != args.spp:  # `stratified` rounds up to a square
@@ -319,7 +369,7 @@ def main(argv=None):
         "renderer": "mitsuba", "mitsuba": mi.__version__, "drjit": dr.__version__,
         "variant": mi.variant(), "mesh": Path(args.mesh).name, "triangles": ntri,
         "width": WIDTH, "height": HEIGHT, "spp": args.spp, "max_depth": args.max_depth,
-        "sampler": args.sampler, "samples_per_pass": spp_pass, "seed": args.seed,
+        "sampler": args.sampler, "rr_depth": args.rr_depth, "samples_per_pass": spp_pass, "seed": args.seed,
         "threads": dr.thread_count(), "machine_threads": os.cpu_count(),
         "build_s": round(t_build, 3), "first_render_s": round(t_first, 3),
     }

@@ -1,0 +1,138 @@
+"""Helpers shared by the peer-renderer scripts (Mitsuba 3 and Cycles).
+
+Pure Python + numpy, so it imports in either venv (scripts/peers/setup.sh,
+scripts/peers/setup_cycles.sh) and in a plain Python with numpy.
+
+- read_lumen_scene(path): a lumen TOML scene (docs/scene-format.md) as a dict,
+  with the defaults the peer scripts rely on filled in and checked.
+- write_pfm(path, rgb): linear float RGB image, top row first in `rgb`.
+- timed_renders(render, seeds, ...): the timing protocol of the efficiency
+  measurements (one warm-up render, then one timed render per seed).
+"""
+
+import json
+import math
+import os
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+
+# ------------------------------------------------------------------ scene
+def read_lumen_scene(path):
+    """The lumen scene at `path` (TOML), with camera/render defaults filled.
+
+    Only what the peer scripts support is accepted: a solid background,
+    diffuse (lambertian, scale) and metal materials, sphere objects.
+    """
+    scene = tomllib.loads(Path(path).read_text())
+    r = scene.setdefault("render", {})
+    r.setdefault("width", 400)
+    if "height" not in r:
+        r["height"] = max(1, int(r["width"] / r.get("aspect_ratio", 16 / 9)))
+    r.setdefault("samples_per_pixel", 100)
+    r.setdefault("max_depth", 50)
+    r.setdefault("seed", 0)
+    c = scene.setdefault("camera", {})
+    c.setdefault("vfov", 90.0)
+    c.setdefault("lookfrom", [0.0, 0.0, 0.0])
+    c.setdefault("lookat", [0.0, 0.0, -1.0])
+    c.setdefault("vup", [0.0, 1.0, 0.0])
+    if c.get("defocus_angle", 0.0) != 0.0:
+        raise ValueError(f"{path}: only a pinhole camera (defocus_angle 0) is supported")
+    bg = scene.get("background", {})
+    if bg.get("type") != "solid":
+        raise ValueError(f"{path}: only a solid background is supported")
+    for name, m in scene.get("materials", {}).items():
+        if m["type"] == "diffuse":
+            if m.get("bounce", "lambertian") != "lambertian" or m.get("attenuation", "scale") != "scale":
+                raise ValueError(f"{path}: material {name}: only lambertian/scale diffuse")
+        elif m["type"] == "metal":
+            if m.get("fuzz", 0.0) != 0.0:
+                raise ValueError(f"{path}: material {name}: only mirrors (fuzz 0)")
+        else:
+            raise ValueError(f"{path}: material {name}: type {m['type']} not supported")
+    for i, o in enumerate(scene.get("objects", [])):
+        if o["type"] != "sphere":
+            raise ValueError(f"{path}: objects[{i}]: only spheres are supported")
+    return scene
+
+
+# ----------------------------------------------------------------- images
+def write_pfm(path, rgb):
+    """Write H x W x 3 linear float RGB (row 0 = top) as a PFM file, atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    a = np.asarray(rgb, dtype=np.float32)[:, :, :3]
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as f:
+        f.write(f"PF\n{a.shape[1]} {a.shape[0]}\n-1.0\n".encode())
+        f.write(np.ascontiguousarray(a[::-1]).astype("<f4").tobytes())  # PFM: bottom row first
+    os.replace(tmp, path)
+
+
+def loadavg():
+    """The 1-, 5- and 15-minute load averages (/proc/loadavg)."""
+    return [round(x, 2) for x in os.getloadavg()]
+
+
+# ----------------------------------------------------------------- timing
+def timed_renders(render, seeds, save=None, warmup=True, log=sys.stderr):
+    """Time one render per seed, after a warm-up render.
+
+    `render(seed)` renders and returns the image (it must block until the
+    image is finished); `save(seed, image)`, if given, writes it (not timed).
+    The warm-up render (first seed) absorbs scene upload, kernel compilation
+    and caches; it is not counted. Returns a dict with the per-seed wall and
+    CPU seconds (this process, all threads) and the load averages at the
+    start and end.
+    """
+    out = {"loadavg_start": loadavg()}
+    if warmup:
+        t0 = time.perf_counter()
+        render(seeds[0])
+        out["warmup_s"] = round(time.perf_counter() - t0, 3)
+        print(f"warm-up render (seed {seeds[0]}): {out['warmup_s']:.3f} s", file=log)
+    times, cpus = [], []
+    for s in seeds:
+        c0, t0 = time.process_time(), time.perf_counter()
+        img = render(s)
+        times.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+        print(f"seed {s}: {times[-1]:.3f} s, {cpus[-1]:.3f} CPU-s", file=log)
+        if save:
+            save(s, img)
+    out.update(seeds=list(seeds), times_s=[round(t, 4) for t in times],
+               cpu_s=[round(t, 3) for t in cpus],
+               mean_s=round(sum(times) / len(times), 4), loadavg_end=loadavg())
+    return out
+
+
+def print_json(d):
+    print(json.dumps(d), flush=True)
+
+
+def camera_basis(cam):
+    """lumen's camera frame: (eye, w, u, v) with w pointing backwards
+    (eye - lookat), u right, v up; numpy float64 vectors."""
+    eye = np.array(cam["lookfrom"], float)
+    at = np.array(cam["lookat"], float)
+    up = np.array(cam["vup"], float)
+    w = eye - at
+    w /= np.linalg.norm(w)
+    u = np.cross(up, w)
+    u /= np.linalg.norm(u)
+    v = np.cross(w, u)
+    return eye, w, u, v
+
+
+def rgb(x):
+    """A colour triple from a number or a list."""
+    if isinstance(x, (int, float)):
+        return [float(x)] * 3
+    if len(x) != 3 or not all(math.isfinite(float(c)) for c in x):
+        raise ValueError(f"bad colour {x!r}")
+    return [float(c) for c in x]
