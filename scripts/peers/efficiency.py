@@ -30,30 +30,12 @@ from pathlib import Path
 import numpy as np
 
 
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        if kind not in (b"PF", b"Pf"):
-            raise ValueError(f"{path}: not a PFM file")
-        dims = f.readline().split()
-        while len(dims) < 2:
-            dims += f.readline().split()
-        w, h = int(dims[0]), int(dims[1])
-        scale = float(f.readline())
-        dt = "<f4" if scale < 0 else ">f4"
-        n = 3 if kind == b"PF" else 1
-        a = np.frombuffer(f.read(w * h * n * 4), dt).astype(np.float64).reshape(h, w, n)
-    a = a[::-1]  # PFM stores the bottom row first
-    return np.repeat(a, 3, axis=2) if n == 1 else a
-
-
 def read_image(path):
-    if str(path).lower().endswith(".pfm"):
-        return read_pfm(path)
-    import mitsuba as mi  # .exr: through Mitsuba's Bitmap (scripts/peers/setup.sh venv)
-    if not mi.variant():
-        mi.set_variant("scalar_rgb")
-    return np.asarray(mi.Bitmap(str(path)), dtype=np.float64)[:, :, :3]
+    """Linear RGB of a .pfm or .exr image: compare.py's reader."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from compare import read_image as read
+
+    return read(str(path))
 
 
 def variance(a, b):
