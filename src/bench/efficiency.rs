@@ -6,7 +6,7 @@
 //! per-pixel variance of one render (A and B are independent estimates of
 //! the same image), and the time is the median time of a render.
 
-use super::{measure_scene, BUNNY_235K};
+use super::{time_renders, BUNNY_235K};
 use crate::film::Film;
 use crate::render::render;
 use crate::scene::builtin;
@@ -69,7 +69,8 @@ impl Efficiency {
 }
 
 /// Renders `desc` with `sampler` at `spp`, with seeds 1 and 2, each `runs`
-/// times after a warm-up, and returns its efficiency.
+/// times after a warm-up (whose image gives the variance), and returns its
+/// efficiency.
 pub fn measure(
     desc: &SceneDesc,
     sampler: Sampling,
@@ -84,8 +85,9 @@ pub fn measure(
         desc.render.samples_per_pixel = spp;
         desc.render.seed = seed;
         let scene = Scene::from_desc(&desc)?;
-        times.extend(measure_scene("efficiency", &scene, runs).runs);
+        // The warm-up render's film is the seed's image.
         films.push(render(&scene, &|_| {}).0);
+        times.extend(time_renders(&scene, runs).0);
     }
     times.sort();
     Ok(Efficiency {
@@ -149,10 +151,7 @@ pub fn measure_adaptive(
     let mut points = Vec::new();
     for noise_target in [Some(target), None] {
         desc.render.noise_target = noise_target;
-        let mut session = Session::new(&desc).map_err(|e| match e {
-            crate::progressive::SessionError::Scene(e) => e,
-            other => unreachable!("a new session reads no checkpoint: {other}"),
-        })?;
+        let mut session = Session::with_scene(&desc, Scene::from_desc(&desc)?);
         let start = Instant::now();
         session
             .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {

@@ -213,14 +213,7 @@ pub fn measure(workload: &Workload, runs: usize) -> Result<Measurement, SceneErr
 /// Renders `scene` `runs` times (after one warm-up) and takes the median time.
 pub fn measure_scene(name: &'static str, scene: &Scene, runs: usize) -> Measurement {
     let _ = render(scene, &|_| {});
-    let mut times = Vec::with_capacity(runs);
-    let mut stats = RenderStats::default();
-    for _ in 0..runs.max(1) {
-        let start = Instant::now();
-        let (_, s) = render(scene, &|_| {});
-        times.push(start.elapsed());
-        stats = s;
-    }
+    let (times, stats) = time_renders(scene, runs);
     let mut sorted = times.clone();
     sorted.sort();
     Measurement {
@@ -229,6 +222,20 @@ pub fn measure_scene(name: &'static str, scene: &Scene, runs: usize) -> Measurem
         median: sorted[sorted.len() / 2],
         runs: times,
     }
+}
+
+/// Renders `scene` `runs` times (at least once): each run's time, in run
+/// order, and the counts of one run (identical in every run).
+pub fn time_renders(scene: &Scene, runs: usize) -> (Vec<Duration>, RenderStats) {
+    let mut times = Vec::with_capacity(runs);
+    let mut stats = RenderStats::default();
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let (_, s) = render(scene, &|_| {});
+        times.push(start.elapsed());
+        stats = s;
+    }
+    (times, stats)
 }
 
 /// Seed of the sphere fields' layout.

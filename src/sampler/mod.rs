@@ -82,11 +82,17 @@ pub trait Sampler {
     fn get_2d(&mut self, dim: Dim) -> [f32; 2];
     /// A uniform integer below `n` (> 0) for `dim`.
     fn get_below(&mut self, dim: Dim, n: u32) -> u32 {
-        ((self.get_1d(dim) * n as f32) as u32).min(n - 1)
+        below(self.get_1d(dim), n)
     }
     /// Marks the start of bounce `bounce` (0 at the first surface a camera
     /// ray meets): the dimensions drawn next are that bounce's.
     fn start_bounce(&mut self, bounce: u32);
+}
+
+/// `u` in [0, 1) scaled to an integer below `n`.
+#[inline(always)]
+fn below(u: f32, n: u32) -> u32 {
+    ((u * n as f32) as u32).min(n - 1)
 }
 
 /// A generator is an independent sampler: numbers in call order.
@@ -141,9 +147,14 @@ impl PixelSampler {
     /// offset in [-0.5, 0.5)² from the pixel's centre (drawn first).
     #[inline(always)]
     pub fn start(&self, index: u32) -> (PixelSample, (f32, f32)) {
+        let sobol = self.kind == SamplerKind::Sobol;
         let mut sample = PixelSample {
-            rng: Rng::for_sample(self.seed, self.pixel, u64::from(index)),
-            sobol: self.kind == SamplerKind::Sobol,
+            rng: if sobol {
+                Rng::placeholder()
+            } else {
+                Rng::for_sample(self.seed, self.pixel, u64::from(index))
+            },
+            sobol,
             key: self.key,
             index,
             bounce: 0,
@@ -172,7 +183,8 @@ impl PixelSampler {
 /// The sampler of one camera sample of a render (see [`PixelSampler`]).
 #[derive(Clone, Debug)]
 pub struct PixelSample {
-    /// The independent stream (unused by Sobol samples).
+    /// The independent stream (not seeded for Sobol samples, which never
+    /// draw from it).
     rng: Rng,
     sobol: bool,
     /// The pixel's scrambling seed.
@@ -225,7 +237,7 @@ impl Sampler for PixelSample {
             let seed = self.dimension_seed(dim);
             sobol::to_unit(sobol::sample_1d(self.index, seed))
         } else {
-            self.rng.next_f32()
+            self.rng.get_1d(dim)
         }
     }
 
@@ -242,10 +254,9 @@ impl Sampler for PixelSample {
     #[inline(always)]
     fn get_below(&mut self, dim: Dim, n: u32) -> u32 {
         if self.sobol {
-            let u = self.get_1d(dim);
-            ((u * n as f32) as u32).min(n - 1)
+            below(self.get_1d(dim), n)
         } else {
-            self.rng.next_u32() % n
+            self.rng.get_below(dim, n)
         }
     }
 
