@@ -85,7 +85,9 @@ pub fn bounce_direction(model: BounceModel, normal: Vec3, sampler: &mut impl Sam
     let d = match model {
         BounceModel::Cube => normal + sampling::on_cube_surface(sampler),
         BounceModel::SphereVolume => normal + sampling::in_unit_sphere(sampler),
-        BounceModel::Lambertian => normal + sampling::unit_vector(sampler.get_2d(Dim::Bsdf)),
+        BounceModel::Lambertian => {
+            normal + sampling::unit_vector_around(sampler.get_2d(Dim::Bsdf), normal)
+        }
         BounceModel::Hemisphere => sampling::on_hemisphere(sampler.get_2d(Dim::Bsdf), normal),
     };
     // A sample opposite the normal cancels it. For N + u with unit u, the exact
