@@ -4,6 +4,7 @@
 
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
+use crate::material::Material;
 use crate::math::{Color, Interval};
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -44,9 +45,10 @@ enum Step {
 }
 
 /// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
-/// `hit` (or nothing, and the background lights it). The surface's material
-/// absorbs the path or scatters it (bounce `depth`), multiplying
-/// `throughput` by its attenuation.
+/// `hit` (or nothing, and the background lights it). The surface's emission,
+/// seen through `throughput`, is added to `radiance`; its material absorbs
+/// the path or scatters it (bounce `depth`), multiplying `throughput` by its
+/// attenuation.
 #[inline(always)]
 fn step(
     scene: &Scene,
@@ -54,20 +56,24 @@ fn step(
     hit: Option<Hit>,
     depth: u32,
     throughput: &mut Color,
+    radiance: &mut Color,
     sampler: &mut impl Sampler,
 ) -> Step {
     let Some(hit) = hit else {
-        return Step::Done(*throughput * scene.background.color(ray.direction));
+        return Step::Done(*radiance + *throughput * scene.background.color(ray.direction));
     };
     let hit = scene.record(ray, hit);
     let material = &scene.materials[hit.material as usize];
+    if let Material::Emissive(light) = material {
+        return Step::Done(*radiance + *throughput * light.emitted(&hit));
+    }
     sampler.start_bounce(depth);
     let Some(scatter) = material.scatter(ray.direction, &hit, sampler) else {
-        return Step::Done(Color::ZERO);
+        return Step::Done(*radiance);
     };
     *throughput *= scatter.attenuation;
     if *throughput == Color::ZERO {
-        return Step::Done(Color::ZERO);
+        return Step::Done(*radiance);
     }
     Step::Continue(Ray::new(
         hit.spawn_origin(scatter.direction),
@@ -77,8 +83,9 @@ fn step(
 
 /// Path tracing: the ray bounces from surface to surface, each bounce
 /// multiplying its colour by the surface's attenuation, until it escapes to
-/// the background (which lights it), is absorbed (black), or reaches
-/// `max_depth` segments (black: it never found light in time).
+/// the background (which lights it), meets a light (an emissive surface,
+/// which ends it), is absorbed, or reaches `max_depth` segments (it never
+/// found light in time).
 #[inline(always)]
 pub fn trace_path(
     scene: &Scene,
@@ -88,15 +95,24 @@ pub fn trace_path(
 ) -> Color {
     let range = hit_range(scene);
     let mut throughput = Color::ONE;
+    let mut radiance = Color::ZERO;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
         let hit = scene.intersect(&ray, range);
-        match step(scene, &ray, hit, depth, &mut throughput, sampler) {
+        match step(
+            scene,
+            &ray,
+            hit,
+            depth,
+            &mut throughput,
+            &mut radiance,
+            sampler,
+        ) {
             Step::Continue(next) => ray = next,
             Step::Done(colour) => return colour,
         }
     }
-    Color::ZERO
+    radiance
 }
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
@@ -121,8 +137,8 @@ pub fn trace_paths<S: Sampler>(
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
-    // Paths still going after `max_depth` segments stay black.
-    colours.fill(Color::ZERO);
+    // Paths still going after `max_depth` segments keep what they gathered.
+    let mut radiance = [Color::ZERO; PATHS];
     let range = hit_range(scene);
     let mut throughput = [Color::ONE; PATHS];
     let mut hits = [None; PATHS];
@@ -137,7 +153,15 @@ pub fn trace_paths<S: Sampler>(
         for k in 0..n_live {
             let i = live[k] as usize;
             let sampler = &mut samplers[i];
-            match step(scene, &rays[i], hits[i], round, &mut throughput[i], sampler) {
+            match step(
+                scene,
+                &rays[i],
+                hits[i],
+                round,
+                &mut throughput[i],
+                &mut radiance[i],
+                sampler,
+            ) {
                 Step::Continue(next) => {
                     rays[i] = next;
                     live[still] = i as u8;
@@ -150,6 +174,9 @@ pub fn trace_paths<S: Sampler>(
         if n_live == 0 {
             break;
         }
+    }
+    for &i in &live[..n_live] {
+        colours[i as usize] = radiance[i as usize];
     }
 }
 

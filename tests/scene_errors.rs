@@ -534,3 +534,39 @@ fn numbers_too_large_or_small_for_f32_arithmetic() {
     let m = refused(&base_with("width = 32", "width = 32\ngamma = 1e-60"));
     assert_mentions(&m, &["render.gamma", "greater than 0"]);
 }
+
+#[test]
+fn emissive_materials_are_checked_like_the_others() {
+    let lamp = |fields: &str| {
+        base_with(
+            "[materials.glass]",
+            &format!("[materials.lamp]\ntype = \"emissive\"\n{fields}\n\n[materials.glass]"),
+        )
+    };
+    // Line 22 is the lamp's first field.
+    let m = refused(&lamp("radiance = [1, -2, 3]"));
+    assert_mentions(
+        &m,
+        &[
+            "scene.toml:22:12:",
+            "materials.lamp.radiance",
+            "must not be negative",
+        ],
+    );
+    let m = refused(&lamp("two_sided = true"));
+    assert_mentions(&m, &["materials.lamp", "radiance"]);
+    let m = refused(&lamp("radiance = [1, 1, 1]\nalbedo = [0.5, 0.5, 0.5]"));
+    assert_mentions(
+        &m,
+        &[
+            "materials.lamp.albedo",
+            "unknown field `albedo` in an emissive material",
+            "`albedo` belongs to diffuse and metal materials",
+        ],
+    );
+    let m = refused(&lamp("radiance = [1, 1, 1]\ntwo_sided = 2"));
+    assert_mentions(&m, &["materials.lamp.two_sided"]);
+    // Radiance above 1 is a bright light, not a mistake.
+    let file = SceneFile::parse("s.toml", lamp("radiance = [15, 15, 15]"), Format::Toml).unwrap();
+    file.compile(&Overrides::default()).unwrap();
+}

@@ -38,7 +38,7 @@ pub fn sky_spheres() -> SceneDesc {
                 }
             }
             MaterialDesc::Metal { fuzz, .. } => *fuzz = 0.0,
-            MaterialDesc::Diffuse { .. } => {}
+            MaterialDesc::Diffuse { .. } | MaterialDesc::Emissive { .. } => {}
         }
     }
     desc
@@ -189,7 +189,7 @@ mod tests {
         assert!(desc.materials.values().all(|m| match m {
             MaterialDesc::Metal { fuzz, .. } => *fuzz == 0.0,
             MaterialDesc::Diffuse { .. } => true,
-            MaterialDesc::Dielectric { .. } => false,
+            MaterialDesc::Dielectric { .. } | MaterialDesc::Emissive { .. } => false,
         }));
         assert_eq!(
             desc.background,

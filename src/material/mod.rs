@@ -1,14 +1,17 @@
-//! Materials: how a surface turns an incoming ray into a scattered one.
+//! Materials: how a surface turns an incoming ray into a scattered one, and
+//! the light it gives off.
 //!
 //! A closed set of materials dispatched with `match`, so the path loop makes no
 //! virtual calls.
 
 pub mod dielectric;
 pub mod diffuse;
+pub mod emissive;
 pub mod metal;
 
 pub use dielectric::{reflectance, refract, Dielectric};
 pub use diffuse::{Attenuation, BounceModel, Diffuse};
+pub use emissive::Emissive;
 pub use metal::{reflect, Metal};
 
 use crate::geometry::HitRecord;
@@ -24,6 +27,8 @@ pub enum Material {
     Metal(Metal),
     /// Clear refracting material such as glass or water.
     Dielectric(Dielectric),
+    /// A light-emitting surface, which scatters nothing.
+    Emissive(Emissive),
 }
 
 /// The outcome of a ray meeting a surface that does not absorb it.
@@ -49,6 +54,22 @@ impl Material {
             Material::Diffuse(m) => m.scatter(hit, sampler),
             Material::Metal(m) => m.scatter(direction, hit, sampler),
             Material::Dielectric(m) => m.scatter(direction, hit, sampler),
+            Material::Emissive(_) => None,
         }
+    }
+
+    /// The radiance the surface emits at `hit` towards the ray that hit it
+    /// (black for every material but [`Emissive`]).
+    #[inline(always)]
+    pub fn emitted(&self, hit: &HitRecord) -> Color {
+        match self {
+            Material::Emissive(m) => m.emitted(hit),
+            _ => Color::ZERO,
+        }
+    }
+
+    /// Whether the material emits light.
+    pub fn is_emissive(&self) -> bool {
+        matches!(self, Material::Emissive(m) if m.radiance != Color::ZERO)
     }
 }

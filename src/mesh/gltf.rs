@@ -462,8 +462,8 @@ fn convert_mesh(
 
 /// Maps a glTF material: base colour (RGB of `baseColorFactor`), metallic,
 /// roughness, `KHR_materials_ior`, `KHR_materials_transmission`, and
-/// `emissiveFactor` times `KHR_materials_emissive_strength`. Textures are
-/// ignored.
+/// `emissiveFactor` times `KHR_materials_emissive_strength`, and
+/// `doubleSided`. Textures are ignored.
 fn convert_material(m: gltf::Material) -> MeshMaterial {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
@@ -479,5 +479,6 @@ fn convert_material(m: gltf::Material) -> MeshMaterial {
         ior: m.ior().unwrap_or(DEFAULT_IOR),
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
         emission: m.emissive_factor().map(|e| e * strength),
+        double_sided: m.double_sided(),
     }
 }

@@ -24,7 +24,7 @@ mod gltf;
 mod obj;
 mod ply;
 
-use crate::material::{Dielectric, Diffuse, Material, Metal};
+use crate::material::{Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::Color;
 use glam::Mat4;
 use std::fmt;
@@ -147,9 +147,13 @@ pub struct MeshMaterial {
     /// `KHR_materials_transmission`.
     pub transmission: f32,
     /// Emitted radiance (MTL `Ke`; glTF `emissiveFactor` times
-    /// `KHR_materials_emissive_strength`). Kept for the renderer; not yet
-    /// rendered.
+    /// `KHR_materials_emissive_strength`).
     pub emission: [f32; 3],
+    /// Whether the surface is seen, and emits, from both sides (glTF
+    /// `doubleSided`; false for MTL, which has no such notion: its lights
+    /// emit towards the side from which the triangles' corners run
+    /// counter-clockwise).
+    pub double_sided: bool,
 }
 
 impl Default for MeshMaterial {
@@ -162,6 +166,7 @@ impl Default for MeshMaterial {
             ior: DEFAULT_IOR,
             transmission: 0.0,
             emission: [0.0; 3],
+            double_sided: false,
         }
     }
 }
@@ -169,18 +174,30 @@ impl Default for MeshMaterial {
 impl MeshMaterial {
     /// The nearest of lumen's materials:
     ///
-    /// - any transmission (> 0) → [`Dielectric`] with `ior` (1.5 when it is
+    /// - any emission (a channel > 0) → [`Emissive`] with that radiance
+    ///   (negative, infinite and NaN channels taken as 0), two-sided when the
+    ///   material is double-sided; such a surface emits and reflects
+    ///   nothing;
+    /// - else any transmission (> 0) → [`Dielectric`] with `ior` (1.5 when it is
     ///   not a positive finite number);
     /// - else `metallic` ≥ 0.5 → [`Metal`] with the base colour as albedo and
     ///   fuzz = α = roughness² (for MTL: √(2 / (Ns + 2)), so Ns = 1000 gives
     ///   0.045 and Ns = 0 gives 1);
     /// - else a Lambertian [`Diffuse`] with the base colour as albedo.
     ///
-    /// Colours are clamped to [0, 1] (NaN to 0); emission is not mapped.
+    /// Colours are clamped to [0, 1] (NaN to 0).
     pub fn to_material(&self) -> Material {
         let unit = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
         let albedo = Color::from_array(self.base_color.map(unit));
-        if self.transmission > 0.0 {
+        let radiance = self
+            .emission
+            .map(|x| if x > 0.0 && x.is_finite() { x } else { 0.0 });
+        if radiance.iter().any(|&x| x > 0.0) {
+            Material::Emissive(Emissive {
+                radiance: Color::from_array(radiance),
+                two_sided: self.double_sided,
+            })
+        } else if self.transmission > 0.0 {
             let ior = if self.ior.is_finite() && self.ior > 0.0 {
                 self.ior
             } else {

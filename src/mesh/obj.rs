@@ -475,5 +475,6 @@ fn convert_material(m: &tobj::Material) -> MeshMaterial {
         ior: m.optical_density.unwrap_or(defaults.ior),
         transmission,
         emission: m.emissive.unwrap_or([0.0; 3]),
+        double_sided: false,
     }
 }

@@ -206,7 +206,7 @@ fn normals_and_uvs_are_carried_per_vertex() {
 }
 
 #[test]
-fn mtl_materials_map_to_diffuse_metal_and_glass() {
+fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
     let dir = TempDir::new();
     dir.write(
         "m.mtl",
@@ -237,9 +237,13 @@ fn mtl_materials_map_to_diffuse_metal_and_glass() {
             .to_material()
     };
 
+    // `Ke` makes a light, one-sided (MTL has no two-sided materials).
     assert_eq!(
         mat("red"),
-        Material::Diffuse(Diffuse::lambertian(Color::new(1.0, 0.2, 0.0)))
+        Material::Emissive(Emissive {
+            radiance: Color::new(0.0, 0.0, 4.0),
+            two_sided: false
+        })
     );
     assert_eq!(m.materials[0].emission, [0.0, 0.0, 4.0]);
     match mat("chrome") {
@@ -510,7 +514,7 @@ fn gltf_json(uri: &str, nodes: &str, extra: &str) -> String {
   {extra}
   "nodes": {nodes},
   "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}}]}}],
-  "materials": [{{"name": "steel", "pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.6, 0.7, 1], "metallicFactor": 1, "roughnessFactor": 0.5}}, "emissiveFactor": [0.1, 0.2, 0.3]}}],
+  "materials": [{{"name": "steel", "pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.6, 0.7, 1], "metallicFactor": 1, "roughnessFactor": 0.5}}, "emissiveFactor": [0.1, 0.2, 0.3], "doubleSided": true}}],
   "accessors": [
     {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
     {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}}
@@ -567,8 +571,21 @@ fn gltf_hierarchy_composes_transforms_and_shares_the_mesh() {
     let steel = &m.materials[0];
     assert_eq!(steel.name, "steel");
     assert_eq!(steel.emission, [0.1, 0.2, 0.3]);
+    assert!(steel.double_sided);
+    // It glows, from both sides; without its glow it is a metal.
     assert_eq!(
         steel.to_material(),
+        Material::Emissive(Emissive {
+            radiance: Color::new(0.1, 0.2, 0.3),
+            two_sided: true
+        })
+    );
+    let dark = MeshMaterial {
+        emission: [0.0; 3],
+        ..steel.clone()
+    };
+    assert_eq!(
+        dark.to_material(),
         Material::Metal(Metal {
             albedo: Color::new(0.5, 0.6, 0.7),
             fuzz: 0.25

@@ -6,7 +6,7 @@
 
 use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc,
-    SamplingDesc, SceneDesc, ShadingDesc, Triple,
+    SamplingDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
 };
 use crate::rng::Rng;
 
@@ -80,6 +80,8 @@ scenes! {
     "camera-lookfrom", "A positioned camera: lookfrom (-2, 2, 1), lookat (0, 0, -1), vfov 20" => || positioned(0.0);
     "depth-of-field", "Depth of field: defocus angle 10, focus distance 3.4" => || positioned(10.0);
     "cover", "The cover: a random field of spheres, glass, diffuse and metal" => cover;
+    "quads", "The Next Week: five coloured quads, the sides of an open box, seen from the front" => quads;
+    "cornell-box", "The Next Week: the Cornell box, lit only by its ceiling light (found by chance: noisy)" => cornell_box;
 }
 
 /// Looks up a built-in scene by name.
@@ -112,6 +114,35 @@ impl Builder {
             radius,
             material: material.to_string(),
             transform: Vec::new(),
+        });
+        self
+    }
+
+    fn quad(mut self, corner: Triple, u: Triple, v: Triple, material: &str) -> Self {
+        self.desc.objects.push(ObjectDesc::Quad {
+            corner,
+            u,
+            v,
+            material: material.to_string(),
+            transform: Vec::new(),
+        });
+        self
+    }
+
+    /// A box from the origin to `size`, turned by `degrees` about the y axis
+    /// and then moved by `offset` (the books' `rotate_y` and `translate`).
+    fn turned_box(mut self, size: Triple, degrees: f64, offset: Triple, material: &str) -> Self {
+        self.desc.objects.push(ObjectDesc::Box {
+            min: [0.0; 3],
+            max: size,
+            material: material.to_string(),
+            transform: vec![
+                TransformDesc::Rotate {
+                    axis: [0.0, 1.0, 0.0],
+                    degrees,
+                },
+                TransformDesc::Translate(offset),
+            ],
         });
         self
     }
@@ -421,6 +452,118 @@ pub fn cover_with_grid(half: i32) -> SceneDesc {
             defocus_angle: 0.6,
             focus_dist: Some(10.0),
         })
+        .build()
+}
+
+/// Settings of a figure of *The Next Week*: random samples, gamma 2.
+fn next_week(width: u32, spp: u32, aspect_ratio: f64) -> RenderDesc {
+    RenderDesc {
+        width,
+        aspect_ratio,
+        samples_per_pixel: spp,
+        max_depth: 50,
+        sampler: SamplingDesc::Independent,
+        ..RenderDesc::default()
+    }
+}
+
+/// A pinhole camera.
+fn pinhole(vfov: f64, lookfrom: Triple, lookat: Triple) -> CameraDesc {
+    CameraDesc {
+        vfov,
+        lookfrom,
+        lookat,
+        vup: [0.0, 1.0, 0.0],
+        defocus_angle: 0.0,
+        focus_dist: None,
+    }
+}
+
+fn quads() -> SceneDesc {
+    Builder::new(next_week(400, 100, 1.0))
+        .material("left-red", lambertian([1.0, 0.2, 0.2]))
+        .material("back-green", lambertian([0.2, 1.0, 0.2]))
+        .material("right-blue", lambertian([0.2, 0.2, 1.0]))
+        .material("upper-orange", lambertian([1.0, 0.5, 0.0]))
+        .material("lower-teal", lambertian([0.2, 0.8, 0.8]))
+        .quad(
+            [-3.0, -2.0, 5.0],
+            [0.0, 0.0, -4.0],
+            [0.0, 4.0, 0.0],
+            "left-red",
+        )
+        .quad(
+            [-2.0, -2.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 4.0, 0.0],
+            "back-green",
+        )
+        .quad(
+            [3.0, -2.0, 1.0],
+            [0.0, 0.0, 4.0],
+            [0.0, 4.0, 0.0],
+            "right-blue",
+        )
+        .quad(
+            [-2.0, 3.0, 1.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 0.0, 4.0],
+            "upper-orange",
+        )
+        .quad(
+            [-2.0, -3.0, 5.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 0.0, -4.0],
+            "lower-teal",
+        )
+        .background(BackgroundDesc::Solid {
+            color: [0.7, 0.8, 1.0],
+        })
+        .camera(pinhole(80.0, [0.0, 0.0, 9.0], [0.0; 3]))
+        .build()
+}
+
+/// The Cornell box of *The Next Week*: a 555-unit box, red on the left,
+/// green on the right, a 130 × 105 light of radiance 15 just under the
+/// ceiling (emitting from both sides, as the book's diffuse light does), and
+/// two white boxes turned about their corners.
+pub fn cornell_box() -> SceneDesc {
+    Builder::new(next_week(600, 200, 1.0))
+        .material("red", lambertian([0.65, 0.05, 0.05]))
+        .material("white", lambertian([0.73, 0.73, 0.73]))
+        .material("green", lambertian([0.12, 0.45, 0.15]))
+        .material(
+            "light",
+            MaterialDesc::Emissive {
+                radiance: [15.0; 3],
+                two_sided: true,
+            },
+        )
+        .quad(
+            [555.0, 0.0, 0.0],
+            [0.0, 555.0, 0.0],
+            [0.0, 0.0, 555.0],
+            "green",
+        )
+        .quad([0.0; 3], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "red")
+        .quad(
+            [343.0, 554.0, 332.0],
+            [-130.0, 0.0, 0.0],
+            [0.0, 0.0, -105.0],
+            "light",
+        )
+        .quad([0.0; 3], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white")
+        .quad([555.0; 3], [-555.0, 0.0, 0.0], [0.0, 0.0, -555.0], "white")
+        .quad(
+            [0.0, 0.0, 555.0],
+            [555.0, 0.0, 0.0],
+            [0.0, 555.0, 0.0],
+            "white",
+        )
+        .turned_box([165.0, 330.0, 165.0], 15.0, [265.0, 0.0, 295.0], "white")
+        .turned_box([165.0; 3], -18.0, [130.0, 0.0, 65.0], "white")
+        .background(BackgroundDesc::Solid { color: [0.0; 3] })
+        .camera(pinhole(40.0, [278.0, 278.0, -800.0], [278.0, 278.0, 0.0]))
         .build()
 }
 

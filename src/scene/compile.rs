@@ -13,7 +13,7 @@ use super::{
 use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
-use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Material, Metal};
+use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::{Color, Vec3};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
 use std::collections::HashMap;
@@ -715,6 +715,13 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
                 refract_only: *refract_only,
             })
         }
+        MaterialDesc::Emissive {
+            radiance,
+            two_sided,
+        } => Material::Emissive(Emissive {
+            radiance: color(&format!("{field}.radiance"), *radiance)?,
+            two_sided: *two_sided,
+        }),
     })
 }
 

@@ -539,6 +539,7 @@ enum MaterialKind {
     Diffuse,
     Metal,
     Dielectric,
+    Emissive,
 }
 
 const MATERIALS: &[Kind<MaterialKind>] = &[
@@ -551,6 +552,8 @@ const MATERIALS: &[Kind<MaterialKind>] = &[
             ("fuzz", "metal materials"),
             ("ior", "dielectric materials"),
             ("refract_only", "dielectric materials"),
+            ("radiance", "emissive materials"),
+            ("two_sided", "emissive materials"),
         ],
     },
     Kind {
@@ -563,6 +566,8 @@ const MATERIALS: &[Kind<MaterialKind>] = &[
             ("attenuation", "diffuse materials"),
             ("ior", "dielectric materials"),
             ("refract_only", "dielectric materials"),
+            ("radiance", "emissive materials"),
+            ("two_sided", "emissive materials"),
         ],
     },
     Kind {
@@ -575,6 +580,22 @@ const MATERIALS: &[Kind<MaterialKind>] = &[
             ("fuzz", "metal materials"),
             ("bounce", "diffuse materials"),
             ("attenuation", "diffuse materials"),
+            ("radiance", "emissive materials"),
+            ("two_sided", "emissive materials"),
+        ],
+    },
+    Kind {
+        name: "emissive",
+        kind: MaterialKind::Emissive,
+        what: "an emissive material",
+        fields: &["type", "radiance", "two_sided"],
+        elsewhere: &[
+            ("albedo", "diffuse and metal materials"),
+            ("fuzz", "metal materials"),
+            ("bounce", "diffuse materials"),
+            ("attenuation", "diffuse materials"),
+            ("ior", "dielectric materials"),
+            ("refract_only", "dielectric materials"),
         ],
     },
 ];
@@ -598,6 +619,10 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
         MaterialKind::Dielectric => MaterialDesc::Dielectric {
             ior: t.require("ior", what, float)?,
             refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
+        },
+        MaterialKind::Emissive => MaterialDesc::Emissive {
+            radiance: t.require("radiance", what, triple)?,
+            two_sided: t.optional("two_sided", boolean)?.unwrap_or(false),
         },
     })
 }

@@ -213,6 +213,19 @@ pub enum MaterialDesc {
         #[serde(default)]
         refract_only: bool,
     },
+    /// A light: emits `radiance` and scatters nothing.
+    Emissive {
+        /// Emitted radiance per channel, ≥ 0 (may exceed 1).
+        radiance: Triple,
+        /// Emit from both sides (the book's diffuse light); otherwise only
+        /// from the side the outward normal points to.
+        #[serde(default, skip_serializing_if = "is_false")]
+        two_sided: bool,
+    },
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// Diffuse bounce model (see [`crate::material::BounceModel`]).
