@@ -4,11 +4,13 @@
 
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
+use crate::geometry::HitRecord;
 use crate::material::Material;
-use crate::math::{Color, Interval};
+use crate::math::{Color, Interval, Point3};
 use crate::ray::Ray;
 use crate::sampler::Sampler;
-use crate::scene::{Scene, Shading};
+use crate::scene::{Integrator, Scene, Shading};
+use std::f32::consts::FRAC_1_PI;
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -44,48 +46,156 @@ enum Step {
     Done(Color),
 }
 
+/// A path on its way: what it carries and what it has gathered.
+#[derive(Clone, Copy, Debug)]
+struct PathState {
+    /// The product of the attenuations so far.
+    throughput: Color,
+    /// The light gathered so far, already multiplied by the throughput at
+    /// which it was met.
+    radiance: Color,
+    /// Where the current segment started, when a light was sampled there:
+    /// the point, and the density (per unit solid angle) with which the
+    /// bounce chose the segment's direction. A light this segment meets
+    /// could also have been sampled from there, and counts only for its
+    /// share of the two strategies.
+    sampled_from: Option<(Point3, f32)>,
+    /// Shadow rays traced (for statistics).
+    shadow_rays: u64,
+}
+
+impl PathState {
+    const START: PathState = PathState {
+        throughput: Color::ONE,
+        radiance: Color::ZERO,
+        sampled_from: None,
+        shadow_rays: 0,
+    };
+}
+
+/// The power heuristic (β = 2): the weight of a strategy that chose a
+/// sample with density `a` when another could have chosen it with density
+/// `b`.
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2.is_infinite() {
+        1.0
+    } else {
+        a2 / (a2 + b2)
+    }
+}
+
 /// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
-/// `hit` (or nothing, and the background lights it). The surface's emission,
-/// seen through `throughput`, is added to `radiance`; its material absorbs
-/// the path or scatters it (bounce `depth`), multiplying `throughput` by its
-/// attenuation.
+/// `hit` (or nothing, and the background lights it). The surface's emission
+/// is added to what the path gathered; its material absorbs the path or
+/// scatters it (bounce `depth`), multiplying the throughput by its
+/// attenuation. With the `path` integrator, a Lambertian surface also
+/// samples a light (next-event estimation): a shadow ray towards a point
+/// chosen on it, the light it brings weighted against the chance that the
+/// bounce would have found the same light (multiple importance sampling).
 #[inline(always)]
 fn step(
     scene: &Scene,
     ray: &Ray,
     hit: Option<Hit>,
     depth: u32,
-    throughput: &mut Color,
-    radiance: &mut Color,
+    path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Step {
     let Some(hit) = hit else {
-        return Step::Done(*radiance + *throughput * scene.background.color(ray.direction));
+        return Step::Done(path.radiance + path.throughput * scene.background.color(ray.direction));
     };
-    let hit = scene.record(ray, hit);
-    let material = &scene.materials[hit.material as usize];
+    let record = scene.record(ray, hit);
+    let material = &scene.materials[record.material as usize];
     if let Material::Emissive(light) = material {
-        return Step::Done(*radiance + *throughput * light.emitted(&hit));
+        let mut emitted = path.throughput * light.emitted(&record);
+        if let (Some((from, bsdf_pdf)), Some(i)) = (path.sampled_from, scene.light_of(&hit)) {
+            let outward = if record.front_face {
+                record.normal
+            } else {
+                -record.normal
+            };
+            let light_pdf = scene.lights.pdf(i, from, record.point, outward);
+            emitted *= power_heuristic(bsdf_pdf, light_pdf);
+        }
+        return Step::Done(path.radiance + emitted);
     }
     sampler.start_bounce(depth);
-    let Some(scatter) = material.scatter(ray.direction, &hit, sampler) else {
-        return Step::Done(*radiance);
+    let lambertian = match material {
+        Material::Diffuse(d) if samples_lights(scene, depth) && d.is_lambertian() => Some(d.albedo),
+        _ => None,
     };
-    *throughput *= scatter.attenuation;
-    if *throughput == Color::ZERO {
-        return Step::Done(*radiance);
+    if let Some(albedo) = lambertian {
+        let (light, traced) = direct_light(scene, &record, albedo, sampler);
+        path.radiance += path.throughput * light;
+        path.shadow_rays += u64::from(traced);
+    }
+    let Some(scatter) = material.scatter(ray.direction, &record, sampler) else {
+        return Step::Done(path.radiance);
+    };
+    path.sampled_from = lambertian.map(|_| {
+        let cos = record.shading_normal.dot(scatter.direction).max(0.0);
+        (record.point, cos * FRAC_1_PI)
+    });
+    path.throughput *= scatter.attenuation;
+    if path.throughput == Color::ZERO {
+        return Step::Done(path.radiance);
     }
     Step::Continue(Ray::new(
-        hit.spawn_origin(scatter.direction),
+        record.spawn_origin(scatter.direction),
         scatter.direction,
     ))
+}
+
+/// Whether a bounce at the end of segment `depth` samples a light: with the
+/// `path` integrator, when the scene has lights and the shadow ray (segment
+/// `depth + 1`) is within the path's length.
+#[inline(always)]
+fn samples_lights(scene: &Scene, depth: u32) -> bool {
+    scene.settings.integrator == Integrator::Path
+        && !scene.lights.is_empty()
+        && depth + 1 < scene.settings.max_depth
+}
+
+/// The light arriving at a Lambertian surface of `albedo` from a point
+/// sampled on a light, reflected towards the path, weighted by the power
+/// heuristic against the bounce's own chance of finding it; and whether a
+/// shadow ray was traced.
+#[inline(never)]
+fn direct_light(
+    scene: &Scene,
+    record: &HitRecord,
+    albedo: Color,
+    sampler: &mut impl Sampler,
+) -> (Color, bool) {
+    let Some(sample) = scene.lights.sample(record.point, sampler) else {
+        return (Color::ZERO, false);
+    };
+    let wi = sample.direction;
+    let cos = record.shading_normal.dot(wi);
+    // The light must be on the side the path came from, by the true surface
+    // as well as by the shading normal.
+    if !(cos > 0.0) || record.normal.dot(wi) <= 0.0 || sample.radiance == Color::ZERO {
+        return (Color::ZERO, false);
+    }
+    let shadow = Ray::new(record.spawn_origin(wi), wi);
+    let range = Interval::new(scene.settings.epsilon, sample.distance * (1.0 - 1e-4));
+    if scene.occluded(&shadow, range) {
+        return (Color::ZERO, true);
+    }
+    let bsdf_pdf = cos * FRAC_1_PI;
+    let weight = power_heuristic(sample.pdf, bsdf_pdf);
+    let light = sample.radiance * albedo * (FRAC_1_PI * cos * weight / sample.pdf);
+    (light, true)
 }
 
 /// Path tracing: the ray bounces from surface to surface, each bounce
 /// multiplying its colour by the surface's attenuation, until it escapes to
 /// the background (which lights it), meets a light (an emissive surface,
 /// which ends it), is absorbed, or reaches `max_depth` segments (it never
-/// found light in time).
+/// found light in time). With the `path` integrator each diffuse bounce
+/// also looks for light directly (see [`step`]).
 #[inline(always)]
 pub fn trace_path(
     scene: &Scene,
@@ -94,25 +204,20 @@ pub fn trace_path(
     rays: &mut u64,
 ) -> Color {
     let range = hit_range(scene);
-    let mut throughput = Color::ONE;
-    let mut radiance = Color::ZERO;
+    let mut path = PathState::START;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
         let hit = scene.intersect(&ray, range);
-        match step(
-            scene,
-            &ray,
-            hit,
-            depth,
-            &mut throughput,
-            &mut radiance,
-            sampler,
-        ) {
+        match step(scene, &ray, hit, depth, &mut path, sampler) {
             Step::Continue(next) => ray = next,
-            Step::Done(colour) => return colour,
+            Step::Done(colour) => {
+                *rays += path.shadow_rays;
+                return colour;
+            }
         }
     }
-    radiance
+    *rays += path.shadow_rays;
+    path.radiance
 }
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
@@ -137,10 +242,8 @@ pub fn trace_paths<S: Sampler>(
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
-    // Paths still going after `max_depth` segments keep what they gathered.
-    let mut radiance = [Color::ZERO; PATHS];
     let range = hit_range(scene);
-    let mut throughput = [Color::ONE; PATHS];
+    let mut paths = [PathState::START; PATHS];
     let mut hits = [None; PATHS];
     // The paths still going, in order.
     let mut live: [u8; PATHS] = std::array::from_fn(|i| i as u8);
@@ -153,15 +256,7 @@ pub fn trace_paths<S: Sampler>(
         for k in 0..n_live {
             let i = live[k] as usize;
             let sampler = &mut samplers[i];
-            match step(
-                scene,
-                &rays[i],
-                hits[i],
-                round,
-                &mut throughput[i],
-                &mut radiance[i],
-                sampler,
-            ) {
+            match step(scene, &rays[i], hits[i], round, &mut paths[i], sampler) {
                 Step::Continue(next) => {
                     rays[i] = next;
                     live[still] = i as u8;
@@ -175,9 +270,11 @@ pub fn trace_paths<S: Sampler>(
             break;
         }
     }
+    // Paths still going after `max_depth` segments keep what they gathered.
     for &i in &live[..n_live] {
-        colours[i as usize] = radiance[i as usize];
+        colours[i as usize] = paths[i as usize].radiance;
     }
+    *traced += paths[..n].iter().map(|p| p.shadow_rays).sum::<u64>();
 }
 
 /// Sets `hits[i]` to the hit of `rays[i]` for every path `i` of `live`:

@@ -13,6 +13,7 @@
 //!   intersection kernel exists once.
 //! - [`material`]: diffuse (four bounce models, two attenuation forms),
 //!   metal, dielectric.
+//! - [`light`]: emissive surfaces gathered to be aimed at (next-event estimation).
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampler`]: the numbers behind every random decision of a path
@@ -53,6 +54,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod isa;
 pub mod lanes;
+pub mod light;
 pub mod material;
 pub mod math;
 pub mod mesh;

@@ -35,7 +35,8 @@ fn values(scene: &Scene) -> Vec<(Color, usize)> {
 /// 10 emitting (2, 3, 4) (the camera sees its inside, the back of its
 /// surface), around a sphere of albedo (0.5, 0.25, 0.75) which fills the view
 /// when the camera looks at it (`towards_sphere`); else the camera sees only
-/// the light.
+/// the light. Lights are met only by chance (the `bsdf` integrator), so
+/// that every sample of a pixel has the same value.
 fn enclosure(two_sided: bool, max_depth: u32, sampler: &str, towards_sphere: bool) -> Scene {
     let lookat_z = if towards_sphere { -1 } else { 1 };
     scene(&format!(
@@ -45,6 +46,7 @@ height = 24
 samples_per_pixel = 4
 max_depth = {max_depth}
 sampler = "{sampler}"
+integrator = "bsdf"
 
 [camera]
 vfov = 20

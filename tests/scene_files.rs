@@ -4,7 +4,7 @@
 use lumen::render::render;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::file::{export, Format, SceneFile};
-use lumen::scene::{Overrides, Sampling, Scene};
+use lumen::scene::{Integrator, Overrides, Sampling, Scene};
 use std::path::{Path, PathBuf};
 
 fn examples_dir() -> PathBuf {
@@ -154,6 +154,7 @@ fn overrides_replace_the_files_settings() {
         max_depth: Some(5),
         seed: Some(11),
         sampler: Some(Sampling::Stratified),
+        integrator: Some(Integrator::Bsdf),
         noise_target: Some(0.25),
     };
     let s = file.compile(&o).unwrap().settings;
@@ -162,6 +163,10 @@ fn overrides_replace_the_files_settings() {
     assert_eq!(
         (s.sampler, s.noise_target),
         (Sampling::Stratified, Some(0.25))
+    );
+    assert_eq!(
+        (own.settings.integrator, s.integrator),
+        (Integrator::Path, Integrator::Bsdf)
     );
 }
 

@@ -55,6 +55,15 @@ impl Diffuse {
         }
     }
 
+    /// Whether it scatters exactly as a Lambertian surface does (cosine
+    /// distributed bounces, the albedo applied to every one): the one
+    /// diffuse form whose density the integrator can weigh against a
+    /// light's. The other bounce models and absorption are sampled only.
+    #[inline(always)]
+    pub fn is_lambertian(&self) -> bool {
+        self.bounce == BounceModel::Lambertian && self.attenuation == Attenuation::Scale
+    }
+
     /// Scatters at `hit`; `None` when the ray is absorbed.
     #[inline(always)]
     pub fn scatter(&self, hit: &HitRecord, sampler: &mut impl Sampler) -> Option<Scatter> {

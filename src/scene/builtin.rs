@@ -1,12 +1,12 @@
-//! The built-in scenes: every figure of the notes, in their order, and the
-//! book's cover image.
+//! The built-in scenes: every figure of the notes, in their order, the
+//! book's cover image, and the figures of *The Next Week* that follow it.
 //!
 //! Each scene is a [`SceneDesc`], the same data a scene file holds, so any of
 //! them can be exported and edited.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc,
-    SamplingDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, IntegratorDesc, MaterialDesc,
+    ObjectDesc, RenderDesc, SamplingDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
 };
 use crate::rng::Rng;
 
@@ -17,7 +17,28 @@ pub struct Builtin {
     pub name: &'static str,
     /// One-line caption.
     pub caption: &'static str,
+    /// The book the figure is from.
+    pub book: Book,
     make: fn() -> SceneDesc,
+}
+
+/// The books whose figures are built in, in reading order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Book {
+    /// *Ray Tracing in One Weekend* (the notes).
+    OneWeekend,
+    /// *Ray Tracing: The Next Week*.
+    NextWeek,
+}
+
+impl Book {
+    /// The book's title.
+    pub fn title(self) -> &'static str {
+        match self {
+            Book::OneWeekend => "Ray Tracing in One Weekend",
+            Book::NextWeek => "Ray Tracing: The Next Week",
+        }
+    }
 }
 
 impl Builtin {
@@ -30,15 +51,16 @@ impl Builtin {
 }
 
 macro_rules! scenes {
-    ($( $name:literal, $caption:literal => $make:expr; )*) => {
-        /// Every built-in scene in the order of the notes.
+    ($( $book:ident { $( $name:literal, $caption:literal => $make:expr; )* } )*) => {
+        /// Every built-in scene, book by book, each in the book's order.
         pub const BUILTINS: &[Builtin] = &[
-            $( Builtin { name: $name, caption: $caption, make: $make }, )*
+            $( $( Builtin { name: $name, caption: $caption, book: Book::$book, make: $make }, )* )*
         ];
     };
 }
 
 scenes! {
+  OneWeekend {
     "gradient", "Background only: a vertical lerp from white to sky blue by the ray's y direction" => gradient;
     "hit-sphere", "Hit or miss: red wherever a ray hits the sphere" => hit_sphere;
     "normals-unit", "The unit normal used directly as a colour" => || normals(ShadingDesc::NormalsUnit, false, 1);
@@ -80,8 +102,11 @@ scenes! {
     "camera-lookfrom", "A positioned camera: lookfrom (-2, 2, 1), lookat (0, 0, -1), vfov 20" => || positioned(0.0);
     "depth-of-field", "Depth of field: defocus angle 10, focus distance 3.4" => || positioned(10.0);
     "cover", "The cover: a random field of spheres, glass, diffuse and metal" => cover;
+  }
+  NextWeek {
     "quads", "The Next Week: five coloured quads, the sides of an open box, seen from the front" => quads;
-    "cornell-box", "The Next Week: the Cornell box, lit only by its ceiling light (found by chance: noisy)" => cornell_box;
+    "cornell-box", "The Next Week: the Cornell box, its ceiling light found only by chance (noisy; --integrator path aims at it)" => cornell_box;
+  }
 }
 
 /// Looks up a built-in scene by name.
@@ -528,7 +553,10 @@ fn quads() -> SceneDesc {
 /// ceiling (emitting from both sides, as the book's diffuse light does), and
 /// two white boxes turned about their corners.
 pub fn cornell_box() -> SceneDesc {
-    Builder::new(next_week(600, 200, 1.0))
+    let mut render = next_week(600, 200, 1.0);
+    // The book's estimator: light is found only by the bounces.
+    render.integrator = IntegratorDesc::Bsdf;
+    Builder::new(render)
         .material("red", lambertian([0.65, 0.05, 0.05]))
         .material("white", lambertian([0.73, 0.73, 0.73]))
         .material("green", lambertian([0.12, 0.45, 0.15]))
@@ -581,6 +609,13 @@ mod tests {
         for b in BUILTINS {
             Scene::from_desc(&b.desc()).unwrap_or_else(|e| panic!("{}: {e}", b.name));
         }
+    }
+
+    #[test]
+    fn books_come_in_reading_order() {
+        assert!(BUILTINS.windows(2).all(|w| w[0].book <= w[1].book));
+        assert_eq!(find("cover").unwrap().book, Book::OneWeekend);
+        assert_eq!(find("cornell-box").unwrap().book, Book::NextWeek);
     }
 
     #[test]

@@ -131,6 +131,7 @@ impl Scene {
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
+        let (lights, light_ids) = world.lights(&materials);
         Ok(Scene {
             settings,
             camera,
@@ -139,6 +140,8 @@ impl Scene {
             spheres,
             sources,
             stats,
+            lights,
+            light_ids,
             world,
         })
     }
@@ -664,6 +667,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         max_depth: r.max_depth,
         seed: r.seed,
         sampler: r.sampler,
+        integrator: r.integrator,
         gamma: r.gamma as f32,
         epsilon: r.epsilon as f32,
         shading: r.shading,

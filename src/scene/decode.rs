@@ -9,8 +9,8 @@
 //! users alike.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc,
-    SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, IntegratorDesc, MaterialDesc,
+    ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
 };
 use super::hint;
 use super::source::{Entry, Node, Value};
@@ -356,6 +356,11 @@ const SAMPLERS: &[(&str, SamplingDesc)] = &[
     ("random", SamplingDesc::Independent),
 ];
 
+const INTEGRATORS: &[(&str, IntegratorDesc)] = &[
+    ("path", IntegratorDesc::Path),
+    ("bsdf", IntegratorDesc::Bsdf),
+];
+
 const SHADINGS: &[(&str, ShadingDesc)] = &[
     ("path", ShadingDesc::Path),
     ("hit", ShadingDesc::Hit),
@@ -378,6 +383,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "seed",
             "sampler",
             "sampling",
+            "integrator",
             "noise_target",
             "gamma",
             "epsilon",
@@ -399,6 +405,9 @@ fn render(node: &Node) -> Result<RenderDesc> {
             .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
             .unwrap_or(d.seed),
         sampler: sampler(&t)?.unwrap_or(d.sampler),
+        integrator: t
+            .optional("integrator", |n, p| keyword(n, p, INTEGRATORS))?
+            .unwrap_or(d.integrator),
         noise_target: t.optional("noise_target", float)?,
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
         epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),

@@ -57,6 +57,8 @@ pub struct RenderDesc {
     /// in the pixel first (`sampling` in older scene files).
     #[serde(alias = "sampling")]
     pub sampler: SamplingDesc,
+    /// How paths gather light.
+    pub integrator: IntegratorDesc,
     /// Adaptive sampling: a pixel stops taking samples once its estimated
     /// relative error is at most this; absent, every pixel takes them all.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -79,6 +81,7 @@ impl Default for RenderDesc {
             max_depth: 50,
             seed: 0,
             sampler: SamplingDesc::Sobol,
+            integrator: IntegratorDesc::Path,
             noise_target: None,
             gamma: 2.0,
             epsilon: 0.001,
@@ -104,6 +107,19 @@ pub enum SamplingDesc {
     Center,
     /// Owen-scrambled Sobol points for every decision: the default.
     Sobol,
+}
+
+/// How a path gathers light (see [`crate::integrator`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorDesc {
+    /// At every diffuse bounce, also aim a shadow ray at a light chosen by
+    /// power (next-event estimation), the two estimates weighted by
+    /// multiple importance sampling: the default.
+    #[default]
+    Path,
+    /// Only what the bounces happen to meet (the notes' estimator).
+    Bsdf,
 }
 
 /// What the colour of a camera ray shows.

@@ -16,12 +16,13 @@ use crate::camera::{Camera, CameraError};
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::{HitRecord, RayBundle, Sphere};
+use crate::light::Lights;
 use crate::material::Material;
 use crate::math::{lerp, Color, Interval, Vec3};
 use crate::ray::Ray;
-use desc::{SamplingDesc, ShadingDesc};
+use desc::{IntegratorDesc, SamplingDesc, ShadingDesc};
 use thiserror::Error;
-use world::World;
+use world::{LightIds, World};
 
 /// Largest magnitude of an object's coordinates and radius: the sphere test
 /// squares lengths of this order in `f32` (whose maximum is about 3.4e38).
@@ -114,6 +115,8 @@ fn invalid(field: impl Into<String>, message: impl Into<String>) -> SceneError {
 pub type Shading = ShadingDesc;
 /// Placement of samples within a pixel (see [`desc::SamplingDesc`]).
 pub type Sampling = SamplingDesc;
+/// How paths gather light (see [`desc::IntegratorDesc`]).
+pub type Integrator = IntegratorDesc;
 
 /// What rays that escape the scene see.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,6 +158,8 @@ pub struct Settings {
     pub seed: u64,
     /// Where the render's random numbers come from.
     pub sampler: Sampling,
+    /// How paths gather light.
+    pub integrator: Integrator,
     /// Adaptive sampling: pixels stop once their estimated relative error
     /// is at most this (see [`crate::adaptive`]); `None` samples every pixel
     /// fully.
@@ -185,6 +190,9 @@ pub struct Scene {
     pub sources: Vec<MeshSource>,
     /// Counts of what the scene holds.
     pub stats: SceneStats,
+    /// The emissive surfaces, to be sampled by next-event estimation.
+    pub lights: Lights,
+    light_ids: LightIds,
     world: World,
 }
 
@@ -236,6 +244,13 @@ impl Scene {
     #[inline(always)]
     pub fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
         self.world.record(ray, hit)
+    }
+
+    /// The index in [`Scene::lights`] of the light `hit` met, if it is one
+    /// that can be sampled.
+    #[inline]
+    pub fn light_of(&self, hit: &Hit) -> Option<usize> {
+        self.light_ids.of(hit)
     }
 
     /// Whether `ray` hits anything within `interval` (a shadow ray's
@@ -312,6 +327,8 @@ pub struct Overrides {
     pub seed: Option<u64>,
     /// The sampler.
     pub sampler: Option<Sampling>,
+    /// The integrator.
+    pub integrator: Option<Integrator>,
     /// The noise target of adaptive sampling.
     pub noise_target: Option<f64>,
 }
@@ -339,6 +356,9 @@ impl Overrides {
         }
         if let Some(s) = self.sampler {
             r.sampler = s;
+        }
+        if let Some(i) = self.integrator {
+            r.integrator = i;
         }
         if let Some(t) = self.noise_target {
             r.noise_target = Some(t);

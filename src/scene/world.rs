@@ -12,7 +12,9 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
 use crate::geometry::{Bvh, HitRecord, Instance, Primitive, Quad, Sphere, Triangle};
-use crate::math::{Point3, Vec3};
+use crate::light::{Light, Lights, Shape as LightShape};
+use crate::material::{Emissive, Material};
+use crate::math::{Color, Point3, Vec3};
 use crate::mesh::TriangleMesh;
 use crate::ray::Ray;
 use std::sync::Arc;
@@ -416,5 +418,126 @@ impl World {
             error: inner.error * placed.stretch * 4.0
                 + point.abs().max_element() * self.error_scale,
         }
+    }
+}
+
+/// Where each primitive's light is in the scene's [`Lights`] list.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LightIds {
+    /// Per primitive of the top-level tree: its light, or [`NO_LIGHT`].
+    top: Vec<u32>,
+    /// Per instance: the light of its tree's primitive 0 (primitive k's is
+    /// k further on), or [`NO_LIGHT`] when it holds no light.
+    instance_first: Vec<u32>,
+}
+
+const NO_LIGHT: u32 = u32::MAX;
+
+impl LightIds {
+    /// The light that `hit` met, if it met one that can be sampled.
+    #[inline]
+    pub(crate) fn of(&self, hit: &Hit) -> Option<usize> {
+        let index = hit.index as usize;
+        let id = match self.top.get(index) {
+            Some(&id) => id,
+            None => {
+                let first = *self.instance_first.get(index - self.top.len())?;
+                if first == NO_LIGHT {
+                    return None;
+                }
+                first + hit.sub
+            }
+        };
+        (id != NO_LIGHT).then_some(id as usize)
+    }
+}
+
+impl World {
+    /// Every emissive primitive as a light in world space, and where each
+    /// primitive's light is. A light's radiance and sides are its
+    /// material's; an instance holding any light gets one entry per
+    /// primitive of its tree (black for the others), so that a hit's light
+    /// is found by arithmetic.
+    pub(crate) fn lights(&self, materials: &[Material]) -> (Lights, LightIds) {
+        let emitter = |m: u32| match materials[m as usize] {
+            Material::Emissive(e) if e.radiance != Color::ZERO => Some(e),
+            _ => None,
+        };
+        let mut lights = Vec::new();
+        let mut ids = LightIds::default();
+        let add = |shape: LightShape, e: Emissive, lights: &mut Vec<Light>| {
+            lights.push(Light {
+                shape,
+                radiance: e.radiance,
+                two_sided: e.two_sided,
+            });
+            (lights.len() - 1) as u32
+        };
+        let top = &self.top;
+        for s in &top.spheres {
+            ids.top.push(emitter(s.material).map_or(NO_LIGHT, |e| {
+                let shape = LightShape::Sphere {
+                    center: s.center,
+                    radius: s.radius,
+                };
+                add(shape, e, &mut lights)
+            }));
+        }
+        for (q, material) in &top.quads {
+            ids.top.push(emitter(*material).map_or(NO_LIGHT, |e| {
+                let shape = LightShape::Quad {
+                    corner: q.corner,
+                    u: q.u,
+                    v: q.v,
+                };
+                add(shape, e, &mut lights)
+            }));
+        }
+        for mesh in &top.meshes {
+            for k in 0..mesh.data.triangles.len() {
+                ids.top
+                    .push(emitter(mesh.material(k)).map_or(NO_LIGHT, |e| {
+                        let vertices = mesh.triangle(k).vertices;
+                        add(LightShape::Triangle { vertices }, e, &mut lights)
+                    }));
+            }
+        }
+        for (i, placed) in self.placed.iter().enumerate() {
+            let group = &self.groups[placed.group as usize];
+            let material = |m: u32| emitter(placed.material.unwrap_or(m));
+            let meshes = &group.shapes.meshes;
+            let any = meshes.iter().any(|mesh| {
+                (0..mesh.data.triangles.len()).any(|k| material(mesh.material(k)).is_some())
+            });
+            if !any || !group.shapes.spheres.is_empty() || !group.shapes.quads.is_empty() {
+                ids.instance_first.push(NO_LIGHT);
+                continue;
+            }
+            ids.instance_first.push(lights.len() as u32);
+            let transform = &self.bvh.instances()[i].transform;
+            for mesh in meshes {
+                for k in 0..mesh.data.triangles.len() {
+                    let tri = mesh.triangle(k);
+                    let [a, b, c] = tri.vertices.map(|p| transform.point(p));
+                    // Keep the outward side the hit record's: a mirroring
+                    // transform reverses the corners' order.
+                    let outward = transform.normal(tri.area_normal());
+                    let vertices = if (b - a).cross(c - a).dot(outward) < 0.0 {
+                        [a, c, b]
+                    } else {
+                        [a, b, c]
+                    };
+                    let e = material(mesh.material(k)).unwrap_or(Emissive {
+                        radiance: Color::ZERO,
+                        two_sided: false,
+                    });
+                    add(LightShape::Triangle { vertices }, e, &mut lights);
+                }
+            }
+        }
+        if lights.is_empty() {
+            return (Lights::default(), LightIds::default());
+        }
+        (Lights::new(lights), ids)
     }
 }

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
-use lumen::scene::{Overrides, Sampling};
+use lumen::scene::{Integrator, Overrides, Sampling};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -138,6 +138,25 @@ impl From<SamplerArg> for Sampling {
     }
 }
 
+/// The integrators, as `--integrator` names them.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum IntegratorArg {
+    /// Bounces plus a shadow ray to a light at every diffuse bounce,
+    /// weighted by multiple importance sampling.
+    Path,
+    /// Only the light the bounces happen to meet (the notes' estimator).
+    Bsdf,
+}
+
+impl From<IntegratorArg> for Integrator {
+    fn from(i: IntegratorArg) -> Self {
+        match i {
+            IntegratorArg::Path => Integrator::Path,
+            IntegratorArg::Bsdf => Integrator::Bsdf,
+        }
+    }
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum FormatArg {
     Toml,
@@ -162,6 +181,10 @@ struct SettingArgs {
     /// unless it says otherwise].
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// How paths gather light [default: the scene's; `path` unless it says
+    /// otherwise].
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
     /// Adaptive sampling: stop sampling a pixel once its estimated relative
     /// error is at most this (e.g. 0.01); --spp stays the upper bound.
     #[arg(long, value_name = "ERROR")]
@@ -200,6 +223,7 @@ impl SettingArgs {
             max_depth: self.depth,
             seed: self.seed,
             sampler: self.sampler.map(Sampling::from),
+            integrator: self.integrator.map(Integrator::from),
             noise_target: self.noise_target,
         }
     }

@@ -1,0 +1,191 @@
+use super::*;
+use crate::rng::Rng;
+
+/// Standard errors allowed between an estimate and its expected value.
+const K: f64 = 5.0;
+
+fn light(shape: Shape) -> Light {
+    Light {
+        shape,
+        radiance: Color::ONE,
+        two_sided: true,
+    }
+}
+
+/// Mean and standard error of `f` over `n` samples.
+fn estimate(n: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
+    let (mut s, mut s2) = (0.0, 0.0);
+    for _ in 0..n {
+        let x = f();
+        s += x;
+        s2 += x * x;
+    }
+    let mean = s / n as f64;
+    let var = (s2 / n as f64 - mean * mean).max(0.0);
+    (mean, (var / n as f64).sqrt())
+}
+
+/// Samples `shape` from `from`, checking each sample's density against
+/// [`Lights::pdf`] at the point it reached, and returns the estimate of the
+/// solid angle the light covers, E[1/pdf].
+fn solid_angle_estimate(shape: Shape, from: Point3) -> (f64, f64) {
+    let lights = Lights::new(vec![light(shape)]);
+    let mut rng = Rng::new(17);
+    estimate(200_000, || {
+        let s = lights.sample(from, &mut rng).expect("a sample");
+        let point = from + s.distance * s.direction;
+        let outward = match shape {
+            Shape::Sphere { center, .. } => (point - center).normalize(),
+            Shape::Quad { u, v, .. } => u.cross(v).normalize(),
+            Shape::Triangle {
+                vertices: [a, b, c],
+            } => (b - a).cross(c - a).normalize(),
+        };
+        let pdf = lights.pdf(0, from, point, outward);
+        assert!(
+            (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
+            "pdf {pdf} at the sampled point, sampled with {}",
+            s.pdf
+        );
+        1.0 / f64::from(s.pdf)
+    })
+}
+
+fn assert_close(what: &str, (mean, se): (f64, f64), exact: f64) {
+    assert!(
+        (mean - exact).abs() <= K * se + 1e-6 * exact,
+        "{what}: {mean} ± {se}, expected {exact}"
+    );
+}
+
+#[test]
+fn a_sphere_is_sampled_over_the_solid_angle_of_its_cap() {
+    let (center, radius) = (Vec3::new(0.5, -1.0, 3.0), 1.5);
+    for distance in [1.6f32, 2.0, 5.0, 100.0] {
+        let from = center - Vec3::new(0.6, 0.0, 0.8) * distance;
+        let sin2 = f64::from(radius / distance).powi(2);
+        let exact = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - sin2).sqrt());
+        let e = solid_angle_estimate(Shape::Sphere { center, radius }, from);
+        assert_close(&format!("distance {distance}"), e, exact);
+        // Uniform over the cap, every sample has the same density.
+        assert!(e.1 < 1e-6 * e.0, "{e:?}");
+    }
+}
+
+#[test]
+fn a_sphere_seen_from_inside_is_sampled_by_area() {
+    let (center, radius) = (Vec3::ZERO, 2.0);
+    // From inside a closed surface every direction meets it once.
+    let e = solid_angle_estimate(Shape::Sphere { center, radius }, Vec3::new(0.3, 1.0, -0.5));
+    assert_close("inside", e, 4.0 * std::f64::consts::PI);
+}
+
+#[test]
+fn a_quad_is_sampled_uniformly_by_area() {
+    // A rectangle a × b seen from height h above one corner subtends
+    // atan(ab / (h √(a² + b² + h²))).
+    let (a, b) = (3.0f64, 2.0f64);
+    for h in [0.5f64, 1.0, 4.0] {
+        let shape = Shape::Quad {
+            corner: Vec3::ZERO,
+            u: Vec3::new(a as f32, 0.0, 0.0),
+            v: Vec3::new(0.0, 0.0, b as f32),
+        };
+        let from = Vec3::new(0.0, h as f32, 0.0);
+        let exact = (a * b / (h * (a * a + b * b + h * h).sqrt())).atan();
+        assert_close(
+            &format!("h = {h}"),
+            solid_angle_estimate(shape, from),
+            exact,
+        );
+    }
+}
+
+#[test]
+fn a_triangle_is_sampled_uniformly_by_area() {
+    let vertices = [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.5),
+        Vec3::new(-1.0, 0.2, 1.0),
+    ];
+    let from = Vec3::new(0.1, 0.3, -1.5);
+    // Van Oosterom and Strackee's formula for the solid angle of a triangle.
+    let [r1, r2, r3] = vertices.map(|v| (v - from).as_dvec3());
+    let (l1, l2, l3) = (r1.length(), r2.length(), r3.length());
+    let numerator = r1.dot(r2.cross(r3)).abs();
+    let denominator = l1 * l2 * l3 + r1.dot(r2) * l3 + r1.dot(r3) * l2 + r2.dot(r3) * l1;
+    let exact = 2.0 * numerator.atan2(denominator);
+    let e = solid_angle_estimate(Shape::Triangle { vertices }, from);
+    assert_close("triangle", e, exact);
+}
+
+#[test]
+fn lights_are_chosen_in_proportion_to_their_power() {
+    let quad = |x: f32, side: f32| Shape::Quad {
+        corner: Vec3::new(x, 5.0, 0.0),
+        u: Vec3::new(side, 0.0, 0.0),
+        v: Vec3::new(0.0, 0.0, side),
+    };
+    // Powers 1 : 4 (twice the side) : 0 (black, never chosen) : 2 (one
+    // side, but four times the radiance).
+    let lights = Lights::new(vec![
+        light(quad(0.0, 1.0)),
+        light(quad(5.0, 2.0)),
+        Light {
+            radiance: Color::ZERO,
+            ..light(quad(10.0, 1.0))
+        },
+        Light {
+            radiance: Color::splat(4.0),
+            two_sided: false,
+            ..light(quad(-5.0, 1.0))
+        },
+    ]);
+    assert_eq!(lights.len(), 4);
+    let expected = [1.0 / 7.0, 4.0 / 7.0, 2.0 / 7.0, 0.0];
+    let mut rng = Rng::new(3);
+    let n = 70_000;
+    let mut counts = [0usize; 4];
+    for _ in 0..n {
+        let s = lights.sample(Vec3::ZERO, &mut rng).expect("a sample");
+        // Which light: by the x of the point reached.
+        let x = s.distance * s.direction.x;
+        let i = if x < 0.0 {
+            2
+        } else if x < 2.0 {
+            0
+        } else if x < 8.0 {
+            1
+        } else {
+            3
+        };
+        counts[i] += 1;
+    }
+    for (i, &p) in expected.iter().enumerate() {
+        let f = counts[i] as f64 / n as f64;
+        let se = (p * (1.0 - p) / n as f64).sqrt();
+        assert!((f - p).abs() <= K * se, "light {i}: {f} instead of {p}");
+        assert_eq!(counts[i] == 0, p == 0.0, "light {i}");
+    }
+}
+
+#[test]
+fn a_one_sided_light_sends_nothing_behind_it() {
+    let shape = Shape::Quad {
+        corner: Vec3::new(-1.0, 1.0, -1.0),
+        u: Vec3::new(2.0, 0.0, 0.0),
+        v: Vec3::new(0.0, 0.0, 2.0),
+    };
+    // u × v points down (−y): lit below, dark above.
+    let lights = Lights::new(vec![Light {
+        two_sided: false,
+        ..light(shape)
+    }]);
+    let mut rng = Rng::new(5);
+    for _ in 0..100 {
+        let below = lights.sample(Vec3::ZERO, &mut rng).unwrap();
+        assert_eq!(below.radiance, Color::ONE);
+        let above = lights.sample(Vec3::new(0.0, 2.0, 0.0), &mut rng).unwrap();
+        assert_eq!(above.radiance, Color::ZERO);
+    }
+}
