@@ -1,5 +1,5 @@
 //! The gallery: every built-in scene rendered into one folder, with an
-//! `index.html` that shows them in the order of the notes.
+//! `index.html` that shows them book by book, in each book's order.
 
 use crate::output::{self, OutputError};
 use crate::render::{render, RenderStats};
@@ -63,7 +63,12 @@ pub fn make_gallery(
          figcaption{max-width:400px}img{max-width:400px}\
          </style>\n</head>\n<body>\n<h1>lumen gallery</h1>\n",
     );
+    let mut book = None;
     for (i, (b, scene)) in scenes.iter().enumerate() {
+        if book != Some(b.book) {
+            book = Some(b.book);
+            let _ = writeln!(html, "<h2>{}</h2>", b.book.title());
+        }
         let (film, stats) = render(scene, &|_| {});
         let file = format!("{}.png", b.name);
         output::write_image(&dir.join(&file), &film, scene.settings.gamma)?;

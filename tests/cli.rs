@@ -243,6 +243,19 @@ fn gallery_writes_every_image_and_an_index_in_order() {
             .find(&format!("src=\"{file}\""))
             .unwrap_or_else(|| panic!("{file} not in index.html"));
         assert!(at > last, "{file} out of order in index.html");
+        // Under its book's heading, which comes after the previous book's figures.
+        let heading = index
+            .find(&format!("<h2>{}</h2>", b.book.title()))
+            .unwrap_or_else(|| panic!("no heading for {:?}", b.book));
+        assert!(heading < at, "{file} before its book's heading");
+        assert!(
+            BUILTINS
+                .iter()
+                .filter(|o| o.book < b.book)
+                .all(|o| index.find(&format!("src=\"{}.png\"", o.name)).unwrap() < heading),
+            "{:?}'s heading among the previous book's figures",
+            b.book
+        );
         last = at;
         assert!(index.contains(b.caption), "caption of {}", b.name);
     }
