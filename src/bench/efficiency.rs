@@ -11,7 +11,7 @@ use crate::film::Film;
 use crate::render::render;
 use crate::scene::builtin;
 use crate::scene::desc::{BackgroundDesc, MaterialDesc, SceneDesc};
-use crate::scene::{Sampling, Scene, SceneError};
+use crate::scene::{Integrator, Sampling, Scene, SceneError};
 use std::time::Duration;
 
 /// The spheres of the efficiency benchmark: the cover's field at 400×225
@@ -44,12 +44,30 @@ pub fn sky_spheres() -> SceneDesc {
     desc
 }
 
-/// The efficiency workloads: [`sky_spheres`], and the mesh workload.
+/// The efficiency workloads: [`sky_spheres`], the mesh workload, and the
+/// Cornell box at 300 × 300 (lit by its ceiling light alone).
 pub fn workloads() -> Vec<(&'static str, SceneDesc)> {
+    let mut cornell = builtin::cornell_box();
+    cornell.render.width = 300;
     vec![
         ("sky-spheres-400x225", sky_spheres()),
         ("bunny-235k-400x400", super::bunny_scene(BUNNY_235K)),
+        ("cornell-box-300x300", cornell),
     ]
+}
+
+/// The integrators worth comparing on `desc`: both where it has lights to
+/// sample, else only its own (the two give the same image bits there).
+pub fn integrators(desc: &SceneDesc) -> Vec<Integrator> {
+    let lights = desc
+        .materials
+        .values()
+        .any(|m| matches!(m, MaterialDesc::Emissive { .. }));
+    if lights {
+        vec![Integrator::Path, Integrator::Bsdf]
+    } else {
+        vec![desc.render.integrator]
+    }
 }
 
 /// One workload's efficiency with one sampler.
@@ -182,6 +200,14 @@ pub fn measure_adaptive(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn both_integrators_are_compared_where_there_are_lights() {
+        let all = workloads();
+        let of = |name: &str| integrators(&all.iter().find(|(n, _)| *n == name).unwrap().1);
+        assert_eq!(of("cornell-box-300x300"), [Integrator::Path, Integrator::Bsdf]);
+        assert_eq!(of("sky-spheres-400x225"), [Integrator::Path]);
+    }
 
     #[test]
     fn sky_spheres_has_no_glass_no_fuzz_and_a_white_sky() {

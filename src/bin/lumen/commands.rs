@@ -219,29 +219,38 @@ pub(crate) fn efficiency_command(
         machine()
     )?;
     outln!(
-        "{:<22} {:<12} {:>10} {:>12} {:>12} {:>9}",
+        "{:<22} {:<12} {:<10} {:>10} {:>12} {:>12} {:>9} {:>14}",
         "workload",
         "sampler",
+        "integrator",
         "median s",
         "variance",
         "efficiency",
-        "relative"
+        "relative",
+        "s to rmse 0.01"
     )?;
-    for (name, desc) in workloads {
+    for (name, mut desc) in workloads {
         let mut first = None;
-        for &sampler in samplers {
-            let e = bench::efficiency::measure(&desc, sampler, spp, runs as usize)
-                .map_err(|e| anyhow!("{name}: {e}"))?;
-            let base = *first.get_or_insert(e.efficiency());
-            outln!(
-                "{:<22} {:<12} {:>10.3} {:>12.4e} {:>12.4e} {:>8.2}x",
-                name,
-                format!("{sampler:?}").to_lowercase(),
-                e.seconds,
-                e.variance,
-                e.efficiency(),
-                e.efficiency() / base
-            )?;
+        for integrator in bench::efficiency::integrators(&desc) {
+            desc.render.integrator = integrator;
+            for &sampler in samplers {
+                let e = bench::efficiency::measure(&desc, sampler, spp, runs as usize)
+                    .map_err(|e| anyhow!("{name}: {e}"))?;
+                let base = *first.get_or_insert(e.efficiency());
+                outln!(
+                    "{:<22} {:<12} {:<10} {:>10.3} {:>12.4e} {:>12.4e} {:>8.2}x {:>14.1}",
+                    name,
+                    format!("{sampler:?}").to_lowercase(),
+                    format!("{integrator:?}").to_lowercase(),
+                    e.seconds,
+                    e.variance,
+                    e.efficiency(),
+                    e.efficiency() / base,
+                    // Variance falls as 1/time: reaching a variance of
+                    // 0.01² takes 1 / (efficiency × 0.01²) seconds.
+                    1.0 / (e.efficiency() * 1e-4)
+                )?;
+            }
         }
     }
     Ok(())
