@@ -8,7 +8,7 @@ use crate::geometry::HitRecord;
 use crate::material::Material;
 use crate::math::{Color, Interval, Point3};
 use crate::ray::Ray;
-use crate::sampler::Sampler;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::{Integrator, Scene, Shading};
 use std::f32::consts::FRAC_1_PI;
 
@@ -142,10 +142,32 @@ fn step(
     if path.throughput == Color::ZERO {
         return Step::Done(path.radiance);
     }
+    // Russian roulette: a path whose throughput has fallen below 1 goes on
+    // with that probability, and is counted 1/p times as much when it does.
+    if roulette(scene, depth) {
+        let p = path.throughput.max_element().sqrt();
+        if p < 1.0 {
+            if sampler.get_1d(Dim::Roulette) >= p {
+                return Step::Done(path.radiance);
+            }
+            path.throughput /= p;
+        }
+    }
     Step::Continue(Ray::new(
         record.spawn_origin(scatter.direction),
         scatter.direction,
     ))
+}
+
+/// Bounces from which the `path` integrator plays Russian roulette: the
+/// first ones carry most of the light and are always continued.
+pub const ROULETTE_FROM: u32 = 5;
+
+/// Whether the bounce at the end of segment `depth` plays Russian roulette:
+/// with the `path` integrator, from bounce [`ROULETTE_FROM`] on.
+#[inline(always)]
+fn roulette(scene: &Scene, depth: u32) -> bool {
+    scene.settings.integrator == Integrator::Path && depth >= ROULETTE_FROM
 }
 
 /// Whether a bounce at the end of segment `depth` samples a light: with the

@@ -1,7 +1,8 @@
 //! Next-event estimation with multiple importance sampling (the `path`
 //! integrator) against the notes' estimator (`bsdf`) and exact answers: both
 //! converge to the same image with quad, sphere and (instanced, mirrored)
-//! triangle lights, and the `path` integrator is the less noisy.
+//! triangle lights, and the `path` integrator is the less noisy; its
+//! Russian roulette leaves the image of a scene without lights unchanged.
 //!
 //! Tolerances are K standard errors from each render's own per-pixel sample
 //! variance; seeds are fixed.
@@ -11,9 +12,22 @@ mod common;
 use common::{assert_agree, builtin_desc, compile_file, pixel_stats, scratch_dir, PixelStats, K};
 use lumen::scene::{Integrator, Sampling, Scene};
 
-/// Each 8 × 8 tile of two renders of one view agrees in every channel; the
-/// first (the `path` render) has the smaller standard error over the image.
+/// Each 8 × 8 tile of two renders of one view agrees in every channel, and
+/// the first (the `path` render) has the smaller standard error over the
+/// image.
 fn assert_tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) {
+    let noise = tiles_agree(what, path, bsdf);
+    assert!(
+        noise.0 < noise.1,
+        "{what}: path's tiles are noisier ({} against {})",
+        noise.0,
+        noise.1
+    );
+}
+
+/// Each 8 × 8 tile of two renders of one view agrees in every channel;
+/// returns the sums of the tiles' standard errors of each.
+fn tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) -> (f64, f64) {
     let mut noise = (0.0, 0.0);
     for c in 0..3 {
         for ty in 0..path.height / 8 {
@@ -26,12 +40,7 @@ fn assert_tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) {
             }
         }
     }
-    assert!(
-        noise.0 < noise.1,
-        "{what}: path's tiles are noisier ({} against {})",
-        noise.0,
-        noise.1
-    );
+    noise
 }
 
 /// `text`'s scene rendered with each integrator.
@@ -213,18 +222,98 @@ material = "matte"
 }
 
 #[test]
-fn without_lights_path_and_bsdf_render_the_same_image() {
-    // Nothing to sample: the `path` integrator draws nothing more and gives
-    // the same bits, which keeps every figure of the notes as it was.
-    for name in ["cover", "glass-hollow", "bounce-cube"] {
-        let mut desc = builtin_desc(name, 40, 4, 2);
+fn russian_roulette_keeps_the_image_of_a_scene_without_lights() {
+    // The cover under its sky: glass and metal keep many paths going past
+    // the bounces where the `path` integrator starts its roulette, which
+    // must end them without changing the image.
+    let stats = |integrator| {
+        let mut desc = builtin_desc("cover", 48, 128, 6);
+        desc.render.integrator = integrator;
         desc.render.sampler = Sampling::Sobol;
-        desc.render.integrator = Integrator::Path;
-        let path = Scene::from_desc(&desc).unwrap();
-        desc.render.integrator = Integrator::Bsdf;
-        let bsdf = Scene::from_desc(&desc).unwrap();
-        let render = |s: &Scene| lumen::render::render(s, &|_| {}).0;
-        let (a, b) = (render(&path), render(&bsdf));
-        assert!(a.pixels().eq(b.pixels()), "{name}");
+        pixel_stats(&Scene::from_desc(&desc).unwrap())
+    };
+    let (path, bsdf) = (stats(Integrator::Path), stats(Integrator::Bsdf));
+    tiles_agree("cover", &path, &bsdf);
+    // The roulette did end paths: fewer segments were traced.
+    assert!(
+        path.stats.rays < bsdf.stats.rays,
+        "{} segments with roulette, {} without",
+        path.stats.rays,
+        bsdf.stats.rays
+    );
+}
+
+#[test]
+fn the_figures_keep_the_books_estimator() {
+    // Every built-in figure gathers light as its book does, so that it
+    // renders as it always has.
+    for b in lumen::scene::builtin::BUILTINS {
+        assert_eq!(b.desc().render.integrator, Integrator::Bsdf, "{}", b.name);
     }
+}
+
+#[test]
+fn an_integrating_sphere_reaches_its_analytic_radiance() {
+    // A small ball of light (radius r, radiance Le, one-sided) at the centre
+    // of a closed matte sphere (radius R, albedo a). Light leaving any point
+    // of a sphere's inside towards it is spread evenly over it, and a
+    // fraction f = r²/R² of each bounce's light returns to the ball, which
+    // absorbs it; so the wall's irradiance is Φ / (A (1 − a (1 − f))) with
+    // Φ = Le·π·4πr² and A = 4πR², and its radiance
+    //   L = a Le r² / (R² (1 − a (1 − f))).
+    // Most of it comes after many bounces, past those where the roulette
+    // starts: an unweighted survivor would show at once.
+    let (r, big_r, a, le) = (1.0f64, 10.0f64, 0.9f64, 100.0f64);
+    let f = r * r / (big_r * big_r);
+    let exact = a * le * r * r / (big_r * big_r * (1.0 - a * (1.0 - f)));
+    let dir = scratch_dir("lights-integrating-sphere");
+    let scene = compile_file(
+        &dir,
+        "scene.toml",
+        &format!(
+            r#"[render]
+width = 16
+height = 16
+samples_per_pixel = 256
+max_depth = 400
+
+[camera]
+vfov = 40
+lookfrom = [0, 0, 5]
+lookat = [0, 0, 10]
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.light]
+type = "emissive"
+radiance = [{le}, {le}, {le}]
+
+[materials.wall]
+type = "diffuse"
+albedo = [{a}, {a}, {a}]
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = {r}
+material = "light"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = {big_r}
+material = "wall"
+"#
+        ),
+    );
+    assert_eq!(scene.settings.integrator, Integrator::Path);
+    let stats = pixel_stats(&scene);
+    let (mean, se) = stats.image(1);
+    assert!(
+        (mean - exact).abs() <= K * se,
+        "{mean} ± {se}, expected {exact}"
+    );
+    assert!(se < 0.01 * exact, "too noisy to tell: {se}");
 }

@@ -24,8 +24,8 @@ Translation (the scene read with tomllib, see docs/scene-format.md):
 - solid background: black only (Mitsuba would need a `constant` emitter).
 - camera: `perspective`, fov_axis "y", box pixel filter; `path` integrator
   with max_depth = lumen's (both count ray segments, the camera ray and the
-  shadow ray included) and no Russian roulette (rr_depth above max_depth,
-  as lumen has none).
+  shadow ray included); Russian roulette from depth --rr-depth (Mitsuba's
+  default is 5; "off", the default here, puts it above max_depth).
 
 The scene is built once; one render per seed, as .pfm (linear RGB) for
 compare.py. With --timed, a warm-up render first (kernel compilation not
@@ -98,14 +98,15 @@ def placement(mi, steps):
     return t
 
 
-def build_scene(mi, scene, spp, seed, width, sampler="independent"):
+def build_scene(mi, scene, spp, seed, width, sampler="independent", rr_depth=None):
     r, cam = scene["render"], scene["camera"]
     height = r["height"] * width // r["width"] if width else r["height"]
     width = width or r["width"]
     max_depth = r["max_depth"]
+    rr = max_depth + 100 if rr_depth is None else rr_depth
     d = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": max_depth + 100},
+        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr},
         "sensor": {
             "type": "perspective",
             "fov": float(cam["vfov"]),
@@ -160,6 +161,8 @@ def main(argv=None):
     ap.add_argument("--one-sided", action="store_true", help="make two-sided lights one-sided")
     ap.add_argument("--sampler", choices=["independent", "stratified", "multijitter", "ldsampler"],
                     default="independent")
+    ap.add_argument("--rr-depth", default="off",
+                    help="Russian roulette from this depth (Mitsuba's default: 5); 'off' (default)")
     ap.add_argument("--timed", action="store_true", help="warm up, then time each seed's render")
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args(argv)
@@ -168,7 +171,8 @@ def main(argv=None):
     import drjit as dr
     import mitsuba as mi
     mi.set_variant(args.variant)
-    ms = build_scene(mi, scene, args.spp, args.seeds[0], args.width, args.sampler)
+    rr_depth = None if args.rr_depth == "off" else int(args.rr_depth)
+    ms = build_scene(mi, scene, args.spp, args.seeds[0], args.width, args.sampler, rr_depth)
 
     def render(seed):
         img = mi.render(ms, seed=seed)
@@ -184,7 +188,8 @@ def main(argv=None):
 
     if args.timed:
         result = {"renderer": "mitsuba", "version": mi.__version__, "variant": mi.variant(),
-                  "scene": Path(args.scene).name, "spp": args.spp, "sampler": args.sampler}
+                  "scene": Path(args.scene).name, "spp": args.spp, "sampler": args.sampler,
+                  "rr_depth": args.rr_depth}
         result.update(peerlib.timed_renders(render, args.seeds, save))
         peerlib.print_json(result)
     else:

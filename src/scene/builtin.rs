@@ -188,9 +188,10 @@ impl Builder {
 }
 
 /// Settings of a figure: a single sample goes through the pixel's centre, as
-/// in the notes' figures before antialiasing; more samples are jittered.
+/// in the notes' figures before antialiasing; more samples are jittered;
+/// light is gathered as the notes do (see [`figure`]).
 fn render(spp: u32, gamma: f64) -> RenderDesc {
-    RenderDesc {
+    figure(RenderDesc {
         samples_per_pixel: spp,
         gamma,
         sampler: if spp == 1 {
@@ -199,6 +200,16 @@ fn render(spp: u32, gamma: f64) -> RenderDesc {
             SamplingDesc::Independent
         },
         ..RenderDesc::default()
+    })
+}
+
+/// A figure's settings: the books' estimator, which finds light only where
+/// the bounces meet it and plays no Russian roulette, as their figures were
+/// made.
+fn figure(render: RenderDesc) -> RenderDesc {
+    RenderDesc {
+        integrator: IntegratorDesc::Bsdf,
+        ..render
     }
 }
 
@@ -423,13 +434,13 @@ pub fn cover() -> SceneDesc {
 /// cover itself. Used to measure how cost grows with the number of spheres.
 pub fn cover_with_grid(half: i32) -> SceneDesc {
     let mut rng = Rng::new(COVER_LAYOUT_SEED);
-    let mut b = Builder::new(RenderDesc {
+    let mut b = Builder::new(figure(RenderDesc {
         width: 1200,
         samples_per_pixel: 500,
         max_depth: 50,
         sampler: SamplingDesc::Independent,
         ..RenderDesc::default()
-    })
+    }))
     .material("ground", lambertian([0.5, 0.5, 0.5]))
     .material("glass", glass_material(1.5, false))
     .sphere([0.0, -1000.0, 0.0], 1000.0, "ground");
@@ -482,14 +493,14 @@ pub fn cover_with_grid(half: i32) -> SceneDesc {
 
 /// Settings of a figure of *The Next Week*: random samples, gamma 2.
 fn next_week(width: u32, spp: u32, aspect_ratio: f64) -> RenderDesc {
-    RenderDesc {
+    figure(RenderDesc {
         width,
         aspect_ratio,
         samples_per_pixel: spp,
         max_depth: 50,
         sampler: SamplingDesc::Independent,
         ..RenderDesc::default()
-    }
+    })
 }
 
 /// A pinhole camera.
@@ -553,10 +564,7 @@ fn quads() -> SceneDesc {
 /// ceiling (emitting from both sides, as the book's diffuse light does), and
 /// two white boxes turned about their corners.
 pub fn cornell_box() -> SceneDesc {
-    let mut render = next_week(600, 200, 1.0);
-    // The book's estimator: light is found only by the bounces.
-    render.integrator = IntegratorDesc::Bsdf;
-    Builder::new(render)
+    Builder::new(next_week(600, 200, 1.0))
         .material("red", lambertian([0.65, 0.05, 0.05]))
         .material("white", lambertian([0.73, 0.73, 0.73]))
         .material("green", lambertian([0.12, 0.45, 0.15]))

@@ -231,7 +231,7 @@ pub(crate) fn efficiency_command(
     )?;
     for (name, mut desc) in workloads {
         let mut first = None;
-        for integrator in bench::efficiency::integrators(&desc) {
+        for integrator in bench::efficiency::integrators() {
             desc.render.integrator = integrator;
             for &sampler in samplers {
                 let e = bench::efficiency::measure(&desc, sampler, spp, runs as usize)
