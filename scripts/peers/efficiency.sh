@@ -5,9 +5,11 @@
 #   scripts/peers/efficiency.sh bunny|spheres SPP [CONFIG...]
 #
 # CONFIG (default: all of them):
-#   lumen:SAMPLER                  lumen with --sampler SAMPLER (sobol, independent,
-#                                  stratified; plain "lumen" is independent), no
-#                                  Russian roulette
+#   lumen:SAMPLER[:RR]             lumen with --sampler SAMPLER (sobol, independent,
+#                                  stratified; plain "lumen" is independent); RR off
+#                                  (the default: --integrator bsdf, no Russian
+#                                  roulette) or rr5 (--integrator path: roulette
+#                                  from the fifth bounce)
 #   mitsuba:SAMPLER:RR             SAMPLER independent|multijitter|ldsampler|stratified,
 #                                  RR rr5 (Mitsuba's default rr_depth 5) or off
 #   cycles:PATTERN:RR              PATTERN startup (the bpy startup scene's, Tabulated
@@ -143,13 +145,15 @@ run_config() {
     lumen)
         # lumen's own "time" line: the render passes, without scene loading;
         # CPU seconds: the whole process (scene loading included, so a bound).
-        local times=() cpus=() c0
+        local times=() cpus=() c0 integrator=bsdf
+        rr=${rr:-off}
+        [ "$rr" = rr5 ] && integrator=path
         "$LUMEN" render "$LUMEN_SCENE" -o "$OUT/$tag-warmup.pfm" --spp "$SPP" --seed "$SEED_A" \
-            --sampler "${s:-independent}" --checkpoint-interval 100h >"$log" 2>&1
+            --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h >"$log" 2>&1
         for seed in "$SEED_A" "$SEED_B"; do
             children_cpu_s >"$OUT/.c"; c0=$(cat "$OUT/.c")
             "$LUMEN" render "$LUMEN_SCENE" -o "$OUT/$tag-s$seed.pfm" --spp "$SPP" --seed "$seed" \
-                --sampler "${s:-independent}" --checkpoint-interval 100h >>"$log" 2>&1
+                --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h >>"$log" 2>&1
             children_cpu_s >"$OUT/.c"
             cpus+=("$(awk -v a="$c0" -v b="$(cat "$OUT/.c")" 'BEGIN { printf "%.2f", b - a }')")
             times+=("$(grep -o '^time [0-9.]* s' "$log" | tail -n1 | awk '{print $2}')")
@@ -184,7 +188,7 @@ printf '%-8s %-12s %-4s %-8s %5s %9s %12s %11s %8s %9s %6s %6s %5s %5s\n' \
     renderer sampler rr scene spp s/render variance efficiency cpu-s eff/cpu-s load0 load1 busy0 other
 for c in "${CONFIGS[@]}"; do
     IFS=: read -r r s rr <<<"$c"
-    [[ $r == lumen ]] && { s=${s:-independent}; rr=off; }
+    [[ $r == lumen ]] && { s=${s:-independent}; rr=${rr:-off}; }
     tag="$SCENE-$SPP-$r-$s-$rr"
     for try in $(seq 0 "$RETRIES"); do
         wait_for_low_load
