@@ -303,3 +303,34 @@ fn sampler_and_noise_target_flags_render_and_refuse_bad_values() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("sobol"), "{}", stderr(&out));
 }
+
+#[test]
+fn the_integrator_flag_chooses_how_light_is_found() {
+    let dir = scratch_dir("integrator");
+    let image = |integrator: Option<&str>| {
+        let path = dir.join("c.pfm");
+        let mut args = vec![
+            "render",
+            "cornell-box",
+            "-o",
+            path.to_str().unwrap(),
+            "--width",
+            "32",
+            "--spp",
+            "4",
+        ];
+        if let Some(i) = integrator {
+            args.extend(["--integrator", i]);
+        }
+        let out = lumen(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        std::fs::read(&path).unwrap()
+    };
+    // The figure's own estimator is the book's.
+    assert_eq!(image(None), image(Some("bsdf")));
+    assert_ne!(image(Some("path")), image(Some("bsdf")));
+    let out = lumen(&["render", "cornell-box", "-o", "x.png", "--integrator", "nee"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("path") && err.contains("bsdf"), "{err}");
+}

@@ -317,3 +317,21 @@ material = "wall"
     );
     assert!(se < 0.01 * exact, "too noisy to tell: {se}");
 }
+
+#[test]
+fn black_lights_render_black_without_nan() {
+    // Emissive objects of zero radiance are no lights to sample: the scene
+    // renders, black, with either integrator.
+    let dir = scratch_dir("lights-black");
+    let text = SPHERE_LIGHT
+        .replace("radiance = [12, 10, 8]", "radiance = [0, 0, 0]")
+        .replace("radiance = [1, 2, 3]", "radiance = [0, 0, 0]")
+        .replace("samples_per_pixel = 128", "samples_per_pixel = 4");
+    for integrator in [Integrator::Path, Integrator::Bsdf] {
+        let mut scene = compile_file(&dir, "scene.toml", &text);
+        scene.settings.integrator = integrator;
+        assert!(scene.lights.is_empty());
+        let (film, _) = lumen::render::render(&scene, &|_| {});
+        assert!(film.pixels().all(|p| p == lumen::math::Color::ZERO), "{integrator:?}");
+    }
+}
