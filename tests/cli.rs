@@ -329,7 +329,14 @@ fn the_integrator_flag_chooses_how_light_is_found() {
     // The figure's own estimator is the book's.
     assert_eq!(image(None), image(Some("bsdf")));
     assert_ne!(image(Some("path")), image(Some("bsdf")));
-    let out = lumen(&["render", "cornell-box", "-o", "x.png", "--integrator", "nee"]);
+    let out = lumen(&[
+        "render",
+        "cornell-box",
+        "-o",
+        "x.png",
+        "--integrator",
+        "nee",
+    ]);
     assert!(!out.status.success());
     let err = stderr(&out);
     assert!(err.contains("path") && err.contains("bsdf"), "{err}");

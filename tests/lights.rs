@@ -332,6 +332,9 @@ fn black_lights_render_black_without_nan() {
         scene.settings.integrator = integrator;
         assert!(scene.lights.is_empty());
         let (film, _) = lumen::render::render(&scene, &|_| {});
-        assert!(film.pixels().all(|p| p == lumen::math::Color::ZERO), "{integrator:?}");
+        assert!(
+            film.pixels().all(|p| p == lumen::math::Color::ZERO),
+            "{integrator:?}"
+        );
     }
 }
