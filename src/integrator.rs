@@ -6,7 +6,7 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
 use crate::material::Material;
-use crate::math::{Color, Interval, Point3};
+use crate::math::{Color, Interval, Point3, Vec3};
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::scene::{Integrator, Scene, Shading};
@@ -79,11 +79,27 @@ impl PathState {
 #[inline]
 fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
-    if a2.is_infinite() {
+    // Where the other strategy cannot make the sample, this one has it all.
+    if a2.is_infinite() || b2 == 0.0 {
         1.0
     } else {
         a2 / (a2 + b2)
     }
+}
+
+/// The density per unit solid angle with which a Lambertian bounce at
+/// `record` leaves along unit `w`: cosine-distributed about the shading
+/// normal, and on a smoothly shaded surface also the directions that fell
+/// below the true surface and were mirrored above it (see
+/// [`HitRecord::reflected_above`]).
+#[inline]
+fn lambertian_pdf(record: &HitRecord, w: Vec3) -> f32 {
+    let mut cos = record.shading_normal.dot(w).max(0.0);
+    if record.is_smooth() {
+        let mirrored = w - 2.0 * w.dot(record.normal) * record.normal;
+        cos += record.shading_normal.dot(mirrored).max(0.0);
+    }
+    cos * FRAC_1_PI
 }
 
 /// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
@@ -134,10 +150,8 @@ fn step(
     let Some(scatter) = material.scatter(ray.direction, &record, sampler) else {
         return Step::Done(path.radiance);
     };
-    path.sampled_from = lambertian.map(|_| {
-        let cos = record.shading_normal.dot(scatter.direction).max(0.0);
-        (record.point, cos * FRAC_1_PI)
-    });
+    path.sampled_from =
+        lambertian.map(|_| (record.point, lambertian_pdf(&record, scatter.direction)));
     path.throughput *= scatter.attenuation;
     if path.throughput == Color::ZERO {
         return Step::Done(path.radiance);
@@ -195,20 +209,33 @@ fn direct_light(
         return (Color::ZERO, false);
     };
     let wi = sample.direction;
-    let cos = record.shading_normal.dot(wi);
-    // The light must be on the side the path came from, by the true surface
-    // as well as by the shading normal.
-    if !(cos > 0.0) || record.normal.dot(wi) <= 0.0 || sample.radiance == Color::ZERO {
+    // The light must be on the side the path came from, by the true surface.
+    // The surface reflects towards it what a bounce would carry there: the
+    // albedo times the bounce's density (cos θ / π about the shading normal,
+    // with the mirrored directions of a smooth surface).
+    let bsdf_pdf = lambertian_pdf(record, wi);
+    if record.normal.dot(wi) <= 0.0 || !(bsdf_pdf > 0.0) || sample.radiance == Color::ZERO {
         return (Color::ZERO, false);
     }
-    let shadow = Ray::new(record.spawn_origin(wi), wi);
-    let range = Interval::new(scene.settings.epsilon, sample.distance * (1.0 - 1e-4));
-    if scene.occluded(&shadow, range) {
+    // The shadow ray starts off the surface (moved by its rounding bound)
+    // and is aimed from there at the light point, ending just short of it by
+    // the point's own rounding: along `wi` from the moved start it would
+    // meet a light's plane before the point, and the light would shadow
+    // itself (far from the origin, where the rounding bounds grow).
+    let origin = record.spawn_origin(wi);
+    let to = sample.point - origin;
+    let length = to.length();
+    let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
+    if !(end > scene.settings.epsilon) {
+        // Closer than the nearest hit a bounce can make: out of reach.
+        return (Color::ZERO, false);
+    }
+    let shadow = Ray::new(origin, to / length);
+    if scene.occluded(&shadow, Interval::new(scene.settings.epsilon, end)) {
         return (Color::ZERO, true);
     }
-    let bsdf_pdf = cos * FRAC_1_PI;
     let weight = power_heuristic(sample.pdf, bsdf_pdf);
-    let light = sample.radiance * albedo * (FRAC_1_PI * cos * weight / sample.pdf);
+    let light = sample.radiance * albedo * (bsdf_pdf * weight / sample.pdf);
     (light, true)
 }
 

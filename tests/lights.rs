@@ -338,3 +338,106 @@ fn black_lights_render_black_without_nan() {
         );
     }
 }
+
+#[test]
+fn a_light_close_to_a_surface_far_from_the_origin_still_lights_it() {
+    // Far from the origin the hit point's rounding bound grows; the shadow
+    // ray must still stop short of the light it was aimed at rather than
+    // meet it and call the surface shadowed.
+    let dir = scratch_dir("lights-far");
+    let text = r#"[render]
+width = 24
+height = 24
+samples_per_pixel = 64
+max_depth = 2
+
+[camera]
+vfov = 30
+lookfrom = [5000, 3, 5004]
+lookat = [5000, 0, 5000]
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.floor]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+
+[materials.lamp]
+type = "emissive"
+radiance = [4, 4, 4]
+
+[[objects]]
+type = "quad"
+corner = [4990, 0, 4990]
+u = [0, 0, 20]
+v = [20, 0, 0]
+material = "floor"
+
+[[objects]]
+type = "quad"
+corner = [4999, 1, 4999]
+u = [2, 0, 0]
+v = [0, 0, 2]
+material = "lamp"
+"#;
+    let (path, bsdf) = both(&dir, text);
+    assert_tiles_agree("light near a far floor", &path, &bsdf);
+}
+
+#[test]
+fn lights_reflect_off_smooth_meshes_as_the_bounces_find_them() {
+    // A floor of two triangles whose vertex normals lean 60° towards +x:
+    // a third of the bounces about them dip under the true floor and are
+    // mirrored above it, towards the low lamp on the +x side. Both
+    // strategies' densities must count those directions.
+    let dir = scratch_dir("lights-smooth");
+    let (s, c) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
+    std::fs::write(
+        dir.join("floor.obj"),
+        format!(
+            "v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nvn {s} {c} 0\n\
+             f 1//1 3//1 2//1\nf 1//1 4//1 3//1\n"
+        ),
+    )
+    .unwrap();
+    let text = r#"[render]
+width = 24
+height = 24
+samples_per_pixel = 256
+max_depth = 2
+
+[camera]
+vfov = 40
+lookfrom = [0, 6, 0.01]
+lookat = [0, 0, 0]
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.matte]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+
+[materials.lamp]
+type = "emissive"
+radiance = [5, 5, 5]
+two_sided = true
+
+[[objects]]
+type = "mesh"
+file = "floor.obj"
+material = "matte"
+
+[[objects]]
+type = "quad"
+corner = [3, 0.2, -1]
+u = [0, 0, 2]
+v = [0, 0.6, 0]
+material = "lamp"
+"#;
+    let (path, bsdf) = both(&dir, text);
+    assert_tiles_agree("smooth mesh", &path, &bsdf);
+}

@@ -67,9 +67,12 @@ pub struct Light {
 
 impl Light {
     /// Its power, up to a constant factor: what [`Lights`] chooses by.
-    fn power(&self) -> f32 {
+    fn power(&self) -> f64 {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
-        luminance(self.radiance) * self.shape.area() * PI * sides
+        f64::from(luminance(self.radiance))
+            * f64::from(self.shape.area())
+            * std::f64::consts::PI
+            * sides
     }
 
     /// The radiance leaving the light at a point of outward normal
@@ -93,6 +96,8 @@ pub fn luminance(c: Color) -> f32 {
 /// A point sampled on a light, seen from a shaded point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
+    /// The point on the light.
+    pub point: Point3,
     /// Unit direction from the shaded point to the light point.
     pub direction: Vec3,
     /// Distance to the light point.
@@ -120,20 +125,29 @@ impl Lights {
     /// `lights`). Lights of no power are never chosen; when none has any
     /// power the list is empty.
     pub fn new(lights: Vec<Light>) -> Self {
-        let powers: Vec<f64> = lights.iter().map(|l| f64::from(l.power())).collect();
+        let powers: Vec<f64> = lights.iter().map(Light::power).collect();
         let total: f64 = powers.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
             return Lights::default();
         }
         let mut running = 0.0;
-        let cdf = powers
+        let mut cdf: Vec<f32> = powers
             .iter()
             .map(|p| {
                 running += p;
                 (running / total) as f32
             })
             .collect();
-        let chance = powers.iter().map(|p| (p / total) as f32).collect();
+        // Every u in [0, 1) chooses a light.
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        // The chance of each light is the width of its step of the f32
+        // table that chooses it, not its exact share: with millions of
+        // lights the two differ, and the weights must use what is sampled.
+        let chance = (0..cdf.len())
+            .map(|i| cdf[i] - if i == 0 { 0.0 } else { cdf[i - 1] })
+            .collect();
         Lights {
             lights,
             cdf,
@@ -185,6 +199,7 @@ impl Lights {
             return None;
         }
         Some(LightSample {
+            point: target,
             direction,
             distance,
             radiance: light.emitted(outward, -direction),
@@ -196,9 +211,12 @@ impl Lights {
     /// `from` picks the direction that meets light `i` at `point` (outward
     /// normal `outward`).
     pub fn pdf(&self, i: usize, from: Point3, point: Point3, outward: Vec3) -> f32 {
-        let Some(light) = self.lights.get(i) else {
+        let (Some(light), Some(&chance)) = (self.lights.get(i), self.chance.get(i)) else {
             return 0.0;
         };
+        if chance == 0.0 {
+            return 0.0;
+        }
         let to = point - from;
         let d2 = to.length_squared();
         let solid_angle = match light.shape {
@@ -216,7 +234,7 @@ impl Lights {
                 d2 / (cos * shape.area())
             }
         };
-        self.chance[i] * solid_angle
+        chance * solid_angle
     }
 }
 
