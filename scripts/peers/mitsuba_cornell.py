@@ -48,14 +48,8 @@ import peerlib  # noqa: E402
 
 
 def read_scene(path, one_sided):
-    scene = tomllib.loads(Path(path).read_text())
-    r = scene.setdefault("render", {})
-    r.setdefault("width", 400)
-    if "height" not in r:
-        r["height"] = max(1, int(r["width"] / r.get("aspect_ratio", 16 / 9)))
-    r.setdefault("max_depth", 50)
-    c = scene.setdefault("camera", {})
-    c.setdefault("vup", [0.0, 1.0, 0.0])
+    scene = peerlib.fill_defaults(tomllib.loads(Path(path).read_text()))
+    c = scene["camera"]
     if c.get("defocus_angle", 0.0) != 0.0:
         raise ValueError(f"{path}: only a pinhole camera is supported")
     bg = scene.get("background", {})
@@ -99,28 +93,8 @@ def placement(mi, steps):
 
 
 def build_scene(mi, scene, spp, seed, width, sampler="independent", rr_depth=None):
-    r, cam = scene["render"], scene["camera"]
-    height = r["height"] * width // r["width"] if width else r["height"]
-    width = width or r["width"]
-    max_depth = r["max_depth"]
-    rr = max_depth + 100 if rr_depth is None else rr_depth
-    d = {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr},
-        "sensor": {
-            "type": "perspective",
-            "fov": float(cam["vfov"]),
-            "fov_axis": "y",
-            "near_clip": 1e-2,
-            "far_clip": 1e6,
-            "to_world": mi.ScalarTransform4f().look_at(origin=cam["lookfrom"], target=cam["lookat"],
-                                                      up=cam["vup"]),
-            "sampler": {"type": sampler, "sample_count": spp, "seed": seed},
-            "film": {"type": "hdrfilm", "width": width, "height": height,
-                     "pixel_format": "rgb", "component_format": "float32",
-                     "rfilter": {"type": "box"}},
-        },
-    }
+    d = peerlib.mitsuba_path_scene(mi, scene, spp, sampler, seed, rr_depth=rr_depth, width=width,
+                                   clip=(1e-2, 1e6))
 
     def material(name):
         m = scene["materials"][name]

@@ -42,31 +42,9 @@ HERE = Path(__file__).resolve().parent
 
 
 def build_scene(mi, scene, spp, sampler="independent", seed=0, rr_depth=None, max_depth=None):
-    r, cam = scene["render"], scene["camera"]
-    max_depth = max_depth or r["max_depth"]
-    rr = max_depth + 100 if rr_depth is None else rr_depth
-    sampler_dict = {"type": sampler, "sample_count": spp, "seed": seed}
-    if sampler in ("stratified", "multijitter"):
-        sampler_dict["jitter"] = True
-    d = {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr},
-        "sensor": {
-            "type": "perspective",
-            "fov": float(cam["vfov"]),
-            "fov_axis": "y",
-            "near_clip": 1e-3,
-            "far_clip": 1e5,
-            "to_world": mi.ScalarTransform4f().look_at(origin=cam["lookfrom"], target=cam["lookat"],
-                                                      up=cam["vup"]),
-            "sampler": sampler_dict,
-            "film": {"type": "hdrfilm", "width": r["width"], "height": r["height"],
-                     "pixel_format": "rgb", "component_format": "float32",
-                     "rfilter": {"type": "box"}},
-        },
-        "sky": {"type": "constant",
-                "radiance": {"type": "rgb", "value": peerlib.rgb(scene["background"]["color"])}},
-    }
+    d = peerlib.mitsuba_path_scene(mi, scene, spp, sampler, seed, max_depth, rr_depth)
+    d["sky"] = {"type": "constant",
+                "radiance": {"type": "rgb", "value": peerlib.rgb(scene["background"]["color"])}}
     bsdfs = {}
     for name, m in scene["materials"].items():
         if m["type"] == "diffuse":

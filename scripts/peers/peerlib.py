@@ -22,13 +22,9 @@ import numpy as np
 
 
 # ------------------------------------------------------------------ scene
-def read_lumen_scene(path):
-    """The lumen scene at `path` (TOML), with camera/render defaults filled.
-
-    Only what the peer scripts support is accepted: a solid background,
-    diffuse (lambertian, scale) and metal materials, sphere objects.
-    """
-    scene = tomllib.loads(Path(path).read_text())
+def fill_defaults(scene):
+    """`scene` (a parsed lumen TOML scene) with lumen's defaults filled in for
+    the render and camera fields the peer scripts read."""
     r = scene.setdefault("render", {})
     r.setdefault("width", 400)
     if "height" not in r:
@@ -41,7 +37,51 @@ def read_lumen_scene(path):
     c.setdefault("lookfrom", [0.0, 0.0, 0.0])
     c.setdefault("lookat", [0.0, 0.0, -1.0])
     c.setdefault("vup", [0.0, 1.0, 0.0])
-    if c.get("defocus_angle", 0.0) != 0.0:
+    return scene
+
+
+def mitsuba_path_scene(mi, scene, spp, sampler="independent", seed=0, max_depth=None,
+                       rr_depth=None, width=None, clip=(1e-3, 1e5)):
+    """The start of a Mitsuba scene dict for a lumen scene: its `path`
+    integrator (max_depth = lumen's, both counting ray segments; Russian
+    roulette from `rr_depth`, None for none) and its camera (`perspective`,
+    fov_axis "y", box pixel filter, `width` wide with the scene's aspect, the
+    scene's size by default). The caller adds shapes and emitters."""
+    r, cam = scene["render"], scene["camera"]
+    width = width or r["width"]
+    height = max(1, r["height"] * width // r["width"])
+    max_depth = max_depth or r["max_depth"]
+    rr = max_depth + 100 if rr_depth is None else rr_depth
+    sampler_dict = {"type": sampler, "sample_count": spp, "seed": seed}
+    if sampler in ("stratified", "multijitter"):
+        sampler_dict["jitter"] = True
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr},
+        "sensor": {
+            "type": "perspective",
+            "fov": float(cam["vfov"]),
+            "fov_axis": "y",
+            "near_clip": clip[0],
+            "far_clip": clip[1],
+            "to_world": mi.ScalarTransform4f().look_at(origin=cam["lookfrom"], target=cam["lookat"],
+                                                      up=cam["vup"]),
+            "sampler": sampler_dict,
+            "film": {"type": "hdrfilm", "width": width, "height": height,
+                     "pixel_format": "rgb", "component_format": "float32",
+                     "rfilter": {"type": "box"}},
+        },
+    }
+
+
+def read_lumen_scene(path):
+    """The lumen scene at `path` (TOML), with camera/render defaults filled.
+
+    Only what the peer scripts support is accepted: a solid background,
+    diffuse (lambertian, scale) and metal materials, sphere objects.
+    """
+    scene = fill_defaults(tomllib.loads(Path(path).read_text()))
+    if scene["camera"].get("defocus_angle", 0.0) != 0.0:
         raise ValueError(f"{path}: only a pinhole camera (defocus_angle 0) is supported")
     bg = scene.get("background", {})
     if bg.get("type") != "solid":
