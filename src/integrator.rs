@@ -5,7 +5,7 @@
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
-use crate::material::Material;
+use crate::material::{reflect, Material};
 use crate::math::{Color, Interval, Point3, Vec3};
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
@@ -96,8 +96,10 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 fn lambertian_pdf(record: &HitRecord, w: Vec3) -> f32 {
     let mut cos = record.shading_normal.dot(w).max(0.0);
     if record.is_smooth() {
-        let mirrored = w - 2.0 * w.dot(record.normal) * record.normal;
-        cos += record.shading_normal.dot(mirrored).max(0.0);
+        cos += record
+            .shading_normal
+            .dot(reflect(w, record.normal))
+            .max(0.0);
     }
     cos * FRAC_1_PI
 }
@@ -127,12 +129,9 @@ fn step(
     if let Material::Emissive(light) = material {
         let mut emitted = path.throughput * light.emitted(&record);
         if let (Some((from, bsdf_pdf)), Some(i)) = (path.sampled_from, scene.light_of(&hit)) {
-            let outward = if record.front_face {
-                record.normal
-            } else {
-                -record.normal
-            };
-            let light_pdf = scene.lights.pdf(i, from, record.point, outward);
+            let light_pdf = scene
+                .lights
+                .pdf(i, from, record.point, record.outward_normal());
             emitted *= power_heuristic(bsdf_pdf, light_pdf);
         }
         return Step::Done(path.radiance + emitted);
@@ -254,19 +253,21 @@ pub fn trace_path(
 ) -> Color {
     let range = hit_range(scene);
     let mut path = PathState::START;
+    // A path still going after `max_depth` segments keeps what it gathered.
+    let mut colour = None;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
         let hit = scene.intersect(&ray, range);
         match step(scene, &ray, hit, depth, &mut path, sampler) {
             Step::Continue(next) => ray = next,
-            Step::Done(colour) => {
-                *rays += path.shadow_rays;
-                return colour;
+            Step::Done(c) => {
+                colour = Some(c);
+                break;
             }
         }
     }
     *rays += path.shadow_rays;
-    path.radiance
+    colour.unwrap_or(path.radiance)
 }
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
@@ -366,11 +367,7 @@ pub(crate) fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &m
     let Some(hit) = scene.hit(&ray, hit_range(scene)) else {
         return scene.background.color(ray.direction);
     };
-    let outward = if hit.front_face {
-        hit.normal
-    } else {
-        -hit.normal
-    };
+    let outward = hit.outward_normal();
     match shading {
         Shading::Hit => Color::new(1.0, 0.0, 0.0),
         Shading::NormalsUnit => outward,

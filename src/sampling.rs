@@ -89,6 +89,22 @@ pub fn unit_vector_around(u: [f32; 2], axis: Vec3) -> Vec3 {
     tangent * v.x + bitangent * v.y + axis * v.z
 }
 
+/// A direction uniformly distributed over the cone of directions within
+/// angle θmax of unit `axis`, given 1 − cos θmax (at most 2, the whole
+/// sphere), from `u` uniform in [0, 1)²: 1 − cos θ uniform in
+/// [0, 1 − cos θmax], the azimuth uniform. sin θ is taken from 1 − cos θ
+/// directly, so that cones too narrow for cos θ to differ from 1 in `f32`
+/// still spread their directions.
+#[inline]
+pub fn in_cone(u: [f32; 2], axis: Vec3, one_minus_cos_max: f32) -> Vec3 {
+    let one_minus_cos = u[0] * one_minus_cos_max;
+    let cos = 1.0 - one_minus_cos;
+    let sin = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let (s, c) = sin_cos_turns(u[1]);
+    let (tangent, bitangent) = axis.any_orthonormal_pair();
+    (tangent * (sin * c) + bitangent * (sin * s) + axis * cos).normalize()
+}
+
 /// A uniformly distributed direction in the hemisphere around `normal`,
 /// from `u` uniform in [0, 1)².
 #[inline]
@@ -150,6 +166,25 @@ mod tests {
                 "height {} not {height}",
                 v.dot(axis)
             );
+        }
+    }
+
+    #[test]
+    fn cone_directions_keep_within_the_cone_at_their_drawn_angle() {
+        let mut rng = crate::rng::Rng::new(9);
+        for max in [2.0f32, 0.3, 1e-3, 1e-9] {
+            for _ in 0..10_000 {
+                let (u, axis) = (rng.next_2d(), unit_vector(rng.next_2d()));
+                let v = in_cone(u, axis, max);
+                assert!((v.length() - 1.0).abs() < 1e-5, "{v} not unit");
+                let expected = 1.0 - u[0] * max;
+                assert!(
+                    (v.dot(axis) - expected).abs() < 2e-6,
+                    "cos {} not {expected}",
+                    v.dot(axis)
+                );
+                assert!(v.dot(axis) >= 1.0 - max - 2e-6);
+            }
         }
     }
 

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{assert_agree, builtin_desc, pixel_stats};
+use common::{assert_agree, ball_in_light, builtin_desc, pixel_stats};
 use lumen::math::Color;
 use lumen::render::render;
 use lumen::scene::file::{Format, SceneFile};
@@ -31,53 +31,20 @@ fn values(scene: &Scene) -> Vec<(Color, usize)> {
     seen
 }
 
-/// The camera inside a light enclosing a diffuse sphere: a sphere of radius
-/// 10 emitting (2, 3, 4) (the camera sees its inside, the back of its
-/// surface), around a sphere of albedo (0.5, 0.25, 0.75) which fills the view
-/// when the camera looks at it (`towards_sphere`); else the camera sees only
-/// the light. Lights are met only by chance (the `bsdf` integrator), so
-/// that every sample of a pixel has the same value.
+/// The camera inside a light enclosing a diffuse sphere (see
+/// [`ball_in_light`]), albedo (0.5, 0.25, 0.75). Lights are met only by
+/// chance (the `bsdf` integrator), so that every sample of a pixel has the
+/// same value.
 fn enclosure(two_sided: bool, max_depth: u32, sampler: &str, towards_sphere: bool) -> Scene {
-    let lookat_z = if towards_sphere { -1 } else { 1 };
-    scene(&format!(
-        r#"[render]
-width = 32
-height = 24
-samples_per_pixel = 4
-max_depth = {max_depth}
-sampler = "{sampler}"
-integrator = "bsdf"
-
-[camera]
-vfov = 20
-lookfrom = [0, 0, 0]
-lookat = [0, 0, {lookat_z}]
-
-[background]
-type = "solid"
-color = [0, 0, 0]
-
-[materials.light]
-type = "emissive"
-radiance = [2, 3, 4]
-two_sided = {two_sided}
-
-[materials.matte]
-type = "diffuse"
-albedo = [0.5, 0.25, 0.75]
-
-[[objects]]
-type = "sphere"
-center = [0, 0, 0]
-radius = 10
-material = "light"
-
-[[objects]]
-type = "sphere"
-center = [0, 0, -3]
-radius = 1
-material = "matte"
-"#
+    let render = format!(
+        "width = 32\nheight = 24\nsamples_per_pixel = 4\nmax_depth = {max_depth}\n\
+         sampler = \"{sampler}\"\nintegrator = \"bsdf\""
+    );
+    scene(&ball_in_light(
+        &render,
+        two_sided,
+        [0.5, 0.25, 0.75],
+        towards_sphere,
     ))
 }
 

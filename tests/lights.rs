@@ -9,7 +9,10 @@
 
 mod common;
 
-use common::{assert_agree, builtin_desc, compile_file, pixel_stats, scratch_dir, PixelStats, K};
+use common::{
+    assert_agree, ball_in_light, builtin_desc, compile_file, pixel_stats, scratch_dir, PixelStats,
+    K,
+};
 use lumen::scene::{Integrator, Sampling, Scene};
 
 /// Each 8 × 8 tile of two renders of one view agrees in every channel, and
@@ -167,46 +170,12 @@ fn a_ball_inside_a_light_returns_its_albedo_times_the_radiance() {
     // bounce off the ball meets the light, so each pixel's expected value
     // is exactly albedo × radiance, and next-event estimation must keep it.
     let dir = scratch_dir("lights-enclosure");
+    let render =
+        "width = 16\nheight = 12\nsamples_per_pixel = 64\nmax_depth = 3\nintegrator = \"path\"";
     let scene = compile_file(
         &dir,
         "scene.toml",
-        r#"[render]
-width = 16
-height = 12
-samples_per_pixel = 64
-max_depth = 3
-integrator = "path"
-
-[camera]
-vfov = 20
-lookfrom = [0, 0, 0]
-lookat = [0, 0, -1]
-
-[background]
-type = "solid"
-color = [0, 0, 0]
-
-[materials.light]
-type = "emissive"
-radiance = [2, 3, 4]
-two_sided = true
-
-[materials.matte]
-type = "diffuse"
-albedo = [0.5, 0.25, 1.0]
-
-[[objects]]
-type = "sphere"
-center = [0, 0, 0]
-radius = 10
-material = "light"
-
-[[objects]]
-type = "sphere"
-center = [0, 0, -3]
-radius = 1
-material = "matte"
-"#,
+        &ball_in_light(render, true, [0.5, 0.25, 1.0], true),
     );
     assert_eq!(scene.lights.len(), 1);
     let stats = pixel_stats(&scene);

@@ -169,31 +169,34 @@ def camera(scene, lookfrom, lookat, vup, vfov_deg):
 def diffuse_material(name, albedo=None, attribute=None):
     """Lambertian (Diffuse BSDF, roughness 0) of colour `albedo`, or of the
     geometry attribute `attribute` (a per-point colour)."""
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    nt.nodes.clear()
-    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Roughness"].default_value = 0.0
-    _colour_input(nt, bsdf.inputs["Color"], albedo, attribute)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    out.target = "CYCLES"
-    nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+    def bsdf(nt):
+        node = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        node.inputs["Roughness"].default_value = 0.0
+        return node
+    return _material(name, bsdf, albedo, attribute)
 
 
 def mirror_material(name, albedo=None, attribute=None):
     """Perfect mirror reflecting exactly `albedo` at every angle: Glossy BSDF
     (GGX, roughness 0; Cycles applies no Fresnel term to it)."""
+    def bsdf(nt):
+        node = nt.nodes.new("ShaderNodeBsdfAnisotropic")  # "Glossy BSDF" since Blender 4.0
+        node.distribution = "GGX"
+        node.inputs["Roughness"].default_value = 0.0
+        if "Anisotropy" in node.inputs:
+            node.inputs["Anisotropy"].default_value = 0.0
+        return node
+    return _material(name, bsdf, albedo, attribute)
+
+
+def _material(name, make_bsdf, albedo, attribute):
+    """A Cycles material whose surface is the BSDF node `make_bsdf(node_tree)`
+    makes, its Color input `albedo` or the geometry attribute `attribute`."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.clear()
-    bsdf = nt.nodes.new("ShaderNodeBsdfAnisotropic")  # "Glossy BSDF" since Blender 4.0
-    bsdf.distribution = "GGX"
-    bsdf.inputs["Roughness"].default_value = 0.0
-    if "Anisotropy" in bsdf.inputs:
-        bsdf.inputs["Anisotropy"].default_value = 0.0
+    bsdf = make_bsdf(nt)
     _colour_input(nt, bsdf.inputs["Color"], albedo, attribute)
     out = nt.nodes.new("ShaderNodeOutputMaterial")
     out.target = "CYCLES"

@@ -59,6 +59,17 @@ impl HitRecord {
         self.shading_normal != self.normal
     }
 
+    /// The unit geometric normal pointing out of the surface (away from its
+    /// inside, whichever side the ray came from).
+    #[inline(always)]
+    pub fn outward_normal(&self) -> Vec3 {
+        if self.front_face {
+            self.normal
+        } else {
+            -self.normal
+        }
+    }
+
     /// `direction` kept on the side of the surface it was meant for: a
     /// reflection scattered around a smooth shading normal can point below
     /// the true (geometric) surface, where the path would enter the object

@@ -9,6 +9,7 @@
 //! per unit solid angle, with which a direction that happens to meet a light
 //! would have been sampled, which multiple importance sampling needs.
 
+use crate::material::Emissive;
 use crate::math::{Color, Point3, Vec3};
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
@@ -59,31 +60,18 @@ impl Shape {
 pub struct Light {
     /// Where it is.
     pub shape: Shape,
-    /// The radiance it emits.
-    pub radiance: Color,
-    /// Whether it emits from both sides.
-    pub two_sided: bool,
+    /// What it emits, and to which sides.
+    pub emission: Emissive,
 }
 
 impl Light {
     /// Its power, up to a constant factor: what [`Lights`] chooses by.
     fn power(&self) -> f64 {
-        let sides = if self.two_sided { 2.0 } else { 1.0 };
-        f64::from(luminance(self.radiance))
+        let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
+        f64::from(luminance(self.emission.radiance))
             * f64::from(self.shape.area())
             * std::f64::consts::PI
             * sides
-    }
-
-    /// The radiance leaving the light at a point of outward normal
-    /// `outward` towards direction `towards` (from the light).
-    #[inline]
-    fn emitted(&self, outward: Vec3, towards: Vec3) -> Color {
-        if self.two_sided || outward.dot(towards) > 0.0 {
-            self.radiance
-        } else {
-            Color::ZERO
-        }
     }
 }
 
@@ -165,11 +153,6 @@ impl Lights {
         self.lights.len()
     }
 
-    /// Light `i`.
-    pub fn get(&self, i: usize) -> &Light {
-        &self.lights[i]
-    }
-
     /// Chooses a light in proportion to its power and samples a direction
     /// from `point` towards it; `None` when the sample carries no light (the
     /// back of a one-sided light, a degenerate direction).
@@ -181,20 +164,16 @@ impl Lights {
             .min(self.lights.len() - 1);
         let light = &self.lights[i];
         let uv = sampler.get_2d(Dim::Light);
-        let (target, outward, pdf_solid_angle) = match light.shape {
-            Shape::Sphere { center, radius } => sample_sphere(center, radius, point, uv)?,
-            shape => {
-                let (target, outward) = sample_flat(&shape, uv);
-                let to = target - point;
-                let d2 = to.length_squared();
-                let cos = outward.dot(to).abs() / d2.sqrt();
-                (target, outward, d2 / (cos * shape.area()))
+        let (target, outward) = match light.shape {
+            Shape::Sphere { center, radius } if !inside(center, radius, point) => {
+                sample_cap(center, radius, point, uv)
             }
+            shape => sample_area(&shape, uv),
         };
         let to = target - point;
         let distance = to.length();
         let direction = to / distance;
-        let pdf = self.chance[i] * pdf_solid_angle;
+        let pdf = self.chance[i] * solid_angle_density(&light.shape, point, target, outward);
         if !(pdf > 0.0 && pdf.is_finite() && distance > 0.0 && distance.is_finite()) {
             return None;
         }
@@ -202,7 +181,7 @@ impl Lights {
             point: target,
             direction,
             distance,
-            radiance: light.emitted(outward, -direction),
+            radiance: light.emission.towards(outward.dot(direction) < 0.0),
             pdf,
         })
     }
@@ -217,24 +196,32 @@ impl Lights {
         if chance == 0.0 {
             return 0.0;
         }
-        let to = point - from;
-        let d2 = to.length_squared();
-        let solid_angle = match light.shape {
-            Shape::Sphere { center, radius } => {
-                let dc2 = (center - from).length_squared();
-                if dc2 > radius * radius {
-                    1.0 / cap_solid_angle(radius * radius / dc2)
-                } else {
-                    let cos = outward.dot(to).abs() / d2.sqrt();
-                    d2 / (cos * light.shape.area())
-                }
-            }
-            shape => {
-                let cos = outward.dot(to).abs() / d2.sqrt();
-                d2 / (cos * shape.area())
-            }
-        };
-        chance * solid_angle
+        chance * solid_angle_density(&light.shape, from, point, outward)
+    }
+}
+
+/// Whether `point` is inside the sphere (or on it).
+#[inline]
+fn inside(center: Point3, radius: f32, point: Point3) -> bool {
+    (center - point).length_squared() <= radius * radius
+}
+
+/// The density per unit solid angle, seen from `from`, of the point `point`
+/// (outward normal `outward`) of a light of `shape` as the sampling chooses
+/// it: uniform over the cone of a sphere seen from outside, else uniform
+/// over the area, whose density 1/A becomes d² / (|cos θ| A) per unit
+/// solid angle.
+#[inline]
+fn solid_angle_density(shape: &Shape, from: Point3, point: Point3, outward: Vec3) -> f32 {
+    match *shape {
+        Shape::Sphere { center, radius } if !inside(center, radius, from) => {
+            1.0 / cap_solid_angle(radius * radius / (center - from).length_squared())
+        }
+        _ => {
+            let to = point - from;
+            let d2 = to.length_squared();
+            d2 * d2.sqrt() / (outward.dot(to).abs() * shape.area())
+        }
     }
 }
 
@@ -246,9 +233,13 @@ fn cap_solid_angle(sin2: f32) -> f32 {
     2.0 * PI * sin2 / (1.0 + cos)
 }
 
-/// A uniform point on a quad or a triangle, and its outward unit normal.
-fn sample_flat(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3) {
+/// A uniform point on the area of `shape`, and its outward unit normal.
+fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3) {
     match *shape {
+        Shape::Sphere { center, radius } => {
+            let outward = sampling::unit_vector([s, t]);
+            (center + radius * outward, outward)
+        }
         Shape::Quad { corner, u, v } => (corner + s * u + t * v, u.cross(v).normalize()),
         Shape::Triangle {
             vertices: [a, b, c],
@@ -264,48 +255,24 @@ fn sample_flat(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3) {
                 (b - a).cross(c - a).normalize(),
             )
         }
-        Shape::Sphere { .. } => unreachable!("spheres are sampled by solid angle"),
     }
 }
 
-/// A point on the sphere seen from `point`: uniform over the solid angle of
-/// the visible cap from outside; uniform over the area from inside. The
-/// point, its outward normal and the density per unit solid angle.
-fn sample_sphere(
-    center: Point3,
-    radius: f32,
-    point: Point3,
-    uv: [f32; 2],
-) -> Option<(Point3, Vec3, f32)> {
+/// The point of the sphere seen from `point` (outside it) along a direction
+/// uniform over the cone it covers, and its outward normal.
+fn sample_cap(center: Point3, radius: f32, point: Point3, uv: [f32; 2]) -> (Point3, Vec3) {
     let oc = center - point;
     let dc2 = oc.length_squared();
     let r2 = radius * radius;
-    if dc2 <= r2 {
-        let outward = sampling::unit_vector(uv);
-        let target = center + radius * outward;
-        let to = target - point;
-        let d2 = to.length_squared();
-        let cos = outward.dot(to).abs() / d2.sqrt();
-        return Some((target, outward, d2 / (cos * 4.0 * PI * r2)));
-    }
-    let sin2_max = r2 / dc2;
-    let solid_angle = cap_solid_angle(sin2_max);
-    // A uniform direction in the cone: 1 − cos θ uniform in [0, 1 − cos θmax].
-    let one_minus_cos = uv[0] * solid_angle / (2.0 * PI);
-    let cos = 1.0 - one_minus_cos;
-    let sin = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
-    let axis = oc / dc2.sqrt();
-    let (t, b) = axis.any_orthonormal_pair();
-    let phi = 2.0 * PI * uv[1];
-    let direction = (t * (sin * phi.cos()) + b * (sin * phi.sin()) + axis * cos).normalize();
+    let one_minus_cos_max = cap_solid_angle(r2 / dc2) / (2.0 * PI);
+    let direction = sampling::in_cone(uv, oc / dc2.sqrt(), one_minus_cos_max);
     // The nearer intersection with the sphere; grazing directions round to
     // the tangent point.
     let along = direction.dot(oc);
     let off_axis2 = (oc - along * direction).length_squared();
     let distance = along - (r2 - off_axis2).max(0.0).sqrt();
     let target = point + distance * direction;
-    let outward = (target - center).normalize();
-    Some((target, outward, 1.0 / solid_angle))
+    (target, (target - center).normalize())
 }
 
 #[cfg(test)]

@@ -4,12 +4,19 @@ use crate::rng::Rng;
 /// Standard errors allowed between an estimate and its expected value.
 const K: f64 = 5.0;
 
-fn light(shape: Shape) -> Light {
+/// A light of `shape` emitting `radiance`, from both sides or one.
+fn emitting(shape: Shape, radiance: Color, two_sided: bool) -> Light {
     Light {
         shape,
-        radiance: Color::ONE,
-        two_sided: true,
+        emission: Emissive {
+            radiance,
+            two_sided,
+        },
     }
+}
+
+fn light(shape: Shape) -> Light {
+    emitting(shape, Color::ONE, true)
 }
 
 /// Mean and standard error of `f` over `n` samples.
@@ -131,15 +138,8 @@ fn lights_are_chosen_in_proportion_to_their_power() {
     let lights = Lights::new(vec![
         light(quad(0.0, 1.0)),
         light(quad(5.0, 2.0)),
-        Light {
-            radiance: Color::ZERO,
-            ..light(quad(10.0, 1.0))
-        },
-        Light {
-            radiance: Color::splat(4.0),
-            two_sided: false,
-            ..light(quad(-5.0, 1.0))
-        },
+        emitting(quad(10.0, 1.0), Color::ZERO, true),
+        emitting(quad(-5.0, 1.0), Color::splat(4.0), false),
     ]);
     assert_eq!(lights.len(), 4);
     let expected = [1.0 / 7.0, 4.0 / 7.0, 2.0 / 7.0, 0.0];
@@ -177,10 +177,7 @@ fn a_one_sided_light_sends_nothing_behind_it() {
         v: Vec3::new(0.0, 0.0, 2.0),
     };
     // u × v points down (−y): lit below, dark above.
-    let lights = Lights::new(vec![Light {
-        two_sided: false,
-        ..light(shape)
-    }]);
+    let lights = Lights::new(vec![emitting(shape, Color::ONE, false)]);
     let mut rng = Rng::new(5);
     for _ in 0..100 {
         let below = lights.sample(Vec3::ZERO, &mut rng).unwrap();

@@ -17,14 +17,21 @@ pub struct Emissive {
 }
 
 impl Emissive {
-    /// The radiance leaving the surface at `hit` towards the ray that hit
-    /// it.
+    /// The radiance leaving the surface towards a side of it: the side its
+    /// outward normal points to when `front`, else the other.
     #[inline(always)]
-    pub fn emitted(&self, hit: &HitRecord) -> Color {
-        if hit.front_face || self.two_sided {
+    pub fn towards(&self, front: bool) -> Color {
+        if front || self.two_sided {
             self.radiance
         } else {
             Color::ZERO
         }
+    }
+
+    /// The radiance leaving the surface at `hit` towards the ray that hit
+    /// it.
+    #[inline(always)]
+    pub fn emitted(&self, hit: &HitRecord) -> Color {
+        self.towards(hit.front_face)
     }
 }

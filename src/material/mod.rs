@@ -58,18 +58,11 @@ impl Material {
         }
     }
 
-    /// The radiance the surface emits at `hit` towards the ray that hit it
-    /// (black for every material but [`Emissive`]).
-    #[inline(always)]
-    pub fn emitted(&self, hit: &HitRecord) -> Color {
-        match self {
-            Material::Emissive(m) => m.emitted(hit),
-            _ => Color::ZERO,
+    /// What the material emits, if it gives off any light.
+    pub fn light(&self) -> Option<Emissive> {
+        match *self {
+            Material::Emissive(m) if m.radiance != Color::ZERO => Some(m),
+            _ => None,
         }
-    }
-
-    /// Whether the material emits light.
-    pub fn is_emissive(&self) -> bool {
-        matches!(self, Material::Emissive(m) if m.radiance != Color::ZERO)
     }
 }

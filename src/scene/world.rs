@@ -394,13 +394,8 @@ impl World {
             group
                 .shapes
                 .record(&object_ray, hit.t * scale, shape, hit.sub, self.error_scale);
-        let outward = if inner.front_face {
-            inner.normal
-        } else {
-            -inner.normal
-        };
         let point = transform.point(inner.point);
-        let (normal, front_face) = face_normal(ray, transform.normal(outward));
+        let (normal, front_face) = face_normal(ray, transform.normal(inner.outward_normal()));
         let shading_normal = if inner.is_smooth() {
             facing(transform.normal(inner.shading_normal), normal)
         } else {
@@ -459,18 +454,11 @@ impl World {
     /// primitive of its tree (black for the others), so that a hit's light
     /// is found by arithmetic.
     pub(crate) fn lights(&self, materials: &[Material]) -> (Lights, LightIds) {
-        let emitter = |m: u32| match materials[m as usize] {
-            Material::Emissive(e) if e.radiance != Color::ZERO => Some(e),
-            _ => None,
-        };
+        let emitter = |m: u32| materials[m as usize].light();
         let mut lights = Vec::new();
         let mut ids = LightIds::default();
-        let add = |shape: LightShape, e: Emissive, lights: &mut Vec<Light>| {
-            lights.push(Light {
-                shape,
-                radiance: e.radiance,
-                two_sided: e.two_sided,
-            });
+        let add = |shape: LightShape, emission: Emissive, lights: &mut Vec<Light>| {
+            lights.push(Light { shape, emission });
             (lights.len() - 1) as u32
         };
         let top = &self.top;

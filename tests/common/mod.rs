@@ -373,3 +373,54 @@ pub fn assert_pixels_agree(what: &str, a: &PixelStats, b: &PixelStats, k: f64) -
     }
     (worst, noisy)
 }
+
+/// A scene file's text: the camera at the centre of a ball of light (radius
+/// 10, radiance (2, 3, 4), one- or `two_sided`; the camera sees its inside,
+/// the back of its surface) that also holds a matte ball of `albedo`
+/// (radius 1, 3 units down −z), which fills the camera's 20° view when it
+/// looks down −z (`towards_ball`) and is out of view when it looks the other
+/// way. `render` gives the lines of the `[render]` table.
+pub fn ball_in_light(
+    render: &str,
+    two_sided: bool,
+    albedo: [f64; 3],
+    towards_ball: bool,
+) -> String {
+    let lookat_z = if towards_ball { -1 } else { 1 };
+    let [r, g, b] = albedo;
+    format!(
+        r#"[render]
+{render}
+
+[camera]
+vfov = 20
+lookfrom = [0, 0, 0]
+lookat = [0, 0, {lookat_z}]
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.light]
+type = "emissive"
+radiance = [2, 3, 4]
+two_sided = {two_sided}
+
+[materials.matte]
+type = "diffuse"
+albedo = [{r}, {g}, {b}]
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 10
+material = "light"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, -3]
+radius = 1
+material = "matte"
+"#
+    )
+}
