@@ -45,7 +45,7 @@ pub const VERSION: u32 = 2;
 /// sample (random stream, sampling, intersection arithmetic, materials) must
 /// bump the revision, so that a checkpoint written before it is refused
 /// rather than mixed with different samples.
-pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.8");
+pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.9");
 /// Extension added to an output path to name its default checkpoint.
 pub const EXTENSION: &str = "lumen-ckpt";
 
@@ -457,9 +457,9 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
         for (name, source) in &b {
             match a.iter().find(|(n, _)| n == name) {
                 Some((_, old)) if old != source => {
-                    out.push(format!("mesh file {name} has changed since the checkpoint"))
+                    out.push(format!("file {name} has changed since the checkpoint"))
                 }
-                None => out.push(format!("mesh file {name} is not in the checkpoint")),
+                None => out.push(format!("file {name} is not in the checkpoint")),
                 _ => {}
             }
         }

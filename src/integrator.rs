@@ -122,10 +122,14 @@ fn step(
     sampler: &mut impl Sampler,
 ) -> Step {
     let Some(hit) = hit else {
-        return Step::Done(path.radiance + path.throughput * scene.background.color(ray.direction));
+        let mut sky = path.throughput * scene.background.color(ray.direction);
+        if let Some((_, bsdf_pdf)) = path.sampled_from {
+            sky *= power_heuristic(bsdf_pdf, scene.lights.environment_pdf(ray.direction));
+        }
+        return Step::Done(path.radiance + sky);
     };
     let record = scene.record(ray, hit);
-    let material = &scene.materials[record.material as usize];
+    let material = &scene.material_at(&record);
     if let Material::Emissive(light) = material {
         let mut emitted = path.throughput * light.emitted(&record);
         if let (Some((from, bsdf_pdf)), Some(i)) = (path.sampled_from, scene.light_of(&hit)) {
@@ -184,8 +188,9 @@ fn roulette(scene: &Scene, depth: u32) -> bool {
 }
 
 /// Whether a bounce at the end of segment `depth` samples a light: with the
-/// `path` integrator, when the scene has lights and the shadow ray (segment
-/// `depth + 1`) is within the path's length.
+/// `path` integrator, when the scene has lights (the environment among
+/// them, unless it is black) and the shadow ray (segment `depth + 1`) is
+/// within the path's length.
 #[inline(always)]
 fn samples_lights(scene: &Scene, depth: u32) -> bool {
     scene.settings.integrator == Integrator::Path
@@ -220,16 +225,21 @@ fn direct_light(
     // and is aimed from there at the light point, ending just short of it by
     // the point's own rounding: along `wi` from the moved start it would
     // meet a light's plane before the point, and the light would shadow
-    // itself (far from the origin, where the rounding bounds grow).
+    // itself (far from the origin, where the rounding bounds grow). The
+    // environment is infinitely far along `wi`.
     let origin = record.spawn_origin(wi);
-    let to = sample.point - origin;
-    let length = to.length();
-    let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
+    let (shadow, end) = if sample.distance.is_infinite() {
+        (Ray::new(origin, wi), f32::INFINITY)
+    } else {
+        let to = sample.point - origin;
+        let length = to.length();
+        let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
+        (Ray::new(origin, to / length), end)
+    };
     if !(end > scene.settings.epsilon) {
         // Closer than the nearest hit a bounce can make: out of reach.
         return (Color::ZERO, false);
     }
-    let shadow = Ray::new(origin, to / length);
     if scene.occluded(&shadow, Interval::new(scene.settings.epsilon, end)) {
         return (Color::ZERO, true);
     }

@@ -13,7 +13,10 @@
 //!   intersection kernel exists once.
 //! - [`material`]: diffuse (four bounce models, two attenuation forms),
 //!   metal, dielectric.
-//! - [`light`]: emissive surfaces gathered to be aimed at (next-event estimation).
+//! - [`light`]: emissive surfaces and the background, gathered to be aimed at
+//!   (next-event estimation); [`distribution`]: drawing in proportion to a
+//!   table of weights.
+//! - [`texture`]: images read from files.
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampler`]: the numbers behind every random decision of a path
@@ -48,6 +51,7 @@ pub mod adaptive;
 pub mod bench;
 pub mod camera;
 pub mod checkpoint;
+pub mod distribution;
 pub mod film;
 pub mod gallery;
 pub mod geometry;
@@ -66,3 +70,4 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod texture;

@@ -48,7 +48,7 @@ pub fn unit_vector(u: [f32; 2]) -> Vec3 {
 /// of the larger costs of a diffuse bounce, and it forces the render loop to
 /// save and restore every vector register around it.
 #[inline(always)]
-fn sin_cos_turns(u: f32) -> (f32, f32) {
+pub(crate) fn sin_cos_turns(u: f32) -> (f32, f32) {
     // The nearest quarter turn q, and the rest as an angle in [−π/4, π/4].
     let x = 4.0 * u;
     // Rounded by truncation (x ≥ 0): `round` is a library call on the

@@ -10,41 +10,10 @@
 mod common;
 
 use common::{
-    assert_agree, ball_in_light, builtin_desc, compile_file, pixel_stats, scratch_dir, PixelStats,
-    K,
+    assert_tiles_agree, ball_in_light, builtin_desc, compile_file, pixel_stats, scratch_dir,
+    tiles_agree, PixelStats, K,
 };
 use lumen::scene::{Integrator, Sampling, Scene};
-
-/// Each 8 × 8 tile of two renders of one view agrees in every channel, and
-/// the first (the `path` render) has the smaller standard error over the
-/// image.
-fn assert_tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) {
-    let noise = tiles_agree(what, path, bsdf);
-    assert!(
-        noise.0 < noise.1,
-        "{what}: path's tiles are noisier ({} against {})",
-        noise.0,
-        noise.1
-    );
-}
-
-/// Each 8 × 8 tile of two renders of one view agrees in every channel;
-/// returns the sums of the tiles' standard errors of each.
-fn tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) -> (f64, f64) {
-    let mut noise = (0.0, 0.0);
-    for c in 0..3 {
-        for ty in 0..path.height / 8 {
-            for tx in 0..path.width / 8 {
-                let tile = |s: &PixelStats| s.region(tx * 8..tx * 8 + 8, ty * 8..ty * 8 + 8, c);
-                let (a, b) = (tile(path), tile(bsdf));
-                assert_agree(&format!("{what}: tile ({tx}, {ty}), channel {c}"), a, b);
-                noise.0 += a.1;
-                noise.1 += b.1;
-            }
-        }
-    }
-    noise
-}
 
 /// `text`'s scene rendered with each integrator.
 fn both(dir: &std::path::Path, text: &str) -> (PixelStats, PixelStats) {

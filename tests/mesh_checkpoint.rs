@@ -117,8 +117,8 @@ fn resume_refuses_a_changed_mesh_and_finishes_an_unchanged_one_bit_identically()
         let (status, err) = run(&args, &out, &["--resume"]);
         assert_eq!(status.code(), Some(1), "{name}: {err}");
         assert!(
-            err.contains(&format!("mesh file {name} has changed"))
-                || err.contains(&format!("mesh file \"{name}\" has changed")),
+            err.contains(&format!("file {name} has changed"))
+                || err.contains(&format!("file \"{name}\" has changed")),
             "{name}: {err}"
         );
         assert!(

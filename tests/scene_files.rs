@@ -4,7 +4,7 @@
 use lumen::render::render;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::file::{export, Format, SceneFile};
-use lumen::scene::{Integrator, Overrides, Sampling, Scene};
+use lumen::scene::{Integrator, LightSelection, Overrides, Sampling, Scene};
 use std::path::{Path, PathBuf};
 
 fn examples_dir() -> PathBuf {
@@ -155,6 +155,7 @@ fn overrides_replace_the_files_settings() {
         seed: Some(11),
         sampler: Some(Sampling::Stratified),
         integrator: Some(Integrator::Bsdf),
+        light_selection: Some(LightSelection::Uniform),
         noise_target: Some(0.25),
     };
     let s = file.compile(&o).unwrap().settings;
@@ -167,6 +168,10 @@ fn overrides_replace_the_files_settings() {
     assert_eq!(
         (own.settings.integrator, s.integrator),
         (Integrator::Path, Integrator::Bsdf)
+    );
+    assert_eq!(
+        (own.settings.light_selection, s.light_selection),
+        (LightSelection::Power, LightSelection::Uniform)
     );
 }
 

@@ -120,7 +120,7 @@ fn expected() -> SceneDesc {
     desc.materials.insert(
         "grey".into(),
         MaterialDesc::Diffuse {
-            albedo: [0.5; 3],
+            albedo: [0.5; 3].into(),
             bounce: Default::default(),
             attenuation: Default::default(),
         },
@@ -128,7 +128,7 @@ fn expected() -> SceneDesc {
     desc.materials.insert(
         "gold".into(),
         MaterialDesc::Metal {
-            albedo: [0.8, 0.6, 0.2],
+            albedo: [0.8, 0.6, 0.2].into(),
             fuzz: 0.1,
         },
     );

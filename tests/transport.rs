@@ -36,7 +36,7 @@ fn hit_facing_up() -> HitRecord {
 
 fn diffuse_desc(albedo: f64, bounce: BounceDesc, attenuation: AttenuationDesc) -> MaterialDesc {
     MaterialDesc::Diffuse {
-        albedo: [albedo; 3],
+        albedo: [albedo; 3].into(),
         bounce,
         attenuation,
     }
@@ -191,7 +191,7 @@ fn white_furnace_diffuse_albedo_one_is_white() {
 #[test]
 fn white_furnace_mirror_and_glass_are_white() {
     let mirror = MaterialDesc::Metal {
-        albedo: [1.0; 3],
+        albedo: [1.0; 3].into(),
         fuzz: 0.0,
     };
     assert_white("mirror", mirror, 50);
@@ -257,7 +257,7 @@ fn white_furnace_fuzzy_metal_loses_exactly_the_absorbed_light() {
     let expected = 1.0 - lost / (4.0 * f64::from(W) / f64::from(H));
 
     let material = MaterialDesc::Metal {
-        albedo: [1.0; 3],
+        albedo: [1.0; 3].into(),
         fuzz,
     };
     let stats = pixel_stats(&furnace(material, W, H, 64, 50));

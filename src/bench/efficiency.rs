@@ -33,7 +33,7 @@ pub fn sky_spheres() -> SceneDesc {
         match material {
             MaterialDesc::Dielectric { .. } => {
                 *material = MaterialDesc::Metal {
-                    albedo: [1.0, 1.0, 1.0],
+                    albedo: [1.0, 1.0, 1.0].into(),
                     fuzz: 0.0,
                 }
             }

@@ -69,7 +69,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
         color: [1.0, 1.0, 1.0],
     };
     let diffuse = |a: f64| MaterialDesc::Diffuse {
-        albedo: [a; 3],
+        albedo: [a; 3].into(),
         bounce: BounceDesc::Lambertian,
         attenuation: AttenuationDesc::Scale,
     };
@@ -256,7 +256,7 @@ pub fn sphere_field(n: usize) -> SceneDesc {
             0..=11 => (
                 format!("field-diffuse{i}"),
                 MaterialDesc::Diffuse {
-                    albedo: [0; 3].map(|_| rng.next_f64() * rng.next_f64()),
+                    albedo: [0; 3].map(|_| rng.next_f64() * rng.next_f64()).into(),
                     bounce: BounceDesc::Lambertian,
                     attenuation: AttenuationDesc::Scale,
                 },
@@ -264,7 +264,7 @@ pub fn sphere_field(n: usize) -> SceneDesc {
             12..=14 => (
                 format!("field-metal{i}"),
                 MaterialDesc::Metal {
-                    albedo: [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64()),
+                    albedo: [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64()).into(),
                     fuzz: 0.5 * rng.next_f64(),
                 },
             ),

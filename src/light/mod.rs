@@ -1,14 +1,22 @@
-//! Lights: the emissive surfaces of a scene, gathered so that a path can aim
-//! at them (next-event estimation) instead of only meeting them by chance.
+//! Lights: the emissive surfaces of a scene and its environment, gathered so
+//! that a path can aim at them (next-event estimation) instead of only
+//! meeting them by chance.
 //!
 //! Every emissive sphere, quad and triangle becomes a [`Light`] in world
-//! space. A [`Lights`] list chooses one in proportion to its power (emitted
-//! radiance × area × π, twice that for two-sided lights) and samples a point
-//! on it: spheres by the solid angle of the cap seen from the shaded point,
-//! quads and triangles uniformly by area. [`Lights::pdf`] gives the density,
+//! space; the [`Environment`] (what escaping rays see) is one more. A
+//! [`Lights`] list chooses one in proportion to its power (emitted radiance
+//! × area × π, twice that for two-sided lights; see [`LightSelection`]) or
+//! uniformly, and samples a point on it: spheres by the solid angle of the
+//! cap seen from the shaded point, quads and triangles uniformly by area, the
+//! environment by its brightness. [`Lights::pdf`] gives the density,
 //! per unit solid angle, with which a direction that happens to meet a light
 //! would have been sampled, which multiple importance sampling needs.
 
+pub mod environment;
+
+pub use environment::{Environment, EnvironmentMap};
+
+use crate::distribution::Distribution1D;
 use crate::material::Emissive;
 use crate::math::{Color, Point3, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -84,11 +92,12 @@ pub fn luminance(c: Color) -> f32 {
 /// A point sampled on a light, seen from a shaded point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
-    /// The point on the light.
+    /// The point on the light (for the environment, infinitely far away:
+    /// the shaded point moved one unit along `direction`).
     pub point: Point3,
     /// Unit direction from the shaded point to the light point.
     pub direction: Vec3,
-    /// Distance to the light point.
+    /// Distance to the light point (infinite for the environment).
     pub distance: f32,
     /// Radiance arriving from the light point along `-direction` (before
     /// any occlusion).
@@ -98,72 +107,99 @@ pub struct LightSample {
     pub pdf: f32,
 }
 
-/// The lights of a scene, and how to choose among them.
+/// How [`Lights`] chooses the light to sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightSelection {
+    /// In proportion to each light's power (the environment's: its
+    /// radiance over the sphere of directions, through the disc of the
+    /// scene's bounding sphere).
+    #[default]
+    Power,
+    /// Every light that emits anything equally often.
+    Uniform,
+}
+
+/// The lights of a scene (its emissive surfaces, and the environment when
+/// it sheds light), and how to choose among them.
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
     lights: Vec<Light>,
-    /// Cumulative powers, normalised to end at 1.
-    cdf: Vec<f32>,
-    /// The probability of choosing each light.
-    chance: Vec<f32>,
+    /// The environment, chosen as light number `lights.len()`.
+    environment: Option<Environment>,
+    /// The choice of a light: `lights`, then the environment.
+    choice: Distribution1D,
 }
 
 impl Lights {
     /// The list of `lights`, in order (a light's index is its place in
-    /// `lights`). Lights of no power are never chosen; when none has any
-    /// power the list is empty.
-    pub fn new(lights: Vec<Light>) -> Self {
-        let powers: Vec<f64> = lights.iter().map(Light::power).collect();
-        let total: f64 = powers.iter().sum();
-        if !(total > 0.0 && total.is_finite()) {
+    /// `lights`), and the `environment` seen by rays that escape a scene
+    /// whose bounding sphere has radius `scene_radius`. Lights of no power
+    /// are never chosen; when nothing sheds any light the list is empty.
+    pub fn new(
+        lights: Vec<Light>,
+        environment: Option<Environment>,
+        scene_radius: f32,
+        selection: LightSelection,
+    ) -> Self {
+        // The environment's power is its light through the disc the scene
+        // presents to it (π r²), whichever way it comes.
+        let disc = std::f64::consts::PI * f64::from(scene_radius.max(f32::MIN_POSITIVE)).powi(2);
+        let environment_power = environment.as_ref().map(|e| e.integral() * disc);
+        let mut powers: Vec<f64> = lights.iter().map(Light::power).collect();
+        powers.extend(environment_power);
+        if selection == LightSelection::Uniform {
+            for p in &mut powers {
+                *p = if *p > 0.0 { 1.0 } else { 0.0 };
+            }
+        }
+        let Some(choice) = Distribution1D::new(&powers) else {
             return Lights::default();
-        }
-        let mut running = 0.0;
-        let mut cdf: Vec<f32> = powers
-            .iter()
-            .map(|p| {
-                running += p;
-                (running / total) as f32
-            })
-            .collect();
-        // Every u in [0, 1) chooses a light.
-        if let Some(last) = cdf.last_mut() {
-            *last = 1.0;
-        }
-        // The chance of each light is the width of its step of the f32
-        // table that chooses it, not its exact share: with millions of
-        // lights the two differ, and the weights must use what is sampled.
-        let chance = (0..cdf.len())
-            .map(|i| cdf[i] - if i == 0 { 0.0 } else { cdf[i - 1] })
-            .collect();
+        };
         Lights {
             lights,
-            cdf,
-            chance,
+            environment,
+            choice,
         }
     }
 
     /// Whether there is no light to sample.
     pub fn is_empty(&self) -> bool {
-        self.lights.is_empty()
+        self.choice.is_empty()
     }
 
-    /// The number of lights.
+    /// The number of lights, the environment included.
     pub fn len(&self) -> usize {
-        self.lights.len()
+        self.choice.len()
     }
 
-    /// Chooses a light in proportion to its power and samples a direction
+    /// The probability of choosing light `i` (the environment is light
+    /// number [`Lights::len`] − 1 when there is one).
+    pub fn chance(&self, i: usize) -> f32 {
+        self.choice.chance(i)
+    }
+
+    /// Chooses a light (see [`LightSelection`]) and samples a direction
     /// from `point` towards it; `None` when the sample carries no light (the
     /// back of a one-sided light, a degenerate direction).
     pub fn sample(&self, point: Point3, sampler: &mut impl Sampler) -> Option<LightSample> {
-        let u = sampler.get_1d(Dim::LightChoice);
-        let i = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .min(self.lights.len() - 1);
-        let light = &self.lights[i];
+        let i = self.choice.sample(sampler.get_1d(Dim::LightChoice));
+        let chance = self.choice.chance(i);
         let uv = sampler.get_2d(Dim::Light);
+        let Some(light) = self.lights.get(i) else {
+            let sky = self.environment.as_ref()?.sample(uv)?;
+            let pdf = chance * sky.pdf;
+            if !(pdf > 0.0 && pdf.is_finite()) {
+                return None;
+            }
+            return Some(LightSample {
+                point: point + sky.direction,
+                direction: sky.direction,
+                distance: f32::INFINITY,
+                radiance: sky.radiance,
+                pdf,
+            });
+        };
         let (target, outward) = match light.shape {
             Shape::Sphere { center, radius } if !inside(center, radius, point) => {
                 sample_cap(center, radius, point, uv)
@@ -173,7 +209,7 @@ impl Lights {
         let to = target - point;
         let distance = to.length();
         let direction = to / distance;
-        let pdf = self.chance[i] * solid_angle_density(&light.shape, point, target, outward);
+        let pdf = chance * solid_angle_density(&light.shape, point, target, outward);
         if !(pdf > 0.0 && pdf.is_finite() && distance > 0.0 && distance.is_finite()) {
             return None;
         }
@@ -190,13 +226,24 @@ impl Lights {
     /// `from` picks the direction that meets light `i` at `point` (outward
     /// normal `outward`).
     pub fn pdf(&self, i: usize, from: Point3, point: Point3, outward: Vec3) -> f32 {
-        let (Some(light), Some(&chance)) = (self.lights.get(i), self.chance.get(i)) else {
+        let (Some(light), chance) = (self.lights.get(i), self.choice.chance(i)) else {
             return 0.0;
         };
         if chance == 0.0 {
             return 0.0;
         }
         chance * solid_angle_density(&light.shape, from, point, outward)
+    }
+
+    /// The density per unit solid angle with which [`Lights::sample`] picks
+    /// unit `direction` towards the environment (0 when the environment is
+    /// not sampled).
+    #[inline]
+    pub fn environment_pdf(&self, direction: Vec3) -> f32 {
+        match &self.environment {
+            Some(sky) => self.choice.chance(self.lights.len()) * sky.pdf(direction),
+            None => 0.0,
+        }
     }
 }
 

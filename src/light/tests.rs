@@ -19,6 +19,11 @@ fn light(shape: Shape) -> Light {
     emitting(shape, Color::ONE, true)
 }
 
+/// `lights` without an environment, chosen by power.
+fn area_lights(lights: Vec<Light>) -> Lights {
+    Lights::new(lights, None, 0.0, LightSelection::Power)
+}
+
 /// Mean and standard error of `f` over `n` samples.
 fn estimate(n: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
     let (mut s, mut s2) = (0.0, 0.0);
@@ -36,7 +41,7 @@ fn estimate(n: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
 /// [`Lights::pdf`] at the point it reached, and returns the estimate of the
 /// solid angle the light covers, E[1/pdf].
 fn solid_angle_estimate(shape: Shape, from: Point3) -> (f64, f64) {
-    let lights = Lights::new(vec![light(shape)]);
+    let lights = area_lights(vec![light(shape)]);
     let mut rng = Rng::new(17);
     estimate(200_000, || {
         let s = lights.sample(from, &mut rng).expect("a sample");
@@ -135,7 +140,7 @@ fn lights_are_chosen_in_proportion_to_their_power() {
     };
     // Powers 1 : 4 (twice the side) : 0 (black, never chosen) : 2 (one
     // side, but four times the radiance).
-    let lights = Lights::new(vec![
+    let lights = area_lights(vec![
         light(quad(0.0, 1.0)),
         light(quad(5.0, 2.0)),
         emitting(quad(10.0, 1.0), Color::ZERO, true),
@@ -177,7 +182,7 @@ fn a_one_sided_light_sends_nothing_behind_it() {
         v: Vec3::new(0.0, 0.0, 2.0),
     };
     // u × v points down (−y): lit below, dark above.
-    let lights = Lights::new(vec![emitting(shape, Color::ONE, false)]);
+    let lights = area_lights(vec![emitting(shape, Color::ONE, false)]);
     let mut rng = Rng::new(5);
     for _ in 0..100 {
         let below = lights.sample(Vec3::ZERO, &mut rng).unwrap();
@@ -185,4 +190,96 @@ fn a_one_sided_light_sends_nothing_behind_it() {
         let above = lights.sample(Vec3::new(0.0, 2.0, 0.0), &mut rng).unwrap();
         assert_eq!(above.radiance, Color::ZERO);
     }
+}
+
+/// The chance of each light, checked against the rule: by power (the
+/// environment's through the disc of the scene's bounding sphere), or
+/// equally among lights that emit.
+#[test]
+fn lights_and_the_sky_are_chosen_by_power_or_uniformly() {
+    let quad = Shape::Quad {
+        corner: Vec3::ZERO,
+        u: Vec3::X,
+        v: Vec3::Z,
+    };
+    // A one-sided unit quad of radiance 1: power π. A grey sky of 0.5 round
+    // a scene of radius 2: 0.5 · 4π · π · 2² = 8π².
+    let lights = vec![
+        emitting(quad, Color::ONE, false),
+        emitting(quad, Color::ZERO, false),
+    ];
+    let sky = Environment::Solid(Color::splat(0.5));
+    let by_power = Lights::new(
+        lights.clone(),
+        Some(sky.clone()),
+        2.0,
+        LightSelection::Power,
+    );
+    assert_eq!(by_power.len(), 3);
+    let (quad_power, sky_power) = (PI, 8.0 * PI * PI);
+    let expected = quad_power / (quad_power + sky_power);
+    assert!((by_power.chance(0) - expected).abs() < 1e-6);
+    assert_eq!(by_power.chance(1), 0.0);
+    assert!((by_power.chance(2) - (1.0 - expected)).abs() < 1e-6);
+    let uniform = Lights::new(lights.clone(), Some(sky), 2.0, LightSelection::Uniform);
+    assert_eq!(
+        [uniform.chance(0), uniform.chance(1), uniform.chance(2)],
+        [0.5, 0.0, 0.5]
+    );
+    // A black sky is no light; nothing at all is no list.
+    let black = Lights::new(
+        lights,
+        Some(Environment::Solid(Color::ZERO)),
+        2.0,
+        LightSelection::Power,
+    );
+    assert_eq!([black.chance(0), black.chance(2)], [1.0, 0.0]);
+    assert_eq!(black.environment_pdf(Vec3::Y), 0.0);
+    let none = Lights::new(
+        Vec::new(),
+        Some(Environment::Solid(Color::ZERO)),
+        2.0,
+        LightSelection::Uniform,
+    );
+    assert!(none.is_empty());
+}
+
+/// A sky sample is infinitely far, carries the sky's radiance, and its
+/// density is the sky's times the sky's chance, as `environment_pdf` says.
+#[test]
+fn a_sky_sample_is_infinitely_far_and_weighted_by_its_chance() {
+    let quad = Shape::Quad {
+        corner: Vec3::new(0.0, 3.0, 0.0),
+        u: Vec3::X,
+        v: Vec3::Z,
+    };
+    let sky = Environment::Gradient {
+        bottom: Color::ZERO,
+        top: Color::splat(2.0),
+    };
+    let lights = Lights::new(
+        vec![light(quad)],
+        Some(sky.clone()),
+        1.0,
+        LightSelection::Uniform,
+    );
+    let mut rng = Rng::new(9);
+    let mut seen_sky = 0;
+    for _ in 0..1000 {
+        let Some(s) = lights.sample(Vec3::ZERO, &mut rng) else {
+            continue;
+        };
+        if s.distance.is_infinite() {
+            seen_sky += 1;
+            assert_eq!(s.radiance, sky.color(s.direction));
+            assert_eq!(s.pdf, 0.5 * sky.pdf(s.direction));
+            assert_eq!(s.pdf, lights.environment_pdf(s.direction));
+        } else {
+            assert!(s.distance.is_finite() && s.point.y == 3.0);
+        }
+    }
+    assert!(
+        (400..600).contains(&seen_sky),
+        "{seen_sky} of 1000 from the sky"
+    );
 }

@@ -58,6 +58,26 @@ impl Material {
         }
     }
 
+    /// The material with its colour replaced by `c` (a texture's value):
+    /// the albedo of a diffuse or metal surface (kept within [0, 1], so that
+    /// no surface reflects more than it receives), the radiance of an
+    /// emissive one. Glass has no colour.
+    #[inline]
+    pub fn with_color(self, c: Color) -> Material {
+        match self {
+            Material::Diffuse(m) => Material::Diffuse(Diffuse {
+                albedo: c.clamp(Color::ZERO, Color::ONE),
+                ..m
+            }),
+            Material::Metal(m) => Material::Metal(Metal {
+                albedo: c.clamp(Color::ZERO, Color::ONE),
+                ..m
+            }),
+            Material::Emissive(m) => Material::Emissive(Emissive { radiance: c, ..m }),
+            Material::Dielectric(_) => self,
+        }
+    }
+
     /// What the material emits, if it gives off any light.
     pub fn light(&self) -> Option<Emissive> {
         match *self {

@@ -5,8 +5,9 @@
 //! them can be exported and edited.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, IntegratorDesc, MaterialDesc,
-    ObjectDesc, RenderDesc, SamplingDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, ColorDesc, IntegratorDesc,
+    MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, SceneDesc, ShadingDesc,
+    TextureDesc, TransformDesc, Triple,
 };
 use crate::rng::Rng;
 
@@ -104,6 +105,8 @@ scenes! {
     "cover", "The cover: a random field of spheres, glass, diffuse and metal" => cover;
   }
   NextWeek {
+    "checkered-spheres", "The Next Week: two spheres under a 3-D checker texture" => checkered_spheres;
+    "perlin-spheres", "The Next Week: Perlin-noise marble on a ground sphere and a ball" => perlin_spheres;
     "quads", "The Next Week: five coloured quads, the sides of an open box, seen from the front" => quads;
     "cornell-box", "The Next Week: the Cornell box, its ceiling light found only by chance (noisy; --integrator path aims at it)" => cornell_box;
   }
@@ -126,6 +129,11 @@ impl Builder {
                 ..SceneDesc::default()
             },
         }
+    }
+
+    fn texture(mut self, name: &str, t: TextureDesc) -> Self {
+        self.desc.textures.insert(name.to_string(), t);
+        self
     }
 
     fn material(mut self, name: &str, m: MaterialDesc) -> Self {
@@ -215,7 +223,7 @@ fn figure(render: RenderDesc) -> RenderDesc {
 
 fn diffuse(albedo: Triple, bounce: BounceDesc) -> MaterialDesc {
     MaterialDesc::Diffuse {
-        albedo,
+        albedo: albedo.into(),
         bounce,
         attenuation: AttenuationDesc::Scale,
     }
@@ -226,7 +234,10 @@ fn lambertian(albedo: Triple) -> MaterialDesc {
 }
 
 fn metal(albedo: Triple, fuzz: f64) -> MaterialDesc {
-    MaterialDesc::Metal { albedo, fuzz }
+    MaterialDesc::Metal {
+        albedo: albedo.into(),
+        fuzz,
+    }
 }
 
 fn glass_material(ior: f64, refract_only: bool) -> MaterialDesc {
@@ -320,7 +331,7 @@ fn bounce(model: BounceDesc) -> SceneDesc {
 
 fn albedo_grey(attenuation: AttenuationDesc) -> SceneDesc {
     let m = |a: f64| MaterialDesc::Diffuse {
-        albedo: [a; 3],
+        albedo: [a; 3].into(),
         bounce: BounceDesc::Lambertian,
         attenuation,
     };
@@ -515,6 +526,60 @@ fn pinhole(vfov: f64, lookfrom: Triple, lookat: Triple) -> CameraDesc {
     }
 }
 
+/// The sky-blue background of *The Next Week*'s figures.
+const NEXT_WEEK_SKY: BackgroundDesc = BackgroundDesc::Solid {
+    color: [0.7, 0.8, 1.0],
+};
+
+/// A diffuse material whose albedo is texture `texture`.
+fn textured(texture: &str) -> MaterialDesc {
+    MaterialDesc::Diffuse {
+        albedo: ColorDesc::Texture(texture.to_string()),
+        bounce: BounceDesc::Lambertian,
+        attenuation: AttenuationDesc::Scale,
+    }
+}
+
+/// Two spheres of radius 10, one above the other, touching at the origin,
+/// both of a checker of 0.8-unit cubes.
+fn checkered_spheres() -> SceneDesc {
+    Builder::new(next_week(400, 100, 16.0 / 9.0))
+        .texture(
+            "checker",
+            TextureDesc::Checker {
+                scale: 0.8,
+                even: [0.2, 0.3, 0.1].into(),
+                odd: [0.9, 0.9, 0.9].into(),
+            },
+        )
+        .material("checker", textured("checker"))
+        .sphere([0.0, -10.0, 0.0], 10.0, "checker")
+        .sphere([0.0, 10.0, 0.0], 10.0, "checker")
+        .background(NEXT_WEEK_SKY)
+        .camera(pinhole(20.0, [13.0, 2.0, 3.0], [0.0; 3]))
+        .build()
+}
+
+/// A ball of radius 2 on a ground sphere, both of Perlin marble at
+/// frequency 4.
+fn perlin_spheres() -> SceneDesc {
+    Builder::new(next_week(400, 100, 16.0 / 9.0))
+        .texture(
+            "marble",
+            TextureDesc::Noise {
+                scale: 4.0,
+                pattern: NoisePatternDesc::Marble,
+                seed: 0,
+            },
+        )
+        .material("marble", textured("marble"))
+        .sphere([0.0, -1000.0, 0.0], 1000.0, "marble")
+        .sphere([0.0, 2.0, 0.0], 2.0, "marble")
+        .background(NEXT_WEEK_SKY)
+        .camera(pinhole(20.0, [13.0, 2.0, 3.0], [0.0; 3]))
+        .build()
+}
+
 fn quads() -> SceneDesc {
     Builder::new(next_week(400, 100, 1.0))
         .material("left-red", lambertian([1.0, 0.2, 0.2]))
@@ -552,9 +617,7 @@ fn quads() -> SceneDesc {
             [0.0, 0.0, -4.0],
             "lower-teal",
         )
-        .background(BackgroundDesc::Solid {
-            color: [0.7, 0.8, 1.0],
-        })
+        .background(NEXT_WEEK_SKY)
         .camera(pinhole(80.0, [0.0, 0.0, 9.0], [0.0; 3]))
         .build()
 }
@@ -571,7 +634,7 @@ pub fn cornell_box() -> SceneDesc {
         .material(
             "light",
             MaterialDesc::Emissive {
-                radiance: [15.0; 3],
+                radiance: [15.0; 3].into(),
                 two_sided: true,
             },
         )

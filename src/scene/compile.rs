@@ -3,21 +3,25 @@
 //! placed once in world space or shared by instances.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc,
+    AttenuationDesc, BackgroundDesc, BounceDesc, ColorDesc, MaterialDesc, ObjectDesc, ScaleDesc,
+    TransformDesc,
 };
+use super::textures::{read_image, ColorRef, TextureTable};
 use super::world::{Group, Mesh, Shapes, Surface, World};
 use super::{
-    invalid, Background, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings,
-    MAX_COORDINATE, MAX_PIXELS,
+    invalid, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings, MAX_COORDINATE,
+    MAX_PIXELS,
 };
 use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
+use crate::light::{Environment, EnvironmentMap, Lights};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::{Color, Vec3};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The factor of [`HitRecord::error`]: the hit point and its offset from the
 /// centre are each rounded to about 2⁻²⁴ of their size (the point's
@@ -39,7 +43,7 @@ fn vec3(t: [f64; 3]) -> Vec3 {
 /// Accepts numbers that stay finite once converted to the renderer's `f32`.
 /// `field` is only formatted when a number is refused (scene files may hold
 /// millions of spheres).
-fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
+pub(super) fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
     // `!(a <= b)` also catches NaN.
     match values.iter().find(|v| !(v.abs() <= f64::from(f32::MAX))) {
         None => Ok(()),
@@ -53,7 +57,7 @@ fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneErro
     }
 }
 
-fn color(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+pub(super) fn color(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
     finite(field, &c)?;
     if c.iter().any(|&v| v < 0.0) {
         return Err(invalid(
@@ -87,37 +91,44 @@ impl Scene {
     pub fn from_desc_in(desc: &SceneDesc, base: &Path) -> Result<Scene, SceneError> {
         let settings = compile_settings(desc)?;
         let camera = compile_camera(desc, &settings)?;
-        let background = match &desc.background {
-            BackgroundDesc::Gradient { bottom, top } => Background::Gradient {
-                bottom: color("background.bottom", *bottom)?,
-                top: color("background.top", *top)?,
-            },
-            BackgroundDesc::Solid { color: c } => Background::Solid(color("background.color", *c)?),
-        };
         let mut materials = Vec::with_capacity(desc.materials.len());
+        let mut material_textures = Vec::with_capacity(desc.materials.len());
         let mut material_index = HashMap::with_capacity(desc.materials.len());
+        let mut table = TextureTable::new(&desc.textures, base);
+        let mut sources = Vec::new();
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);
-            materials.push(compile_material(&format!("materials.{name}"), m)?);
+            let field = format!("materials.{name}");
+            let (material, texture) = compile_material(&field, m, &mut table, &mut sources)?;
+            materials.push(material);
+            material_textures.push(texture);
         }
+        let textures = table.textures;
+        // Spheres work out their (u, v) only for textures that use them.
+        let sphere_uv: Vec<bool> = material_textures
+            .iter()
+            .map(|t| t.is_some_and(|t| textures[t as usize].uses_uv(&textures)))
+            .collect();
         let mut objects = Objects {
             desc,
             base,
             materials,
             material_index,
+            sphere_uv,
             top: Shapes::default(),
             spheres: Vec::with_capacity(desc.objects.len()),
             groups: Vec::new(),
             instances: Vec::new(),
             models: HashMap::new(),
             placements: Vec::new(),
-            sources: Vec::new(),
+            sources,
             stats: SceneStats::default(),
         };
         for (i, object) in desc.objects.iter().enumerate() {
             objects.add(i, object)?;
         }
         objects.place_meshes()?;
+        let background = compile_background(&desc.background, base, &mut objects.sources)?;
         let Objects {
             materials,
             top,
@@ -128,15 +139,25 @@ impl Scene {
             mut stats,
             ..
         } = objects;
+        // The materials of mesh files come last, untextured.
+        material_textures.resize(materials.len(), None);
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
         let (lights, light_ids) = world.lights(&materials);
+        let lights = Lights::new(
+            lights,
+            Some(background.clone()),
+            world.bounding_radius(),
+            settings.light_selection,
+        );
         Ok(Scene {
             settings,
             camera,
             background,
             materials,
+            textures,
+            material_textures,
             spheres,
             sources,
             stats,
@@ -145,6 +166,42 @@ impl Scene {
             world,
         })
     }
+}
+
+/// The environment of `desc`; an image is read relative to `base`, and
+/// recorded in `sources`.
+fn compile_background(
+    desc: &BackgroundDesc,
+    base: &Path,
+    sources: &mut Vec<MeshSource>,
+) -> Result<Environment, SceneError> {
+    Ok(match desc {
+        BackgroundDesc::Gradient { bottom, top } => Environment::Gradient {
+            bottom: color("background.bottom", *bottom)?,
+            top: color("background.top", *top)?,
+        },
+        BackgroundDesc::Solid { color: c } => Environment::Solid(color("background.color", *c)?),
+        BackgroundDesc::Image {
+            file,
+            rotation,
+            intensity,
+        } => {
+            finite("background.rotation", &[*rotation])?;
+            finite("background.intensity", &[*intensity])?;
+            if *intensity < 0.0 {
+                return Err(invalid(
+                    "background.intensity",
+                    format!("must not be negative, got {intensity}"),
+                ));
+            }
+            let image = read_image("background.file", base, file, sources)?;
+            match EnvironmentMap::new(image, *rotation as f32, *intensity as f32) {
+                Some(map) => Environment::Map(Arc::new(map)),
+                // Black everywhere: it sheds no light.
+                None => Environment::Solid(Color::ZERO),
+            }
+        }
+    })
 }
 
 fn compile_camera(desc: &SceneDesc, settings: &Settings) -> Result<Camera, SceneError> {
@@ -207,6 +264,9 @@ struct Objects<'a> {
     base: &'a Path,
     materials: Vec<Material>,
     material_index: HashMap<&'a str, u32>,
+    /// Per material of the description: whether spheres of it need their
+    /// (u, v).
+    sphere_uv: Vec<bool>,
     top: Shapes,
     spheres: Vec<Sphere>,
     groups: Vec<Group>,
@@ -259,21 +319,32 @@ impl<'a> Objects<'a> {
                 }
                 let m = self.material(i, material)?;
                 let sphere = Sphere::new(vec3(*center), *radius as f32);
-                match similarity(&transform) {
+                // A textured sphere that is turned keeps its own space, so
+                // that its texture turns with it.
+                let uv = self.sphere_uv[m as usize];
+                let keeps_texture = |scale: f32| {
+                    !uv || [Vec3::X, Vec3::Y, Vec3::Z]
+                        .iter()
+                        .all(|&e| (transform.vector(e) / scale - e).length() <= 1e-6)
+                };
+                match similarity(&transform).filter(|&scale| keeps_texture(scale)) {
                     Some(scale) => {
                         let placed =
                             Sphere::new(transform.point(sphere.center), sphere.radius * scale);
                         if !placed.center.is_finite() || !(placed.radius.is_finite()) {
                             return Err(out_of_range(i));
                         }
-                        self.top.spheres.push(Surface::new(&placed, m));
+                        self.top.spheres.push(Surface::new(&placed, m, uv));
                         self.spheres.push(placed);
                     }
                     None => {
-                        // Stretched unevenly: an ellipsoid, traced as the
-                        // sphere in its own space.
+                        // Stretched unevenly (an ellipsoid) or turned with
+                        // its texture: traced as the sphere in its own
+                        // space.
                         let mut shapes = Shapes::default();
-                        shapes.spheres.push(Surface::new(&sphere, m));
+                        // Placed by an instance, whose material may be
+                        // another: (u, v) always.
+                        shapes.spheres.push(Surface::new(&sphere, m, true));
                         self.groups.push(Group::new(shapes));
                         self.instances
                             .push((self.groups.len() as u32 - 1, transform, None));
@@ -668,20 +739,41 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         seed: r.seed,
         sampler: r.sampler,
         integrator: r.integrator,
+        light_selection: r.light_selection,
         gamma: r.gamma as f32,
         epsilon: r.epsilon as f32,
         shading: r.shading,
     })
 }
 
-fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneError> {
-    Ok(match m {
+/// The material `m` of field `field`, and the texture that gives its
+/// colour (albedo or radiance), if one does.
+fn compile_material<'a>(
+    field: &str,
+    m: &'a MaterialDesc,
+    textures: &mut TextureTable<'a>,
+    sources: &mut Vec<MeshSource>,
+) -> Result<(Material, Option<u32>), SceneError> {
+    // A textured colour leaves a placeholder that the texture replaces
+    // where a ray hits: 0 radiance, so that a textured emitter is not taken
+    // for a light of known power (it is found by the bounces).
+    let mut texture = None;
+    let mut colour = |name: &str, c: &'a ColorDesc, check| -> Result<Color, SceneError> {
+        match textures.color(&format!("{field}.{name}"), c, check, sources)? {
+            ColorRef::Rgb(c) => Ok(c),
+            ColorRef::Texture(t) => {
+                texture = Some(t);
+                Ok(Color::ZERO)
+            }
+        }
+    };
+    let material = match m {
         MaterialDesc::Diffuse {
             albedo: a,
             bounce,
             attenuation,
         } => Material::Diffuse(Diffuse {
-            albedo: albedo(&format!("{field}.albedo"), *a)?,
+            albedo: colour("albedo", a, albedo)?,
             bounce: match bounce {
                 BounceDesc::Cube => BounceModel::Cube,
                 BounceDesc::SphereVolume => BounceModel::SphereVolume,
@@ -702,7 +794,7 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
                 ));
             }
             Material::Metal(Metal {
-                albedo: albedo(&format!("{field}.albedo"), *a)?,
+                albedo: colour("albedo", a, albedo)?,
                 fuzz: *fuzz as f32,
             })
         }
@@ -723,10 +815,11 @@ fn compile_material(field: &str, m: &MaterialDesc) -> Result<Material, SceneErro
             radiance,
             two_sided,
         } => Material::Emissive(Emissive {
-            radiance: color(&format!("{field}.radiance"), *radiance)?,
+            radiance: colour("radiance", radiance, color)?,
             two_sided: *two_sided,
         }),
-    })
+    };
+    Ok((material, texture))
 }
 
 #[cfg(test)]

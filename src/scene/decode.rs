@@ -9,11 +9,13 @@
 //! users alike.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, IntegratorDesc, MaterialDesc,
-    ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, ColorDesc, IntegratorDesc,
+    MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc,
+    ShadingDesc, TextureDesc, TransformDesc, Triple,
 };
 use super::hint;
 use super::source::{Entry, Node, Value};
+use crate::light::LightSelection;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -224,6 +226,22 @@ fn triple(node: &Node, path: &str) -> Result<Triple> {
     ))
 }
 
+/// A colour as a triple, or the name of a texture.
+fn color_or_texture(node: &Node, path: &str) -> Result<ColorDesc> {
+    match &node.value {
+        Value::String(name) => Ok(ColorDesc::Texture(name.clone())),
+        Value::Array(_) => Ok(ColorDesc::Rgb(triple(node, path)?)),
+        other => Err(error(
+            path,
+            &node.span,
+            format!(
+                "expected an array of 3 numbers [r, g, b] or the name of a texture, got {}",
+                other.describe()
+            ),
+        )),
+    }
+}
+
 fn string<'a>(node: &'a Node, path: &str) -> Result<&'a str> {
     match &node.value {
         Value::String(s) => Ok(s),
@@ -280,6 +298,7 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
             "render",
             "camera",
             "background",
+            "textures",
             "materials",
             "objects",
         ],
@@ -295,8 +314,13 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
         background: t
             .optional("background", |n, _| background(n))?
             .unwrap_or_default(),
+        textures: t
+            .optional("textures", |n, _| named(n, "textures", "texture", texture))?
+            .unwrap_or_default(),
         materials: t
-            .optional("materials", |n, _| materials(n))?
+            .optional("materials", |n, _| {
+                named(n, "materials", "material", material)
+            })?
             .unwrap_or_default(),
         objects: t
             .optional("objects", |n, _| objects(n))?
@@ -304,30 +328,37 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
     })
 }
 
-fn materials(n: &Node) -> Result<BTreeMap<String, MaterialDesc>> {
+/// A table of named entries (`[materials.NAME]`, `[textures.NAME]`) of the
+/// top-level table `section`, each decoded by `entry`.
+fn named<T>(
+    n: &Node,
+    section: &str,
+    noun: &str,
+    entry: impl Fn(&Node, &str) -> Result<T>,
+) -> Result<BTreeMap<String, T>> {
     let Value::Table(entries) = &n.value else {
         return Err(error(
-            "materials",
+            section,
             &n.span,
             format!(
-                "expected a table of named materials, got {}",
+                "expected a table of named {section}, got {}",
                 n.value.describe()
             ),
         ));
     };
-    let mut materials = BTreeMap::new();
+    let mut out = BTreeMap::new();
     for e in entries {
-        let path = child("materials", &e.key);
-        if materials.contains_key(&e.key) {
+        let path = child(section, &e.key);
+        if out.contains_key(&e.key) {
             return Err(error(
                 &path,
                 &e.key_span,
-                format!("material `{}` is defined twice", e.key),
+                format!("{noun} `{}` is defined twice", e.key),
             ));
         }
-        materials.insert(e.key.clone(), material(&e.node, &path)?);
+        out.insert(e.key.clone(), entry(&e.node, &path)?);
     }
-    Ok(materials)
+    Ok(out)
 }
 
 fn objects(n: &Node) -> Result<Vec<ObjectDesc>> {
@@ -361,6 +392,11 @@ const INTEGRATORS: &[(&str, IntegratorDesc)] = &[
     ("bsdf", IntegratorDesc::Bsdf),
 ];
 
+const LIGHT_SELECTIONS: &[(&str, LightSelection)] = &[
+    ("power", LightSelection::Power),
+    ("uniform", LightSelection::Uniform),
+];
+
 const SHADINGS: &[(&str, ShadingDesc)] = &[
     ("path", ShadingDesc::Path),
     ("hit", ShadingDesc::Hit),
@@ -384,6 +420,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "sampler",
             "sampling",
             "integrator",
+            "light_selection",
             "noise_target",
             "gamma",
             "epsilon",
@@ -408,6 +445,9 @@ fn render(node: &Node) -> Result<RenderDesc> {
         integrator: t
             .optional("integrator", |n, p| keyword(n, p, INTEGRATORS))?
             .unwrap_or(d.integrator),
+        light_selection: t
+            .optional("light_selection", |n, p| keyword(n, p, LIGHT_SELECTIONS))?
+            .unwrap_or(d.light_selection),
         noise_target: t.optional("noise_target", float)?,
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
         epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),
@@ -496,6 +536,7 @@ fn tagged<'a, K: Copy>(
 enum BackgroundKind {
     Gradient,
     Solid,
+    Image,
 }
 
 const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
@@ -504,7 +545,10 @@ const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
         kind: BackgroundKind::Gradient,
         what: "a gradient background",
         fields: &["type", "bottom", "top"],
-        elsewhere: &[("color", "a solid background")],
+        elsewhere: &[
+            ("color", "a solid background"),
+            ("file", "an image background"),
+        ],
     },
     Kind {
         name: "solid",
@@ -512,6 +556,18 @@ const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
         what: "a solid background",
         fields: &["type", "color"],
         elsewhere: &[
+            ("bottom", "a gradient background"),
+            ("top", "a gradient background"),
+            ("file", "an image background"),
+        ],
+    },
+    Kind {
+        name: "image",
+        kind: BackgroundKind::Image,
+        what: "an image background",
+        fields: &["type", "file", "rotation", "intensity"],
+        elsewhere: &[
+            ("color", "a solid background"),
             ("bottom", "a gradient background"),
             ("top", "a gradient background"),
         ],
@@ -527,6 +583,11 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
         },
         BackgroundKind::Solid => BackgroundDesc::Solid {
             color: t.require("color", what, triple)?,
+        },
+        BackgroundKind::Image => BackgroundDesc::Image {
+            file: t.require("file", what, string)?.to_string(),
+            rotation: t.optional("rotation", float)?.unwrap_or(0.0),
+            intensity: t.optional("intensity", float)?.unwrap_or(1.0),
         },
     })
 }
@@ -613,7 +674,7 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
     let (kind, what, t) = tagged(node, path, "a material", MATERIALS)?;
     Ok(match kind {
         MaterialKind::Diffuse => MaterialDesc::Diffuse {
-            albedo: t.require("albedo", what, triple)?,
+            albedo: t.require("albedo", what, color_or_texture)?,
             bounce: t
                 .optional("bounce", |n, p| keyword(n, p, BOUNCES))?
                 .unwrap_or_default(),
@@ -622,7 +683,7 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
                 .unwrap_or_default(),
         },
         MaterialKind::Metal => MaterialDesc::Metal {
-            albedo: t.require("albedo", what, triple)?,
+            albedo: t.require("albedo", what, color_or_texture)?,
             fuzz: t.optional("fuzz", float)?.unwrap_or(0.0),
         },
         MaterialKind::Dielectric => MaterialDesc::Dielectric {
@@ -630,8 +691,82 @@ fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
             refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
         },
         MaterialKind::Emissive => MaterialDesc::Emissive {
-            radiance: t.require("radiance", what, triple)?,
+            radiance: t.require("radiance", what, color_or_texture)?,
             two_sided: t.optional("two_sided", boolean)?.unwrap_or(false),
+        },
+    })
+}
+
+#[derive(Clone, Copy)]
+enum TextureKind {
+    Checker,
+    Image,
+    Noise,
+}
+
+const TEXTURES: &[Kind<TextureKind>] = &[
+    Kind {
+        name: "checker",
+        kind: TextureKind::Checker,
+        what: "a checker texture",
+        fields: &["type", "scale", "even", "odd"],
+        elsewhere: &[
+            ("file", "image textures"),
+            ("pattern", "noise textures"),
+            ("seed", "noise textures"),
+        ],
+    },
+    Kind {
+        name: "image",
+        kind: TextureKind::Image,
+        what: "an image texture",
+        fields: &["type", "file"],
+        elsewhere: &[
+            ("scale", "checker and noise textures"),
+            ("even", "checker textures"),
+            ("odd", "checker textures"),
+            ("pattern", "noise textures"),
+            ("seed", "noise textures"),
+        ],
+    },
+    Kind {
+        name: "noise",
+        kind: TextureKind::Noise,
+        what: "a noise texture",
+        fields: &["type", "scale", "pattern", "seed"],
+        elsewhere: &[
+            ("file", "image textures"),
+            ("even", "checker textures"),
+            ("odd", "checker textures"),
+        ],
+    },
+];
+
+const NOISE_PATTERNS: &[(&str, NoisePatternDesc)] = &[
+    ("smooth", NoisePatternDesc::Smooth),
+    ("turbulence", NoisePatternDesc::Turbulence),
+    ("marble", NoisePatternDesc::Marble),
+];
+
+fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
+    let (kind, what, t) = tagged(node, path, "a texture", TEXTURES)?;
+    Ok(match kind {
+        TextureKind::Checker => TextureDesc::Checker {
+            scale: t.require("scale", what, float)?,
+            even: t.require("even", what, color_or_texture)?,
+            odd: t.require("odd", what, color_or_texture)?,
+        },
+        TextureKind::Image => TextureDesc::Image {
+            file: t.require("file", what, string)?.to_string(),
+        },
+        TextureKind::Noise => TextureDesc::Noise {
+            scale: t.optional("scale", float)?.unwrap_or(1.0),
+            pattern: t
+                .optional("pattern", |n, p| keyword(n, p, NOISE_PATTERNS))?
+                .unwrap_or_default(),
+            seed: t
+                .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
+                .unwrap_or(0),
         },
     })
 }

@@ -6,6 +6,7 @@
 //! people write them; the renderer converts them to `f32` when it compiles the
 //! scene.
 
+pub use crate::light::LightSelection;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -28,6 +29,9 @@ pub struct SceneDesc {
     /// What rays that hit nothing see.
     #[serde(default)]
     pub background: BackgroundDesc,
+    /// Textures by name; materials refer to them by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub textures: BTreeMap<String, TextureDesc>,
     /// Materials by name; objects refer to them by name.
     #[serde(default)]
     pub materials: BTreeMap<String, MaterialDesc>,
@@ -59,6 +63,9 @@ pub struct RenderDesc {
     pub sampler: SamplingDesc,
     /// How paths gather light.
     pub integrator: IntegratorDesc,
+    /// How the `path` integrator chooses the light it samples.
+    #[serde(skip_serializing_if = "is_power")]
+    pub light_selection: LightSelection,
     /// Adaptive sampling: a pixel stops taking samples once its estimated
     /// relative error is at most this; absent, every pixel takes them all.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -82,6 +89,7 @@ impl Default for RenderDesc {
             seed: 0,
             sampler: SamplingDesc::Sobol,
             integrator: IntegratorDesc::Path,
+            light_selection: LightSelection::Power,
             noise_target: None,
             gamma: 2.0,
             epsilon: 0.001,
@@ -187,6 +195,35 @@ pub enum BackgroundDesc {
         /// The colour.
         color: Triple,
     },
+    /// An equirectangular image around the scene (see
+    /// [`EnvironmentMap`](crate::light::EnvironmentMap) for its layout).
+    Image {
+        /// The image file (`.exr`, `.hdr`, `.png`, `.jpg`), relative to
+        /// the scene file.
+        file: String,
+        /// Turn about +y, in degrees (counter-clockwise seen from above).
+        #[serde(default, skip_serializing_if = "is_zero")]
+        rotation: f64,
+        /// Factor on every texel, ≥ 0.
+        #[serde(default = "one", skip_serializing_if = "is_one")]
+        intensity: f64,
+    },
+}
+
+fn is_power(s: &LightSelection) -> bool {
+    *s == LightSelection::Power
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
 }
 
 impl Default for BackgroundDesc {
@@ -204,8 +241,9 @@ impl Default for BackgroundDesc {
 pub enum MaterialDesc {
     /// A matte surface.
     Diffuse {
-        /// Reflected fraction per channel, each in [0, 1].
-        albedo: Triple,
+        /// Reflected fraction per channel, each in [0, 1], or a texture
+        /// giving it.
+        albedo: ColorDesc,
         /// Bounce direction model.
         #[serde(default)]
         bounce: BounceDesc,
@@ -215,8 +253,9 @@ pub enum MaterialDesc {
     },
     /// A reflective metal.
     Metal {
-        /// Reflection colour, each channel in [0, 1].
-        albedo: Triple,
+        /// Reflection colour, each channel in [0, 1], or a texture giving
+        /// it.
+        albedo: ColorDesc,
         /// Blur of the reflection, in [0, 1].
         #[serde(default)]
         fuzz: f64,
@@ -231,8 +270,9 @@ pub enum MaterialDesc {
     },
     /// A light: emits `radiance` and scatters nothing.
     Emissive {
-        /// Emitted radiance per channel, ≥ 0 (may exceed 1).
-        radiance: Triple,
+        /// Emitted radiance per channel, ≥ 0 (may exceed 1), or a texture
+        /// giving it.
+        radiance: ColorDesc,
         /// Emit from both sides (the book's diffuse light); otherwise only
         /// from the side the outward normal points to.
         #[serde(default, skip_serializing_if = "is_false")]
@@ -242,6 +282,72 @@ pub enum MaterialDesc {
 
 fn is_false(b: &bool) -> bool {
     !*b
+}
+
+/// A colour given outright, or by naming a texture of `textures`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ColorDesc {
+    /// The colour.
+    Rgb(Triple),
+    /// The name of a texture.
+    Texture(String),
+}
+
+impl From<Triple> for ColorDesc {
+    fn from(c: Triple) -> Self {
+        ColorDesc::Rgb(c)
+    }
+}
+
+/// A texture (see [`crate::texture::Texture`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum TextureDesc {
+    /// Alternating cubes in space, as in *The Next Week*.
+    Checker {
+        /// The side of a cube, > 0.
+        scale: f64,
+        /// The colour (or texture) of the cubes whose integer coordinates
+        /// add up to an even number.
+        even: ColorDesc,
+        /// The colour (or texture) of the others.
+        odd: ColorDesc,
+    },
+    /// An image wrapped by the surface's texture coordinates.
+    Image {
+        /// The image file, relative to the scene file.
+        file: String,
+    },
+    /// Perlin noise.
+    Noise {
+        /// Frequency: the point in space is multiplied by it; > 0.
+        #[serde(default = "one", skip_serializing_if = "is_one")]
+        scale: f64,
+        /// How the noise becomes a grey level.
+        #[serde(default)]
+        pattern: NoisePatternDesc,
+        /// The seed the noise is made from.
+        #[serde(default, skip_serializing_if = "is_zero_u64")]
+        seed: u64,
+    },
+}
+
+fn is_zero_u64(x: &u64) -> bool {
+    *x == 0
+}
+
+/// How noise becomes a grey level (see [`crate::texture::NoisePattern`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoisePatternDesc {
+    /// ½(1 + noise).
+    #[default]
+    Smooth,
+    /// A sum of seven octaves.
+    Turbulence,
+    /// Veined marble along z.
+    Marble,
 }
 
 /// Diffuse bounce model (see [`crate::material::BounceModel`]).

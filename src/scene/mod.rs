@@ -8,6 +8,7 @@ pub mod desc;
 pub mod file;
 pub mod hint;
 pub mod source;
+mod textures;
 mod world;
 
 pub use desc::SceneDesc;
@@ -16,10 +17,12 @@ use crate::camera::{Camera, CameraError};
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::{HitRecord, RayBundle, Sphere};
-use crate::light::Lights;
+pub use crate::light::LightSelection;
+use crate::light::{Environment, Lights};
 use crate::material::Material;
-use crate::math::{lerp, Color, Interval, Vec3};
+use crate::math::Interval;
 use crate::ray::Ray;
+use crate::texture::Texture;
 use desc::{IntegratorDesc, SamplingDesc, ShadingDesc};
 use thiserror::Error;
 use world::{LightIds, World};
@@ -118,31 +121,6 @@ pub type Sampling = SamplingDesc;
 /// How paths gather light (see [`desc::IntegratorDesc`]).
 pub type Integrator = IntegratorDesc;
 
-/// What rays that escape the scene see.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Background {
-    /// Blend from `bottom` to `top` by the unit direction's y.
-    Gradient {
-        /// Colour straight down.
-        bottom: Color,
-        /// Colour straight up.
-        top: Color,
-    },
-    /// One colour everywhere.
-    Solid(Color),
-}
-
-impl Background {
-    /// The colour seen along unit direction `direction`.
-    #[inline]
-    pub fn color(&self, direction: Vec3) -> Color {
-        match *self {
-            Background::Gradient { bottom, top } => lerp(bottom, top, 0.5 * (direction.y + 1.0)),
-            Background::Solid(c) => c,
-        }
-    }
-}
-
 /// Render settings after validation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -160,6 +138,8 @@ pub struct Settings {
     pub sampler: Sampling,
     /// How paths gather light.
     pub integrator: Integrator,
+    /// How the `path` integrator chooses the light it samples.
+    pub light_selection: LightSelection,
     /// Adaptive sampling: pixels stop once their estimated relative error
     /// is at most this (see [`crate::adaptive`]); `None` samples every pixel
     /// fully.
@@ -179,10 +159,16 @@ pub struct Scene {
     pub settings: Settings,
     /// The camera, sized for the image.
     pub camera: Camera,
-    /// The background.
-    pub background: Background,
-    /// Material table indexed by [`HitRecord::material`].
+    /// What rays that escape the scene see: the environment.
+    pub background: Environment,
+    /// Material table indexed by [`HitRecord::material`]. A material whose
+    /// colour is a texture holds a placeholder here; [`Scene::material_at`]
+    /// gives it its colour where a ray hits.
     pub materials: Vec<Material>,
+    /// The textures materials refer to.
+    pub textures: Vec<Texture>,
+    /// Per material, the texture of its colour (albedo or radiance), if any.
+    pub material_textures: Vec<Option<u32>>,
     /// The spheres placed directly in the world, in description order.
     pub spheres: Vec<Sphere>,
     /// The mesh files the scene reads, with a hash of their content: part
@@ -190,7 +176,8 @@ pub struct Scene {
     pub sources: Vec<MeshSource>,
     /// Counts of what the scene holds.
     pub stats: SceneStats,
-    /// The emissive surfaces, to be sampled by next-event estimation.
+    /// The emissive surfaces and the environment, to be sampled by
+    /// next-event estimation.
     pub lights: Lights,
     light_ids: LightIds,
     world: World,
@@ -251,6 +238,21 @@ impl Scene {
     #[inline]
     pub fn light_of(&self, hit: &Hit) -> Option<usize> {
         self.light_ids.of(hit)
+    }
+
+    /// The material at `record`, its colour given by its texture there
+    /// when it has one.
+    #[inline(always)]
+    pub fn material_at(&self, record: &HitRecord) -> Material {
+        let i = record.material as usize;
+        let material = self.materials[i];
+        match self.material_textures.get(i) {
+            Some(&Some(t)) => {
+                let c = self.textures[t as usize].value(&self.textures, record.uv, record.point);
+                material.with_color(c)
+            }
+            _ => material,
+        }
     }
 
     /// Whether `ray` hits anything within `interval` (a shadow ray's
@@ -329,6 +331,8 @@ pub struct Overrides {
     pub sampler: Option<Sampling>,
     /// The integrator.
     pub integrator: Option<Integrator>,
+    /// How lights are chosen.
+    pub light_selection: Option<LightSelection>,
     /// The noise target of adaptive sampling.
     pub noise_target: Option<f64>,
 }
@@ -359,6 +363,9 @@ impl Overrides {
         }
         if let Some(i) = self.integrator {
             r.integrator = i;
+        }
+        if let Some(l) = self.light_selection {
+            r.light_selection = l;
         }
         if let Some(t) = self.noise_target {
             r.noise_target = Some(t);

@@ -12,7 +12,7 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
 use crate::geometry::{Bvh, HitRecord, Instance, Primitive, Quad, Sphere, Triangle};
-use crate::light::{Light, Lights, Shape as LightShape};
+use crate::light::{Light, Shape as LightShape};
 use crate::material::{Emissive, Material};
 use crate::math::{Color, Point3, Vec3};
 use crate::mesh::TriangleMesh;
@@ -28,15 +28,19 @@ pub(crate) struct Surface {
     pub(crate) inverse_radius: f32,
     pub(crate) radius: f32,
     pub(crate) material: u32,
+    /// Whether hit records on it carry their (u, v) (the inverse
+    /// trigonometry is worth paying only for a texture that uses them).
+    pub(crate) uv: bool,
 }
 
 impl Surface {
-    pub(crate) fn new(sphere: &Sphere, material: u32) -> Self {
+    pub(crate) fn new(sphere: &Sphere, material: u32, uv: bool) -> Self {
         Surface {
             center: sphere.center,
             inverse_radius: 1.0 / sphere.radius,
             radius: sphere.radius,
             material,
+            uv,
         }
     }
 }
@@ -152,9 +156,13 @@ impl Shapes {
                     point,
                     normal,
                     shading_normal: normal,
-                    // Computed when asked for (`Sphere::uv`): the inverse
+                    // Only for textures that use them: the inverse
                     // trigonometry cost a fifth of the cover's render.
-                    uv: [0.0, 0.0],
+                    uv: if surface.uv {
+                        Sphere::uv(outward)
+                    } else {
+                        [0.0, 0.0]
+                    },
                     t,
                     front_face,
                     material: surface.material,
@@ -349,6 +357,18 @@ impl World {
         }
     }
 
+    /// The radius of a sphere around everything (half the diagonal of the
+    /// bounding box; 0 for an empty scene).
+    pub(crate) fn bounding_radius(&self) -> f32 {
+        let b = self.bvh.bounds();
+        let diagonal = (b.max - b.min).length();
+        if diagonal.is_finite() {
+            0.5 * diagonal
+        } else {
+            0.0
+        }
+    }
+
     /// Bytes held by the meshes and the trees.
     pub(crate) fn memory_bytes(&self) -> usize {
         let shapes = std::iter::once(&self.top).chain(self.groups.iter().map(|g| &g.shapes));
@@ -453,7 +473,7 @@ impl World {
     /// material's; an instance holding any light gets one entry per
     /// primitive of its tree (black for the others), so that a hit's light
     /// is found by arithmetic.
-    pub(crate) fn lights(&self, materials: &[Material]) -> (Lights, LightIds) {
+    pub(crate) fn lights(&self, materials: &[Material]) -> (Vec<Light>, LightIds) {
         let emitter = |m: u32| materials[m as usize].light();
         let mut lights = Vec::new();
         let mut ids = LightIds::default();
@@ -524,8 +544,8 @@ impl World {
             }
         }
         if lights.is_empty() {
-            return (Lights::default(), LightIds::default());
+            ids = LightIds::default();
         }
-        (Lights::new(lights), ids)
+        (lights, ids)
     }
 }

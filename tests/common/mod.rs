@@ -32,7 +32,9 @@ pub fn builtin_scene(name: &str, width: u32, spp: u32, seed: u64) -> Scene {
 }
 
 /// One sphere of `material`, radius 1 at distance 2 in front of the default
-/// camera, inside a uniform white background ("white furnace"); gamma 1.
+/// camera, inside a uniform white background ("white furnace"); gamma 1,
+/// the notes' estimator (`bsdf`: every sample of a white sphere is at most
+/// 1).
 pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth: u32) -> Scene {
     let desc = SceneDesc {
         caption: String::new(),
@@ -43,12 +45,14 @@ pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth:
             max_depth: depth,
             gamma: 1.0,
             seed: 11,
+            integrator: lumen::scene::Integrator::Bsdf,
             ..RenderDesc::default()
         },
         camera: Default::default(),
         background: BackgroundDesc::Solid {
             color: [1.0, 1.0, 1.0],
         },
+        textures: Default::default(),
         materials: [("m".to_string(), material)].into_iter().collect(),
         objects: vec![ObjectDesc::Sphere {
             center: FURNACE_CENTER,
@@ -423,4 +427,49 @@ radius = 1
 material = "matte"
 "#
     )
+}
+
+/// Each 8 × 8 tile of two renders of one view agrees in every channel, and
+/// the first (the `path` render) has the smaller standard error over the
+/// image.
+pub fn assert_tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) {
+    let noise = tiles_agree(what, path, bsdf);
+    assert!(
+        noise.0 < noise.1,
+        "{what}: path's tiles are noisier ({} against {})",
+        noise.0,
+        noise.1
+    );
+}
+
+/// Each 8 × 8 tile of two renders of one view agrees in every channel;
+/// returns the sums of the tiles' standard errors of each.
+pub fn tiles_agree(what: &str, path: &PixelStats, bsdf: &PixelStats) -> (f64, f64) {
+    let mut noise = (0.0, 0.0);
+    for c in 0..3 {
+        for ty in 0..path.height / 8 {
+            for tx in 0..path.width / 8 {
+                let tile = |s: &PixelStats| s.region(tx * 8..tx * 8 + 8, ty * 8..ty * 8 + 8, c);
+                let (a, b) = (tile(path), tile(bsdf));
+                assert_agree(&format!("{what}: tile ({tx}, {ty}), channel {c}"), a, b);
+                noise.0 += a.1;
+                noise.1 += b.1;
+            }
+        }
+    }
+    noise
+}
+
+/// The message of the scene file `text` (written to `dir/bad.toml`), which
+/// must be refused, when read or when compiled.
+pub fn scene_file_error(dir: &std::path::Path, text: &str) -> String {
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    match lumen::scene::file::SceneFile::read(&path) {
+        Err(e) => e.to_string(),
+        Ok(file) => match file.compile(&Overrides::default()) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("accepted:\n{text}"),
+        },
+    }
 }

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
-use lumen::scene::{Integrator, Overrides, Sampling};
+use lumen::scene::{Integrator, LightSelection, Overrides, Sampling};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -157,6 +157,25 @@ impl From<IntegratorArg> for Integrator {
     }
 }
 
+/// How the `path` integrator chooses a light, as `--light-selection`
+/// names it.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LightSelectionArg {
+    /// In proportion to each light's power.
+    Power,
+    /// Every light equally often.
+    Uniform,
+}
+
+impl From<LightSelectionArg> for LightSelection {
+    fn from(l: LightSelectionArg) -> Self {
+        match l {
+            LightSelectionArg::Power => LightSelection::Power,
+            LightSelectionArg::Uniform => LightSelection::Uniform,
+        }
+    }
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum FormatArg {
     Toml,
@@ -185,6 +204,10 @@ struct SettingArgs {
     /// otherwise].
     #[arg(long, value_enum)]
     integrator: Option<IntegratorArg>,
+    /// How the `path` integrator chooses the light it samples [default: the
+    /// scene's; `power` unless it says otherwise].
+    #[arg(long, value_enum)]
+    light_selection: Option<LightSelectionArg>,
     /// Adaptive sampling: stop sampling a pixel once its estimated relative
     /// error is at most this (e.g. 0.01); --spp stays the upper bound.
     #[arg(long, value_name = "ERROR")]
@@ -224,6 +247,7 @@ impl SettingArgs {
             seed: self.seed,
             sampler: self.sampler.map(Sampling::from),
             integrator: self.integrator.map(Integrator::from),
+            light_selection: self.light_selection.map(LightSelection::from),
             noise_target: self.noise_target,
         }
     }

@@ -1,0 +1,247 @@
+//! The environment: the light arriving from infinitely far away along every
+//! direction a ray escapes by. A gradient, one colour, or an
+//! equirectangular image; each can be sampled as a light, with a density in
+//! proportion to its brightness.
+
+use super::luminance;
+use crate::distribution::Distribution2D;
+use crate::math::{lerp, Color, Vec3};
+use crate::sampling::sin_cos_turns;
+use crate::texture::Image;
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+/// What rays that escape the scene see, and the light it sheds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Environment {
+    /// Blend from `bottom` to `top` by the unit direction's y.
+    Gradient {
+        /// Colour straight down.
+        bottom: Color,
+        /// Colour straight up.
+        top: Color,
+    },
+    /// One colour everywhere.
+    Solid(Color),
+    /// An image wrapped around the sky.
+    Map(Arc<EnvironmentMap>),
+}
+
+/// A direction drawn towards the environment.
+#[derive(Clone, Copy, Debug)]
+pub struct EnvironmentSample {
+    /// Unit direction towards the sky.
+    pub direction: Vec3,
+    /// The radiance arriving from it.
+    pub radiance: Color,
+    /// Its density per unit solid angle.
+    pub pdf: f32,
+}
+
+impl Environment {
+    /// The radiance arriving along unit `direction` (the colour seen looking
+    /// that way).
+    #[inline]
+    pub fn color(&self, direction: Vec3) -> Color {
+        match self {
+            Environment::Gradient { bottom, top } => lerp(*bottom, *top, 0.5 * (direction.y + 1.0)),
+            Environment::Solid(c) => *c,
+            Environment::Map(map) => map.color(direction),
+        }
+    }
+
+    /// A direction drawn from `u` in [0, 1)² with density in proportion to
+    /// the brightness seen along it (luminance for a gradient and one
+    /// colour; for an image, the brightest texel near it, times the area
+    /// its texel covers); `None` where the draw is degenerate (a pole of an
+    /// image).
+    #[inline]
+    pub fn sample(&self, u: [f32; 2]) -> Option<EnvironmentSample> {
+        let (direction, pdf) = match self {
+            Environment::Gradient { bottom, top } => sample_gradient(*bottom, *top, u),
+            Environment::Solid(_) => sample_gradient(Color::ONE, Color::ONE, u),
+            Environment::Map(map) => map.sample(u)?,
+        };
+        Some(EnvironmentSample {
+            direction,
+            radiance: self.color(direction),
+            pdf,
+        })
+    }
+
+    /// The density per unit solid angle with which [`Environment::sample`]
+    /// draws unit `direction`.
+    #[inline]
+    pub fn pdf(&self, direction: Vec3) -> f32 {
+        match self {
+            Environment::Gradient { bottom, top } => gradient_pdf(*bottom, *top, direction),
+            Environment::Solid(_) => 1.0 / (4.0 * PI),
+            Environment::Map(map) => map.pdf(direction),
+        }
+    }
+
+    /// The luminance of the environment integrated over the sphere of
+    /// directions (∫ Y(ω) dω).
+    pub fn integral(&self) -> f64 {
+        match self {
+            Environment::Gradient { bottom, top } => {
+                // The mean of a linear blend is the mean of its ends.
+                2.0 * std::f64::consts::PI * f64::from(luminance(*bottom) + luminance(*top))
+            }
+            Environment::Solid(c) => 4.0 * std::f64::consts::PI * f64::from(luminance(*c)),
+            Environment::Map(map) => map.integral,
+        }
+    }
+}
+
+/// A direction with density in proportion to the luminance of a blend from
+/// `bottom` to `top` by y: y = 2t − 1 with t drawn from the mixture of
+/// densities 2(1 − t) and 2t, weighted by the luminances of the two ends;
+/// the azimuth uniform.
+fn sample_gradient(bottom: Color, top: Color, u: [f32; 2]) -> (Vec3, f32) {
+    let (a, b) = (luminance(bottom), luminance(top));
+    let share_bottom = if a + b > 0.0 { a / (a + b) } else { 0.5 };
+    let t = if u[0] < share_bottom {
+        1.0 - (u[0] / share_bottom).sqrt()
+    } else {
+        ((u[0] - share_bottom) / (1.0 - share_bottom))
+            .min(1.0)
+            .sqrt()
+    };
+    let y = (2.0 * t - 1.0).clamp(-1.0, 1.0);
+    let r = (1.0 - y * y).max(0.0).sqrt();
+    let (s, c) = sin_cos_turns(u[1]);
+    let direction = Vec3::new(r * c, y, r * s);
+    (direction, gradient_pdf(bottom, top, direction))
+}
+
+/// The density of [`sample_gradient`]: that of t, 2((1 − t)a + t b)/(a + b),
+/// over the 4π of the sphere (y = 2t − 1 is uniform on it when t is).
+fn gradient_pdf(bottom: Color, top: Color, direction: Vec3) -> f32 {
+    let (a, b) = (luminance(bottom), luminance(top));
+    let t = (0.5 * (direction.y + 1.0)).clamp(0.0, 1.0);
+    let density_t = if a + b > 0.0 {
+        2.0 * ((1.0 - t) * a + t * b) / (a + b)
+    } else {
+        1.0
+    };
+    density_t / (4.0 * PI)
+}
+
+/// An equirectangular image of the sky: u = 0.5 + φ/2π across, the azimuth
+/// φ = atan2(x, −z) turning from −z towards +x (so the image's centre lies
+/// along −z, where the default camera looks, with +x to its right, and its
+/// left and right edges meet along +z), and v = θ/π down, θ measured from
+/// +y (the top row is straight up). The image is turned by
+/// `rotation` about +y and scaled by `intensity`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentMap {
+    image: Image,
+    intensity: f32,
+    /// sin and cos of the rotation about +y.
+    rotation: (f32, f32),
+    distribution: Distribution2D,
+    integral: f64,
+}
+
+impl EnvironmentMap {
+    /// The environment of `image`, turned by `rotation_degrees` about +y
+    /// (counter-clockwise seen from above) and scaled by `intensity` (≥ 0);
+    /// `None` when the image is black everywhere or the intensity is 0.
+    pub fn new(image: Image, rotation_degrees: f32, intensity: f32) -> Option<Self> {
+        let (w, h) = (image.width(), image.height());
+        // A texel's weight: the brightest of it and its eight neighbours
+        // (the bilinear lookup within the texel's area draws on them, so
+        // nothing visible goes unsampled), times the sine of its row's
+        // polar angle (rows near the poles cover less of the sphere).
+        let mut weights = vec![0.0f64; w * h];
+        let mut integral = 0.0f64;
+        let row_area = |y: usize| -> f64 {
+            let theta = std::f64::consts::PI * (y as f64 + 0.5) / h as f64;
+            theta.sin()
+        };
+        for y in 0..h {
+            let sin = row_area(y);
+            for x in 0..w {
+                let mut brightest = 0.0f32;
+                for dy in [-1i64, 0, 1] {
+                    let yy = (y as i64 + dy).clamp(0, h as i64 - 1) as usize;
+                    for dx in [-1i64, 0, 1] {
+                        let xx = (x as i64 + dx).rem_euclid(w as i64) as usize;
+                        brightest = brightest.max(luminance(image.texel(xx, yy)));
+                    }
+                }
+                weights[y * w + x] = f64::from(brightest) * sin;
+                integral += f64::from(luminance(image.texel(x, y))) * sin;
+            }
+        }
+        // Each texel covers (2π/w)(π/h) sin θ of the sphere.
+        let texel_area = 2.0 * std::f64::consts::PI * std::f64::consts::PI / (w * h) as f64;
+        let integral = integral * texel_area * f64::from(intensity);
+        if !(intensity > 0.0) {
+            return None;
+        }
+        let distribution = Distribution2D::new(&weights, w)?;
+        let (sin, cos) = rotation_degrees.to_radians().sin_cos();
+        Some(EnvironmentMap {
+            image,
+            intensity,
+            rotation: (sin, cos),
+            distribution,
+            integral,
+        })
+    }
+
+    /// The image's (u, v) seen along unit world `direction`.
+    #[inline]
+    fn uv(&self, direction: Vec3) -> [f32; 2] {
+        // Into the image's frame: turned back by the rotation.
+        let (s, c) = self.rotation;
+        let x = c * direction.x - s * direction.z;
+        let z = s * direction.x + c * direction.z;
+        let u = 0.5 + x.atan2(-z) * (0.5 / PI);
+        // θ from its sine and cosine: acos(y) loses the digits near the
+        // poles.
+        let v = (x * x + z * z).sqrt().atan2(direction.y) / PI;
+        [u.rem_euclid(1.0), v.clamp(0.0, 1.0)]
+    }
+
+    /// The world direction of the image's point `[u, v]`, and sin θ there.
+    #[inline]
+    fn direction(&self, [u, v]: [f32; 2]) -> (Vec3, f32) {
+        let (sin_theta, cos_theta) = (PI * v).sin_cos();
+        // φ = 2π(u − 0.5): half a turn from 2πu.
+        let (s_u, c_u) = sin_cos_turns(u);
+        let (sin_phi, cos_phi) = (-s_u, -c_u);
+        let (x, z) = (sin_theta * sin_phi, -sin_theta * cos_phi);
+        let (s, c) = self.rotation;
+        let world = Vec3::new(c * x + s * z, cos_theta, -s * x + c * z);
+        (world, sin_theta)
+    }
+
+    fn color(&self, direction: Vec3) -> Color {
+        let [u, v] = self.uv(direction);
+        self.intensity * self.image.bilinear_wrap_u(u, v)
+    }
+
+    fn sample(&self, u: [f32; 2]) -> Option<(Vec3, f32)> {
+        let (uv, density) = self.distribution.sample(u);
+        let (direction, sin_theta) = self.direction(uv);
+        if !(sin_theta > 0.0) {
+            return None;
+        }
+        // (u, v) covers the sphere at 2π² sin θ per unit area.
+        Some((direction, density / (2.0 * PI * PI * sin_theta)))
+    }
+
+    fn pdf(&self, direction: Vec3) -> f32 {
+        let sin_theta = (direction.x * direction.x + direction.z * direction.z).sqrt();
+        if !(sin_theta > 0.0) {
+            return 0.0;
+        }
+        self.distribution.density(self.uv(direction)) / (2.0 * PI * PI * sin_theta)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,186 @@
+//! Compiling the textures of a description: each named texture once, in
+//! the order materials (and other textures) ask for them, with references
+//! between textures followed and cycles refused; image files read once and
+//! recorded as sources of the scene.
+
+use super::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
+use super::{invalid, MeshSource, SceneError};
+use crate::math::Color;
+use crate::texture::{Image, NoisePattern, Perlin, Texture};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::sync::Arc;
+
+/// A colour parameter as compiled: a colour, or a texture of the table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum ColorRef {
+    /// The colour itself.
+    Rgb(Color),
+    /// Texture number n of the table.
+    Texture(u32),
+}
+
+/// The textures compiled so far.
+pub(crate) struct TextureTable<'a> {
+    descs: &'a BTreeMap<String, TextureDesc>,
+    base: &'a Path,
+    /// The compiled textures; materials refer to them by index.
+    pub(crate) textures: Vec<Texture>,
+    index: HashMap<&'a str, u32>,
+}
+
+impl<'a> TextureTable<'a> {
+    /// An empty table for the textures `descs`, whose files are relative to
+    /// `base`.
+    pub(crate) fn new(descs: &'a BTreeMap<String, TextureDesc>, base: &'a Path) -> Self {
+        TextureTable {
+            descs,
+            base,
+            textures: Vec::new(),
+            index: HashMap::new(),
+        }
+    }
+
+    /// The colour parameter `field` given by `c`; `check` validates a
+    /// colour given outright. Image files read are added to `sources`.
+    pub(crate) fn color(
+        &mut self,
+        field: &str,
+        c: &'a ColorDesc,
+        check: fn(&str, [f64; 3]) -> Result<Color, SceneError>,
+        sources: &mut Vec<MeshSource>,
+    ) -> Result<ColorRef, SceneError> {
+        match c {
+            ColorDesc::Rgb(rgb) => Ok(ColorRef::Rgb(check(field, *rgb)?)),
+            ColorDesc::Texture(name) => {
+                let mut chain = Vec::new();
+                Ok(ColorRef::Texture(
+                    self.named(field, name, &mut chain, sources)?,
+                ))
+            }
+        }
+    }
+
+    /// The index of the texture `name`, compiled on first use; `chain`
+    /// holds the textures being compiled that led here (to refuse cycles).
+    fn named(
+        &mut self,
+        field: &str,
+        name: &'a str,
+        chain: &mut Vec<&'a str>,
+        sources: &mut Vec<MeshSource>,
+    ) -> Result<u32, SceneError> {
+        if let Some(&i) = self.index.get(name) {
+            return Ok(i);
+        }
+        let descs = self.descs;
+        let Some((key, desc)) = descs.get_key_value(name) else {
+            let mut known: Vec<&str> = self.descs.keys().map(String::as_str).collect();
+            known.truncate(8);
+            let listed = if known.is_empty() {
+                "the scene defines no textures".to_string()
+            } else {
+                format!("defined: {}", known.join(", "))
+            };
+            return Err(invalid(
+                field,
+                format!("no texture named \"{name}\" ({listed})"),
+            ));
+        };
+        if chain.contains(&name) {
+            chain.push(name);
+            return Err(invalid(
+                format!("textures.{name}"),
+                format!("refers to itself: {}", chain.join(" → ")),
+            ));
+        }
+        chain.push(key);
+        let here = format!("textures.{name}");
+        let texture = match desc {
+            TextureDesc::Checker { scale, even, odd } => {
+                super::compile::finite(format_args!("{here}.scale"), &[*scale])?;
+                if !(*scale as f32 > 0.0) {
+                    return Err(invalid(
+                        format!("{here}.scale"),
+                        format!("must be greater than 0, got {scale}"),
+                    ));
+                }
+                let mut part = |which: &str, c: &'a ColorDesc| -> Result<u32, SceneError> {
+                    let field = format!("{here}.{which}");
+                    match c {
+                        ColorDesc::Rgb(rgb) => {
+                            let colour = super::compile::color(&field, *rgb)?;
+                            self.textures.push(Texture::Solid(colour));
+                            Ok(self.textures.len() as u32 - 1)
+                        }
+                        ColorDesc::Texture(inner) => self.named(&field, inner, chain, sources),
+                    }
+                };
+                let even = part("even", even)?;
+                let odd = part("odd", odd)?;
+                Texture::Checker {
+                    inverse_scale: 1.0 / *scale as f32,
+                    even,
+                    odd,
+                }
+            }
+            TextureDesc::Image { file } => Texture::Image(Arc::new(read_image(
+                &format!("{here}.file"),
+                self.base,
+                file,
+                sources,
+            )?)),
+            TextureDesc::Noise {
+                scale,
+                pattern,
+                seed,
+            } => {
+                super::compile::finite(format_args!("{here}.scale"), &[*scale])?;
+                if !(*scale as f32 > 0.0) {
+                    return Err(invalid(
+                        format!("{here}.scale"),
+                        format!("must be greater than 0, got {scale}"),
+                    ));
+                }
+                Texture::Noise {
+                    perlin: Arc::new(Perlin::new(*seed)),
+                    scale: *scale as f32,
+                    pattern: match pattern {
+                        NoisePatternDesc::Smooth => NoisePattern::Smooth,
+                        NoisePatternDesc::Turbulence => NoisePattern::Turbulence,
+                        NoisePatternDesc::Marble => NoisePattern::Marble,
+                    },
+                }
+            }
+        };
+        chain.pop();
+        self.textures.push(texture);
+        let i = self.textures.len() as u32 - 1;
+        self.index.insert(key, i);
+        Ok(i)
+    }
+}
+
+/// Reads the image `file` (relative to `base`) of field `field`, and
+/// records it in `sources`.
+pub(crate) fn read_image(
+    field: &str,
+    base: &Path,
+    file: &str,
+    sources: &mut Vec<MeshSource>,
+) -> Result<Image, SceneError> {
+    let path = base.join(file);
+    let fail = |message: String| invalid(field, message);
+    let bytes =
+        std::fs::read(&path).map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?;
+    let image =
+        Image::decode(&bytes, &path.display().to_string()).map_err(|e| fail(e.to_string()))?;
+    if !sources.iter().any(|s| s.file == file) {
+        sources.push(MeshSource {
+            file: file.to_string(),
+            crc: crc32fast::hash(&bytes),
+            len: bytes.len() as u64,
+        });
+    }
+    Ok(image)
+}

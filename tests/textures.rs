@@ -1,0 +1,349 @@
+//! Textures as a scene uses them: the colour a ray finds where it hits
+//! (checker cells in space, an image by a quad's, a sphere's and a mesh's
+//! (u, v), noise), textured lights, and the messages for bad textures.
+
+mod common;
+
+use common::{compile_file, scene_file_error, scratch_dir};
+use lumen::material::Material;
+use lumen::math::{Color, Interval, Vec3};
+use lumen::ray::Ray;
+use lumen::scene::Scene;
+
+/// The colour of the material where the ray from `from` along `towards`
+/// first hits: its albedo, or its radiance for a light.
+fn colour_at(scene: &Scene, from: Vec3, towards: Vec3) -> Color {
+    let ray = Ray::new(from, towards.normalize());
+    let record = scene
+        .hit(&ray, Interval::new(1e-4, f32::INFINITY))
+        .expect("a hit");
+    match scene.material_at(&record) {
+        Material::Diffuse(d) => d.albedo,
+        Material::Metal(m) => m.albedo,
+        Material::Emissive(e) => e.radiance,
+        Material::Dielectric(_) => panic!("glass has no colour"),
+    }
+}
+
+fn close(a: Color, b: Color) -> bool {
+    (a - b).abs().max_element() < 1e-4
+}
+
+#[test]
+fn a_checker_alternates_cubes_of_its_scale_in_space() {
+    let dir = scratch_dir("tex-checker");
+    let scene = compile_file(
+        &dir,
+        "c.toml",
+        r#"
+[textures.cells]
+type = "checker"
+scale = 0.5
+even = [1, 0, 0]
+odd = "inner"
+
+[textures.inner]
+type = "checker"
+scale = 0.25
+even = [0, 1, 0]
+odd = [0, 0, 1]
+
+[materials.floor]
+type = "diffuse"
+albedo = "cells"
+
+[[objects]]
+type = "quad"
+corner = [-4, 0.1, -4]
+u = [0, 0, 8]
+v = [8, 0, 0]
+material = "floor"
+"#,
+    );
+    // The floor at y = 0.1 lies in the cells ⌊y/s⌋ = 0 of both checkers.
+    let at = |x: f32, z: f32| colour_at(&scene, Vec3::new(x, 1.0, z), -Vec3::Y);
+    let parity = |x: f32, z: f32, s: f32| ((x / s).floor() + (z / s).floor()) as i64 % 2 == 0;
+    let mut seen = [0; 3];
+    for i in 0..40 {
+        let (x, z) = (-2.0 + 0.1037 * i as f32, 1.9 - 0.0871 * i as f32);
+        let want = if parity(x, z, 0.5) {
+            Color::X
+        } else if parity(x, z, 0.25) {
+            Color::Y
+        } else {
+            Color::Z
+        };
+        assert_eq!(at(x, z), want, "({x}, {z})");
+        seen[if want == Color::X {
+            0
+        } else if want == Color::Y {
+            1
+        } else {
+            2
+        }] += 1;
+    }
+    assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+}
+
+/// Writes a 2 × 2 PNG: top row red, green; bottom row blue, grey 128.
+fn write_png(path: &std::path::Path) {
+    let img = image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128])
+        .unwrap();
+    img.save(path).unwrap();
+}
+
+#[test]
+fn an_image_is_wrapped_by_a_quads_coordinates_with_v_upwards() {
+    let dir = scratch_dir("tex-image-quad");
+    write_png(&dir.join("four.png"));
+    let scene = compile_file(
+        &dir,
+        "q.toml",
+        r#"
+[textures.four]
+type = "image"
+file = "four.png"
+
+[materials.wall]
+type = "diffuse"
+albedo = "four"
+
+[[objects]]
+type = "quad"
+corner = [0, 0, 0]
+u = [1, 0, 0]
+v = [0, 1, 0]
+material = "wall"
+"#,
+    );
+    let look = |u: f32, v: f32| colour_at(&scene, Vec3::new(u, v, 1.0), -Vec3::Z);
+    // (α, β) = (u, v): the image's bottom row at β = 0, its top at β = 1;
+    // texel centres at 1/4 and 3/4.
+    assert!(close(look(0.25, 0.75), Color::X), "top left red");
+    assert!(close(look(0.75, 0.75), Color::Y), "top right green");
+    assert!(close(look(0.25, 0.25), Color::Z), "bottom left blue");
+    // 8-bit texels are sRGB: 128 is 0.2158 in linear light.
+    let grey = look(0.75, 0.25);
+    assert!(close(grey, Color::splat(0.215_861)), "{grey:?}");
+    // Halfway between red and green.
+    assert!(close(look(0.5, 0.75), Color::new(0.5, 0.5, 0.0)));
+}
+
+#[test]
+fn spheres_and_meshes_give_textures_their_coordinates() {
+    let dir = scratch_dir("tex-image-sphere");
+    // 4 columns: the u of a sphere runs from −x round by +z... each column
+    // its own colour, constant down the rows.
+    let columns: [[u8; 3]; 4] = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]];
+    let raw: Vec<u8> = (0..2)
+        .flat_map(|_| columns.iter().flatten().copied())
+        .collect();
+    image::RgbImage::from_raw(4, 2, raw)
+        .unwrap()
+        .save(dir.join("bands.png"))
+        .unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.125 0.5\nvt 0.375 0.5\nvt 0.625 0.5\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let scene = compile_file(
+        &dir,
+        "s.toml",
+        r#"
+[textures.bands]
+type = "image"
+file = "bands.png"
+
+[materials.globe]
+type = "diffuse"
+albedo = "bands"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "globe"
+
+[[objects]]
+type = "sphere"
+center = [10, 0, 0]
+radius = 1
+material = "globe"
+transform = [{ rotate = { axis = [0, 1, 0], degrees = 90 } }, { translate = [0, 0, 5] }]
+
+[[objects]]
+type = "mesh"
+file = "tri.obj"
+material = "globe"
+transform = [{ translate = [0, 0, 20] }]
+"#,
+    );
+    // The Next Week's sphere coordinates: u = φ/2π, φ measured from −x
+    // towards −z... so that the point +z has u = 1/4: halfway between the
+    // centres of columns 0 (red) and 1 (green), the rows all alike.
+    let front = colour_at(&scene, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
+    assert!(close(front, Color::new(0.5, 0.5, 0.0)), "{front:?}");
+    // The point −x has u = 0 ≡ 1: halfway between columns 3 (white) and 0.
+    let left = colour_at(&scene, Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+    assert!(close(left, Color::new(1.0, 0.5, 0.5)), "{left:?}");
+    // The second sphere is turned 90° about y (and moved to (0, 0, −5)):
+    // its texture turns with it, what faced +z now faces +x.
+    let turned = colour_at(&scene, Vec3::new(5.0, 0.0, -5.0), -Vec3::X);
+    assert!(close(turned, front), "{turned:?} instead of {front:?}");
+    // The mesh's own coordinates: near its first corner (u = 0.125, the
+    // centre of column 0), barycentrics 0.01 towards the others move u to
+    // 0.1325, 3% of the way to column 1.
+    let corner = colour_at(&scene, Vec3::new(0.01, 0.01, 25.0), -Vec3::Z);
+    assert!(
+        (corner - Color::new(0.97, 0.03, 0.0)).abs().max_element() < 2e-3,
+        "{corner:?}"
+    );
+}
+
+#[test]
+fn a_textured_light_emits_its_texture_and_is_found_by_bounces() {
+    let dir = scratch_dir("tex-light");
+    let scene = compile_file(
+        &dir,
+        "l.toml",
+        r#"
+[textures.stripes]
+type = "checker"
+scale = 1
+even = [4, 4, 4]
+odd = [0, 0, 0]
+
+[materials.lamp]
+type = "emissive"
+radiance = "stripes"
+
+[materials.bulb]
+type = "emissive"
+radiance = [1, 1, 1]
+
+[[objects]]
+type = "quad"
+corner = [-2, 3, -2]
+u = [4, 0, 0]
+v = [0, 0, 4]
+material = "lamp"
+
+[[objects]]
+type = "sphere"
+center = [0, -5, 0]
+radius = 1
+material = "bulb"
+"#,
+    );
+    // Cells of side 1 at y = 3: (0.5, 3, 0.5) is in cell (0, 3, 0), odd.
+    let up = Vec3::Y;
+    assert_eq!(colour_at(&scene, Vec3::new(0.5, 0.0, 0.5), up), Color::ZERO);
+    assert_eq!(
+        colour_at(&scene, Vec3::new(1.5, 0.0, 0.5), up),
+        Color::splat(4.0)
+    );
+    // The bulb and the gradient sky are sampled; the textured lamp is not.
+    assert_eq!(scene.lights.len(), 2);
+}
+
+#[test]
+fn noise_textures_are_grey_deterministic_and_seeded() {
+    let dir = scratch_dir("tex-noise");
+    let text = |seed: u64| {
+        format!(
+            r#"
+[textures.n]
+type = "noise"
+scale = 3
+pattern = "turbulence"
+seed = {seed}
+
+[materials.m]
+type = "metal"
+albedo = "n"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+"#
+        )
+    };
+    let a = compile_file(&dir, "a.toml", &text(1));
+    let b = compile_file(&dir, "b.toml", &text(1));
+    let c = compile_file(&dir, "c.toml", &text(2));
+    let mut differ = 0;
+    for i in 0..20 {
+        let d = Vec3::new(0.02 * i as f32 - 0.2, 0.1, -1.0);
+        let from = Vec3::new(0.0, 0.0, 3.0);
+        let (x, y, z) = (
+            colour_at(&a, from, d),
+            colour_at(&b, from, d),
+            colour_at(&c, from, d),
+        );
+        assert_eq!(x, y);
+        assert!(x.x == x.y && x.y == x.z && (0.0..=1.0).contains(&x.x));
+        differ += usize::from(x != z);
+    }
+    assert!(differ > 10, "seeds 1 and 2 gave the same noise");
+}
+
+#[test]
+fn bad_textures_are_refused_with_the_field_named() {
+    let dir = scratch_dir("tex-errors");
+    let cases: [(&str, &str, &str); 8] = [
+        (
+            "[materials.m]\ntype = \"diffuse\"\nalbedo = \"nothing\"",
+            "materials.m.albedo",
+            "no texture named \"nothing\"",
+        ),
+        (
+            "[textures.a]\ntype = \"checker\"\nscale = 1\neven = \"b\"\nodd = [0, 0, 0]\n\
+             [textures.b]\ntype = \"checker\"\nscale = 1\neven = [1, 1, 1]\nodd = \"a\"\n\
+             [materials.m]\ntype = \"diffuse\"\nalbedo = \"a\"",
+            "textures.a",
+            "a → b → a",
+        ),
+        (
+            "[textures.a]\ntype = \"checker\"\nscale = 0\neven = [1, 1, 1]\nodd = [0, 0, 0]\n\
+             [materials.m]\ntype = \"diffuse\"\nalbedo = \"a\"",
+            "textures.a.scale",
+            "greater than 0",
+        ),
+        (
+            "[textures.a]\ntype = \"image\"\nfile = \"gone.png\"\n\
+             [materials.m]\ntype = \"diffuse\"\nalbedo = \"a\"",
+            "textures.a.file",
+            "gone.png",
+        ),
+        ("[textures.a]\ntype = \"wood\"", "textures.a.type", "wood"),
+        (
+            "[textures.a]\ntype = \"noise\"\nfile = \"x.png\"",
+            "textures.a",
+            "image textures",
+        ),
+        (
+            "[materials.m]\ntype = \"diffuse\"\nalbedo = 3",
+            "materials.m.albedo",
+            "name of a texture",
+        ),
+        (
+            "[textures.a]\ntype = \"checker\"\nscale = 1\neven = [2, 0, 0]\nodd = [0, 0, 0]\n\
+             [materials.m]\ntype = \"emissive\"\nradiance = \"a\"\n\
+             [materials.n]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n\
+             [textures.b]\ntype = \"checker\"\nscale = 1\neven = [-1, 0, 0]\nodd = [0, 0, 0]\n\
+             [materials.o]\ntype = \"diffuse\"\nalbedo = \"b\"",
+            "textures.b.even",
+            "negative",
+        ),
+    ];
+    for (text, field, words) in cases {
+        let message = scene_file_error(&dir, text);
+        assert!(
+            message.contains(field) && message.contains(words),
+            "{text}\n→ {message}"
+        );
+    }
+}
