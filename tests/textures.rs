@@ -201,6 +201,96 @@ transform = [{ translate = [0, 0, 20] }]
     );
 }
 
+/// A 4 × 2 PNG: the top row red, green, blue, white; the bottom row black.
+fn write_banded_png(path: &std::path::Path) {
+    let top: [u8; 12] = [255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255];
+    let raw: Vec<u8> = top.iter().copied().chain([0u8; 12]).collect();
+    image::RgbImage::from_raw(4, 2, raw)
+        .unwrap()
+        .save(path)
+        .unwrap();
+}
+
+/// Mesh files bring their own textures: MTL `map_Kd` (times `Kd`) and glTF
+/// `baseColorTexture` (times `baseColorFactor`), each read by the file's
+/// texture coordinates (glTF's v running down the image, OBJ's up).
+#[test]
+fn mesh_files_bring_their_base_colour_textures() {
+    let dir = scratch_dir("tex-mesh-files");
+    write_banded_png(&dir.join("bands.png"));
+    // One triangle facing +z, its first corner on the centre of the top
+    // row's first texel (u = 1/8; v = 3/4 upwards, 1/4 downwards).
+    std::fs::write(
+        dir.join("tri.obj"),
+        "mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+         vt 0.125 0.75\nvt 0.375 0.75\nvt 0.625 0.75\nusemtl half\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("tri.mtl"),
+        "newmtl half\nKd 0.5 0.5 0.5\nmap_Kd bands.png\n",
+    )
+    .unwrap();
+    let floats: Vec<f32> = vec![
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, // positions
+        0.125, 0.25, 0.375, 0.25, 0.625, 0.25, // texture coordinates
+    ];
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    use base64::Engine as _;
+    let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    let gltf = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [1, 0.5, 1, 1],
+      "baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}}}],
+  "textures": [{{"source": 0}}], "images": [{{"uri": "bands.png"}}],
+  "buffers": [{{"byteLength": 60, "uri": "data:application/octet-stream;base64,{data}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
+                  {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+      "min": [0, 0, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}]}}"#
+    );
+    std::fs::write(dir.join("tri.gltf"), gltf).unwrap();
+    let scene = compile_file(
+        &dir,
+        "m.toml",
+        r#"
+[[objects]]
+type = "mesh"
+file = "tri.obj"
+
+[[objects]]
+type = "mesh"
+file = "tri.gltf"
+transform = [{ translate = [0, 0, 10] }]
+"#,
+    );
+    // Near the first corner: 3% of the way from red to green (see
+    // `spheres_and_meshes_give_textures_their_coordinates`), in the top row.
+    let obj = colour_at(&scene, Vec3::new(0.01, 0.01, 5.0), -Vec3::Z);
+    let want = Color::new(0.97, 0.03, 0.0);
+    assert!(
+        (obj - 0.5 * want).abs().max_element() < 2e-3,
+        "OBJ: {obj:?}"
+    );
+    let gltf = colour_at(&scene, Vec3::new(0.01, 0.01, 15.0), -Vec3::Z);
+    let factor = Color::new(1.0, 0.5, 1.0);
+    assert!(
+        (gltf - factor * want).abs().max_element() < 2e-3,
+        "glTF: {gltf:?}"
+    );
+    // A missing image is named with its material.
+    std::fs::write(dir.join("tri.mtl"), "newmtl half\nmap_Kd gone.png\n").unwrap();
+    let message = scene_file_error(&dir, "[[objects]]\ntype = \"mesh\"\nfile = \"tri.obj\"\n");
+    assert!(
+        message.contains("map_Kd") && message.contains("gone.png"),
+        "{message}"
+    );
+}
+
 #[test]
 fn a_textured_light_emits_its_texture_and_is_found_by_bounces() {
     let dir = scratch_dir("tex-light");

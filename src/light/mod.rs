@@ -145,6 +145,8 @@ impl Lights {
         // The environment's power is its light through the disc the scene
         // presents to it (π r²), whichever way it comes.
         let disc = std::f64::consts::PI * f64::from(scene_radius.max(f32::MIN_POSITIVE)).powi(2);
+        // A black environment is no light.
+        let environment = environment.filter(|e| e.integral() > 0.0);
         let environment_power = environment.as_ref().map(|e| e.integral() * disc);
         let mut powers: Vec<f64> = lights.iter().map(Light::power).collect();
         powers.extend(environment_power);

@@ -18,11 +18,13 @@
 //! checked against its buffer view and buffer before it is read.
 
 use super::{fan, MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
+use crate::texture::Image;
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Loads a `.gltf` or `.glb` file.
 /// `bytes` are the file's content.
@@ -38,8 +40,12 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let document = gltf::Document::from_json(json).map_err(invalid)?;
     let buffers = load_buffers(path, &document, blob)?;
 
+    let materials = document
+        .materials()
+        .map(|m| convert_material(m, path, &buffers))
+        .collect::<Result<_, _>>()?;
     let mut model = Model {
-        materials: document.materials().map(convert_material).collect(),
+        materials,
         ..Model::default()
     };
     // glTF mesh index → index in model.meshes, for meshes already converted.
@@ -127,6 +133,26 @@ fn check_attribute_indices(json: &gltf::json::Root) -> Result<(), String> {
 
 /// The bytes of every buffer: the GLB's binary chunk, a base64 data URI, or a
 /// file beside the glTF file.
+/// The bytes a URI of the file names: a base64 data URI, or a file beside
+/// the glTF file (`dir`).
+fn read_uri(dir: &Path, uri: &str) -> Result<Vec<u8>, String> {
+    if uri.starts_with("data:") {
+        let (_, payload) = uri
+            .split_once(";base64,")
+            .ok_or_else(|| "only base64 data URIs are supported".to_string())?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("bad base64 data: {e}"));
+    }
+    if uri.contains("://") {
+        return Err(format!(
+            "`{uri}`: only files beside the glTF file are supported"
+        ));
+    }
+    let file = dir.join(percent_decode(uri));
+    std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))
+}
+
 fn load_buffers(
     path: &Path,
     document: &gltf::Document,
@@ -140,24 +166,7 @@ fn load_buffers(
             gltf::buffer::Source::Bin => blob
                 .take()
                 .ok_or_else(|| err("refers to the GLB binary chunk, which is missing".into()))?,
-            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                let (_, payload) = uri
-                    .split_once(";base64,")
-                    .ok_or_else(|| err("only base64 data URIs are supported".into()))?;
-                base64::engine::general_purpose::STANDARD
-                    .decode(payload)
-                    .map_err(|e| err(format!("bad base64 data: {e}")))?
-            }
-            gltf::buffer::Source::Uri(uri) => {
-                if uri.contains("://") {
-                    return Err(err(format!(
-                        "`{uri}`: only files beside the glTF file are supported"
-                    )));
-                }
-                let file = dir.join(percent_decode(uri));
-                std::fs::read(&file)
-                    .map_err(|e| err(format!("cannot read `{}`: {e}", file.display())))?
-            }
+            gltf::buffer::Source::Uri(uri) => read_uri(dir, uri).map_err(err)?,
         };
         if data.len() < buffer.length() {
             return Err(err(format!(
@@ -403,7 +412,8 @@ fn convert_mesh(
             _ => all_normals = false,
         }
         match reader.read_tex_coords(0) {
-            Some(t) if all_uvs => uvs.extend(t.into_f32()),
+            // glTF's v runs down the image; lumen's up.
+            Some(t) if all_uvs => uvs.extend(t.into_f32().map(|[u, v]| [u, 1.0 - v])),
             _ => all_uvs = false,
         }
 
@@ -463,12 +473,41 @@ fn convert_mesh(
 /// Maps a glTF material: base colour (RGB of `baseColorFactor`), metallic,
 /// roughness, `KHR_materials_ior`, `KHR_materials_transmission`, and
 /// `emissiveFactor` times `KHR_materials_emissive_strength`, and
-/// `doubleSided`. Textures are ignored.
-fn convert_material(m: gltf::Material) -> MeshMaterial {
+/// `doubleSided`; of the textures, `baseColorTexture` (read by texture
+/// coordinates 0; others are ignored).
+fn convert_material(
+    m: gltf::Material,
+    path: &Path,
+    buffers: &[Vec<u8>],
+) -> Result<MeshMaterial, MeshError> {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();
     let strength = m.emissive_strength().unwrap_or(1.0);
-    MeshMaterial {
+    let base_color_texture = match pbr.base_color_texture() {
+        Some(info) if info.tex_coord() == 0 => {
+            let image = info.texture().source();
+            let err =
+                |msg: String| MeshError::new(path, None, format!("image {}: {msg}", image.index()));
+            let bytes = match image.source() {
+                gltf::image::Source::View { view, .. } => {
+                    let data = buffers.get(view.buffer().index());
+                    let range = view.offset()..view.offset() + view.length();
+                    data.and_then(|d| d.get(range))
+                        .ok_or_else(|| err("its buffer view lies outside its buffer".into()))?
+                        .to_vec()
+                }
+                gltf::image::Source::Uri { uri, .. } => {
+                    read_uri(path.parent().unwrap_or(Path::new("")), uri).map_err(err)?
+                }
+            };
+            let shown = format!("{} image {}", path.display(), image.index());
+            let decoded = Image::decode(&bytes, &shown).map_err(|e| err(e.to_string()))?;
+            Some(Arc::new(decoded))
+        }
+        _ => None,
+    };
+    Ok(MeshMaterial {
+        base_color_texture,
         name: m
             .name()
             .map(str::to_string)
@@ -480,5 +519,5 @@ fn convert_material(m: gltf::Material) -> MeshMaterial {
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
         emission: m.emissive_factor().map(|e| e * strength),
         double_sided: m.double_sided(),
-    }
+    })
 }

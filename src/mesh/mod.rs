@@ -26,9 +26,11 @@ mod ply;
 
 use crate::material::{Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::Color;
+use crate::texture::Image;
 use glam::Mat4;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Material index of a triangle whose file gives it no material.
 pub const NO_MATERIAL: u32 = u32::MAX;
@@ -134,6 +136,9 @@ pub struct MeshMaterial {
     /// Linear RGB base colour (MTL `Kd`, or `Ks` for a metal; glTF
     /// `baseColorFactor`).
     pub base_color: [f32; 3],
+    /// An image the base colour is multiplied by, looked up by the mesh's
+    /// texture coordinates (MTL `map_Kd`; glTF `baseColorTexture`).
+    pub base_color_texture: Option<Arc<Image>>,
     /// 0 for a dielectric surface, 1 for a metal.
     pub metallic: f32,
     /// Perceptual roughness in [0, 1] as in glTF; the microfacet width is
@@ -161,6 +166,7 @@ impl Default for MeshMaterial {
         Self {
             name: String::new(),
             base_color: [0.8; 3],
+            base_color_texture: None,
             metallic: 0.0,
             roughness: 1.0,
             ior: DEFAULT_IOR,

@@ -13,10 +13,12 @@
 //! Line (`l`) and point (`p`) elements have no surface and are ignored.
 
 use super::{MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use crate::texture::Image;
 use glam::Mat4;
 use std::borrow::Cow;
 use std::cell::RefCell;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Loads an OBJ file and the MTL files it names.
 /// `bytes` are the file's content.
@@ -26,6 +28,8 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
 
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_error: RefCell<Option<MeshError>> = RefCell::new(None);
+    // The MTL file read, whose directory its images are relative to.
+    let mtl_path: RefCell<Option<PathBuf>> = RefCell::new(None);
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -37,7 +41,9 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
             // `mtllib` without a file name: nothing to load.
             return Err(tobj::LoadError::OpenFileFailed);
         }
-        load_mtl(&dir.join(name), &mtl_error)
+        let file = dir.join(name);
+        *mtl_path.borrow_mut() = Some(file.clone());
+        load_mtl(&file, &mtl_error)
     });
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);
@@ -48,8 +54,8 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let materials: Vec<MeshMaterial> = materials
         .unwrap_or_default()
         .iter()
-        .map(convert_material)
-        .collect();
+        .map(|m| convert_material(m, mtl_path.borrow().as_deref().unwrap_or(path)))
+        .collect::<Result<_, _>>()?;
 
     let mut model = Model {
         materials,
@@ -449,8 +455,20 @@ fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
 ///   roughness² is √(2 / (Ns + 2));
 /// - ior = `Ni` (1.5 when absent); transmission = the larger of 1 − `d` and
 ///   `Tr`, and 1 for illumination models 4, 6 and 7 (glass, refraction);
-/// - emission = `Ke`.
-fn convert_material(m: &tobj::Material) -> MeshMaterial {
+/// - emission = `Ke`;
+/// - `map_Kd`: an image (relative to the MTL file `mtl`) the base colour is
+///   multiplied by.
+fn convert_material(m: &tobj::Material, mtl: &Path) -> Result<MeshMaterial, MeshError> {
+    let base_color_texture = match &m.diffuse_texture {
+        Some(file) => {
+            let dir = mtl.parent().unwrap_or(Path::new(""));
+            let image = Image::read(&dir.join(file)).map_err(|e| {
+                MeshError::new(mtl, None, format!("material `{}`: map_Kd: {e}", m.name))
+            })?;
+            Some(Arc::new(image))
+        }
+        None => None,
+    };
     let defaults = MeshMaterial::default();
     let kd = m.diffuse.unwrap_or(defaults.base_color);
     let ks = m.specular.unwrap_or([0.0; 3]);
@@ -467,14 +485,15 @@ fn convert_material(m: &tobj::Material) -> MeshMaterial {
     if matches!(m.illumination_model, Some(4 | 6 | 7)) {
         transmission = 1.0;
     }
-    MeshMaterial {
+    Ok(MeshMaterial {
         name: m.name.clone(),
         base_color: if metal { ks } else { kd },
+        base_color_texture,
         metallic: if metal { 1.0 } else { 0.0 },
         roughness: (2.0 / (ns + 2.0)).sqrt().sqrt(),
         ior: m.optical_density.unwrap_or(defaults.ior),
         transmission,
         emission: m.emissive.unwrap_or([0.0; 3]),
         double_sided: false,
-    }
+    })
 }

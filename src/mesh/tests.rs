@@ -937,6 +937,10 @@ fn mutated_bunnies_never_panic() {
         r#""scene": 0, "scenes": [{"nodes": [0]}],"#,
     );
     dir.write("m.mtl", RICH_MTL);
+    // The texture the MTL names.
+    ::image::RgbImage::new(1, 1)
+        .save(dir.0.join("tex.png"))
+        .unwrap();
     for (name, original, head, rounds) in [
         (
             "bunny.obj",

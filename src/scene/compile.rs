@@ -19,6 +19,7 @@ use crate::light::{Environment, EnvironmentMap, Lights};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::{Color, Vec3};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -115,6 +116,8 @@ impl Scene {
             materials,
             material_index,
             sphere_uv,
+            textures,
+            material_textures,
             top: Shapes::default(),
             spheres: Vec::with_capacity(desc.objects.len()),
             groups: Vec::new(),
@@ -131,6 +134,8 @@ impl Scene {
         let background = compile_background(&desc.background, base, &mut objects.sources)?;
         let Objects {
             materials,
+            textures,
+            material_textures,
             top,
             spheres,
             groups,
@@ -139,8 +144,6 @@ impl Scene {
             mut stats,
             ..
         } = objects;
-        // The materials of mesh files come last, untextured.
-        material_textures.resize(materials.len(), None);
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
@@ -267,6 +270,9 @@ struct Objects<'a> {
     /// Per material of the description: whether spheres of it need their
     /// (u, v).
     sphere_uv: Vec<bool>,
+    textures: Vec<Texture>,
+    /// Per material, its colour's texture (see [`Scene::material_textures`]).
+    material_textures: Vec<Option<u32>>,
     top: Shapes,
     spheres: Vec<Sphere>,
     groups: Vec<Group>,
@@ -457,12 +463,24 @@ impl<'a> Objects<'a> {
         if let Some(index) = loaded.materials[slot] {
             return index;
         }
-        let material = loaded.model.materials.get(slot).map_or_else(
-            || MeshMaterial::default().to_material(),
-            MeshMaterial::to_material,
-        );
+        let default = MeshMaterial::default();
+        let mesh_material = loaded.model.materials.get(slot).unwrap_or(&default);
+        let mut material = mesh_material.to_material();
+        // A base colour image, times the base colour, becomes the albedo's
+        // texture (the material's own albedo a placeholder).
+        let texture = match (&mesh_material.base_color_texture, material) {
+            (Some(image), Material::Diffuse(_) | Material::Metal(_)) => {
+                let factor = Color::from_array(mesh_material.base_color);
+                self.textures
+                    .push(Texture::Image(Arc::new(image.scaled(factor))));
+                material = material.with_color(Color::ZERO);
+                Some(self.textures.len() as u32 - 1)
+            }
+            _ => None,
+        };
         let index = self.materials.len() as u32;
         self.materials.push(material);
+        self.material_textures.push(texture);
         loaded.materials[slot] = Some(index);
         index
     }

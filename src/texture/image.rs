@@ -106,6 +106,15 @@ impl Image {
         Ok(Image::new(width, height, texels))
     }
 
+    /// The image with every texel multiplied by `c`.
+    pub fn scaled(&self, c: Color) -> Image {
+        Image::new(
+            self.width,
+            self.height,
+            self.texels.iter().map(|t| *t * c).collect(),
+        )
+    }
+
     /// Width in texels.
     pub fn width(&self) -> usize {
         self.width
