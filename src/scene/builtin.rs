@@ -108,6 +108,7 @@ scenes! {
     "checkered-spheres", "The Next Week: two spheres under a 3-D checker texture" => checkered_spheres;
     "perlin-spheres", "The Next Week: Perlin-noise marble on a ground sphere and a ball" => perlin_spheres;
     "quads", "The Next Week: five coloured quads, the sides of an open box, seen from the front" => quads;
+    "simple-light", "The Next Week: Perlin marble lit by a ball and a panel of light in the dark" => simple_light;
     "cornell-box", "The Next Week: the Cornell box, its ceiling light found only by chance (noisy; --integrator path aims at it)" => cornell_box;
   }
 }
@@ -620,6 +621,27 @@ fn quads() -> SceneDesc {
         .background(NEXT_WEEK_SKY)
         .camera(pinhole(80.0, [0.0, 0.0, 9.0], [0.0; 3]))
         .build()
+}
+
+/// The marble spheres of [`perlin_spheres`] in the dark, lit by a ball of
+/// light above them and a square panel beside them (radiance 4, emitting
+/// from both sides, as the book's diffuse light does).
+fn simple_light() -> SceneDesc {
+    Builder {
+        desc: perlin_spheres(),
+    }
+    .material(
+        "light",
+        MaterialDesc::Emissive {
+            radiance: [4.0; 3].into(),
+            two_sided: true,
+        },
+    )
+    .sphere([0.0, 7.0, 0.0], 2.0, "light")
+    .quad([3.0, 1.0, -2.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], "light")
+    .background(BackgroundDesc::Solid { color: [0.0; 3] })
+    .camera(pinhole(20.0, [26.0, 3.0, 6.0], [0.0, 2.0, 0.0]))
+    .build()
 }
 
 /// The Cornell box of *The Next Week*: a 555-unit box, red on the left,
