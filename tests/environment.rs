@@ -11,7 +11,7 @@
 mod common;
 
 use common::{
-    assert_tiles_agree, compile_file, furnace, pixel_stats, scene_file, scene_file_error,
+    assert_tiles_agree, compile_file, furnace_desc, pixel_stats, scene_file, scene_file_error,
     scratch_dir, tiles_agree, PixelStats, K,
 };
 use lumen::scene::desc::MaterialDesc;
@@ -64,9 +64,14 @@ fn white_furnace_with_next_event_estimation_and_mis_is_white() {
         attenuation: Default::default(),
     };
     for sampler in [Sampling::Sobol, Sampling::Independent] {
-        let mut scene = furnace(lambertian.clone(), 32, 24, 32, 50);
-        scene.settings.integrator = Integrator::Path;
-        scene.settings.sampler = sampler;
+        let mut desc = furnace_desc(lambertian.clone(), 32, 24, 32, 50);
+        desc.render.integrator = Integrator::Path;
+        desc.render.sampler = sampler;
+        // One colour is not sampled unless asked for.
+        assert!(Scene::from_desc(&desc).unwrap().lights.is_empty());
+        desc.render.sample_background = Some(true);
+        let scene = Scene::from_desc(&desc).unwrap();
+        assert_eq!(scene.lights.len(), 1);
         let stats = pixel_stats(&scene);
         assert_white(&format!("solid sky, {sampler:?}"), &stats);
         // MIS makes single samples differ from 1 (the two strategies'

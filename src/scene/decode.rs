@@ -421,6 +421,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "sampling",
             "integrator",
             "light_selection",
+            "sample_background",
             "noise_target",
             "gamma",
             "epsilon",
@@ -448,6 +449,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
         light_selection: t
             .optional("light_selection", |n, p| keyword(n, p, LIGHT_SELECTIONS))?
             .unwrap_or(d.light_selection),
+        sample_background: t.optional("sample_background", boolean)?,
         noise_target: t.optional("noise_target", float)?,
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
         epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),

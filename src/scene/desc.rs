@@ -66,6 +66,11 @@ pub struct RenderDesc {
     /// How the `path` integrator chooses the light it samples.
     #[serde(skip_serializing_if = "is_power")]
     pub light_selection: LightSelection,
+    /// Whether the `path` integrator samples the background as a light;
+    /// absent, an image background is sampled and a gradient or one colour
+    /// is not (the bounces find a smooth sky at least as well).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_background: Option<bool>,
     /// Adaptive sampling: a pixel stops taking samples once its estimated
     /// relative error is at most this; absent, every pixel takes them all.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -90,6 +95,7 @@ impl Default for RenderDesc {
             sampler: SamplingDesc::Sobol,
             integrator: IntegratorDesc::Path,
             light_selection: LightSelection::Power,
+            sample_background: None,
             noise_target: None,
             gamma: 2.0,
             epsilon: 0.001,

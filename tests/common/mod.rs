@@ -36,7 +36,18 @@ pub fn builtin_scene(name: &str, width: u32, spp: u32, seed: u64) -> Scene {
 /// the notes' estimator (`bsdf`: every sample of a white sphere is at most
 /// 1).
 pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth: u32) -> Scene {
-    let desc = SceneDesc {
+    Scene::from_desc(&furnace_desc(material, width, height, spp, depth)).unwrap()
+}
+
+/// The description of [`furnace`]'s scene.
+pub fn furnace_desc(
+    material: MaterialDesc,
+    width: u32,
+    height: u32,
+    spp: u32,
+    depth: u32,
+) -> SceneDesc {
+    SceneDesc {
         caption: String::new(),
         render: RenderDesc {
             width,
@@ -60,8 +71,7 @@ pub fn furnace(material: MaterialDesc, width: u32, height: u32, spp: u32, depth:
             material: "m".into(),
             transform: Vec::new(),
         }],
-    };
-    Scene::from_desc(&desc).unwrap()
+    }
 }
 
 /// Centre of the furnace sphere.
