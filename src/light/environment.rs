@@ -149,6 +149,9 @@ impl EnvironmentMap {
     /// (counter-clockwise seen from above) and scaled by `intensity` (≥ 0);
     /// `None` when the image is black everywhere or the intensity is 0.
     pub fn new(image: Image, rotation_degrees: f32, intensity: f32) -> Option<Self> {
+        if !(intensity > 0.0) {
+            return None;
+        }
         let (w, h) = (image.width(), image.height());
         // A texel's weight: the brightest of it and its eight neighbours
         // (the bilinear lookup within the texel's area draws on them, so
@@ -156,12 +159,8 @@ impl EnvironmentMap {
         // polar angle (rows near the poles cover less of the sphere).
         let mut weights = vec![0.0f64; w * h];
         let mut integral = 0.0f64;
-        let row_area = |y: usize| -> f64 {
-            let theta = std::f64::consts::PI * (y as f64 + 0.5) / h as f64;
-            theta.sin()
-        };
         for y in 0..h {
-            let sin = row_area(y);
+            let sin = (std::f64::consts::PI * (y as f64 + 0.5) / h as f64).sin();
             for x in 0..w {
                 let mut brightest = 0.0f32;
                 for dy in [-1i64, 0, 1] {
@@ -178,9 +177,6 @@ impl EnvironmentMap {
         // Each texel covers (2π/w)(π/h) sin θ of the sphere.
         let texel_area = 2.0 * std::f64::consts::PI * std::f64::consts::PI / (w * h) as f64;
         let integral = integral * texel_area * f64::from(intensity);
-        if !(intensity > 0.0) {
-            return None;
-        }
         let distribution = Distribution2D::new(&weights, w)?;
         let (sin, cos) = rotation_degrees.to_radians().sin_cos();
         Some(EnvironmentMap {

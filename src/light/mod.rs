@@ -146,10 +146,12 @@ impl Lights {
         // presents to it (π r²), whichever way it comes.
         let disc = std::f64::consts::PI * f64::from(scene_radius.max(f32::MIN_POSITIVE)).powi(2);
         // A black environment is no light.
-        let environment = environment.filter(|e| e.integral() > 0.0);
-        let environment_power = environment.as_ref().map(|e| e.integral() * disc);
+        let environment = environment
+            .map(|e| (e.integral(), e))
+            .filter(|(integral, _)| *integral > 0.0);
         let mut powers: Vec<f64> = lights.iter().map(Light::power).collect();
-        powers.extend(environment_power);
+        powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
+        let environment = environment.map(|(_, e)| e);
         if selection == LightSelection::Uniform {
             for p in &mut powers {
                 *p = if *p > 0.0 { 1.0 } else { 0.0 };

@@ -23,6 +23,7 @@ use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
+use std::borrow::Cow;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -131,8 +132,6 @@ fn check_attribute_indices(json: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
-/// The bytes of every buffer: the GLB's binary chunk, a base64 data URI, or a
-/// file beside the glTF file.
 /// The bytes a URI of the file names: a base64 data URI, or a file beside
 /// the glTF file (`dir`).
 fn read_uri(dir: &Path, uri: &str) -> Result<Vec<u8>, String> {
@@ -153,6 +152,8 @@ fn read_uri(dir: &Path, uri: &str) -> Result<Vec<u8>, String> {
     std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))
 }
 
+/// The bytes of every buffer: the GLB's binary chunk, a base64 data URI, or a
+/// file beside the glTF file.
 fn load_buffers(
     path: &Path,
     document: &gltf::Document,
@@ -488,16 +489,17 @@ fn convert_material(
             let image = info.texture().source();
             let err =
                 |msg: String| MeshError::new(path, None, format!("image {}: {msg}", image.index()));
-            let bytes = match image.source() {
+            let bytes: Cow<[u8]> = match image.source() {
                 gltf::image::Source::View { view, .. } => {
                     let data = buffers.get(view.buffer().index());
                     let range = view.offset()..view.offset() + view.length();
-                    data.and_then(|d| d.get(range))
-                        .ok_or_else(|| err("its buffer view lies outside its buffer".into()))?
-                        .to_vec()
+                    Cow::Borrowed(
+                        data.and_then(|d| d.get(range))
+                            .ok_or_else(|| err("its buffer view lies outside its buffer".into()))?,
+                    )
                 }
                 gltf::image::Source::Uri { uri, .. } => {
-                    read_uri(path.parent().unwrap_or(Path::new("")), uri).map_err(err)?
+                    Cow::Owned(read_uri(path.parent().unwrap_or(Path::new("")), uri).map_err(err)?)
                 }
             };
             let shown = format!("{} image {}", path.display(), image.index());

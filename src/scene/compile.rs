@@ -105,17 +105,11 @@ impl Scene {
             material_textures.push(texture);
         }
         let textures = table.textures;
-        // Spheres work out their (u, v) only for textures that use them.
-        let sphere_uv: Vec<bool> = material_textures
-            .iter()
-            .map(|t| t.is_some_and(|t| textures[t as usize].uses_uv(&textures)))
-            .collect();
         let mut objects = Objects {
             desc,
             base,
             materials,
             material_index,
-            sphere_uv,
             textures,
             material_textures,
             top: Shapes::default(),
@@ -276,9 +270,6 @@ struct Objects<'a> {
     base: &'a Path,
     materials: Vec<Material>,
     material_index: HashMap<&'a str, u32>,
-    /// Per material of the description: whether spheres of it need their
-    /// (u, v).
-    sphere_uv: Vec<bool>,
     textures: Vec<Texture>,
     /// Per material, its colour's texture (see [`Scene::material_textures`]).
     material_textures: Vec<Option<u32>>,
@@ -293,6 +284,13 @@ struct Objects<'a> {
 }
 
 impl<'a> Objects<'a> {
+    /// Whether material `m`'s texture uses the surface's (u, v), which
+    /// spheres then work out.
+    fn uses_uv(&self, m: u32) -> bool {
+        self.material_textures[m as usize]
+            .is_some_and(|t| self.textures[t as usize].uses_uv(&self.textures))
+    }
+
     fn material(&self, i: usize, name: &str) -> Result<u32, SceneError> {
         self.material_index
             .get(name)
@@ -336,7 +334,7 @@ impl<'a> Objects<'a> {
                 let sphere = Sphere::new(vec3(*center), *radius as f32);
                 // A textured sphere that is turned keeps its own space, so
                 // that its texture turns with it.
-                let uv = self.sphere_uv[m as usize];
+                let uv = self.uses_uv(m);
                 let keeps_texture = |scale: f32| {
                     !uv || [Vec3::X, Vec3::Y, Vec3::Z]
                         .iter()

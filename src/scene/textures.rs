@@ -61,6 +61,25 @@ impl<'a> TextureTable<'a> {
         }
     }
 
+    /// The texture of the colour parameter `field` of a texture: a colour
+    /// given outright becomes a texture of that one colour.
+    fn texture_of(
+        &mut self,
+        field: &str,
+        c: &'a ColorDesc,
+        chain: &mut Vec<&'a str>,
+        sources: &mut Vec<MeshSource>,
+    ) -> Result<u32, SceneError> {
+        match c {
+            ColorDesc::Rgb(rgb) => {
+                let colour = super::compile::color(field, *rgb)?;
+                self.textures.push(Texture::Solid(colour));
+                Ok(self.textures.len() as u32 - 1)
+            }
+            ColorDesc::Texture(name) => self.named(field, name, chain, sources),
+        }
+    }
+
     /// The index of the texture `name`, compiled on first use; `chain`
     /// holds the textures being compiled that led here (to refuse cycles).
     fn named(
@@ -75,7 +94,7 @@ impl<'a> TextureTable<'a> {
         }
         let descs = self.descs;
         let Some((key, desc)) = descs.get_key_value(name) else {
-            let mut known: Vec<&str> = self.descs.keys().map(String::as_str).collect();
+            let mut known: Vec<&str> = descs.keys().map(String::as_str).collect();
             known.truncate(8);
             let listed = if known.is_empty() {
                 "the scene defines no textures".to_string()
@@ -97,33 +116,11 @@ impl<'a> TextureTable<'a> {
         chain.push(key);
         let here = format!("textures.{name}");
         let texture = match desc {
-            TextureDesc::Checker { scale, even, odd } => {
-                super::compile::finite(format_args!("{here}.scale"), &[*scale])?;
-                if !(*scale as f32 > 0.0) {
-                    return Err(invalid(
-                        format!("{here}.scale"),
-                        format!("must be greater than 0, got {scale}"),
-                    ));
-                }
-                let mut part = |which: &str, c: &'a ColorDesc| -> Result<u32, SceneError> {
-                    let field = format!("{here}.{which}");
-                    match c {
-                        ColorDesc::Rgb(rgb) => {
-                            let colour = super::compile::color(&field, *rgb)?;
-                            self.textures.push(Texture::Solid(colour));
-                            Ok(self.textures.len() as u32 - 1)
-                        }
-                        ColorDesc::Texture(inner) => self.named(&field, inner, chain, sources),
-                    }
-                };
-                let even = part("even", even)?;
-                let odd = part("odd", odd)?;
-                Texture::Checker {
-                    inverse_scale: 1.0 / *scale as f32,
-                    even,
-                    odd,
-                }
-            }
+            TextureDesc::Checker { scale, even, odd } => Texture::Checker {
+                inverse_scale: 1.0 / positive(&format!("{here}.scale"), *scale)?,
+                even: self.texture_of(&format!("{here}.even"), even, chain, sources)?,
+                odd: self.texture_of(&format!("{here}.odd"), odd, chain, sources)?,
+            },
             TextureDesc::Image { file } => Texture::Image(Arc::new(read_image(
                 &format!("{here}.file"),
                 self.base,
@@ -134,24 +131,15 @@ impl<'a> TextureTable<'a> {
                 scale,
                 pattern,
                 seed,
-            } => {
-                super::compile::finite(format_args!("{here}.scale"), &[*scale])?;
-                if !(*scale as f32 > 0.0) {
-                    return Err(invalid(
-                        format!("{here}.scale"),
-                        format!("must be greater than 0, got {scale}"),
-                    ));
-                }
-                Texture::Noise {
-                    perlin: Arc::new(Perlin::new(*seed)),
-                    scale: *scale as f32,
-                    pattern: match pattern {
-                        NoisePatternDesc::Smooth => NoisePattern::Smooth,
-                        NoisePatternDesc::Turbulence => NoisePattern::Turbulence,
-                        NoisePatternDesc::Marble => NoisePattern::Marble,
-                    },
-                }
-            }
+            } => Texture::Noise {
+                perlin: Arc::new(Perlin::new(*seed)),
+                scale: positive(&format!("{here}.scale"), *scale)?,
+                pattern: match pattern {
+                    NoisePatternDesc::Smooth => NoisePattern::Smooth,
+                    NoisePatternDesc::Turbulence => NoisePattern::Turbulence,
+                    NoisePatternDesc::Marble => NoisePattern::Marble,
+                },
+            },
         };
         chain.pop();
         self.textures.push(texture);
@@ -159,6 +147,18 @@ impl<'a> TextureTable<'a> {
         self.index.insert(key, i);
         Ok(i)
     }
+}
+
+/// A scale of field `field`: finite and above 0 in `f32`.
+fn positive(field: &str, value: f64) -> Result<f32, SceneError> {
+    super::compile::finite(field, &[value])?;
+    if !(value as f32 > 0.0) {
+        return Err(invalid(
+            field,
+            format!("must be greater than 0, got {value}"),
+        ));
+    }
+    Ok(value as f32)
 }
 
 /// Reads the image `file` (relative to `base`) of field `field`, and
