@@ -29,6 +29,10 @@ pub struct CameraSettings {
     pub defocus_angle: f32,
     /// Distance from `lookfrom` to the plane in perfect focus.
     pub focus_dist: f32,
+    /// The times `[open, close]` the shutter opens and closes, within
+    /// [0, 1]; each ray is traced at a time drawn uniformly between them
+    /// (at `open` when they are equal).
+    pub shutter: [f32; 2],
 }
 
 impl Default for CameraSettings {
@@ -40,6 +44,7 @@ impl Default for CameraSettings {
             vup: Vec3::Y,
             defocus_angle: 0.0,
             focus_dist: 1.0,
+            shutter: [0.0, 0.0],
         }
     }
 }
@@ -71,6 +76,9 @@ pub enum CameraError {
     /// A value is NaN or infinite.
     #[error("camera {0} is not a finite number")]
     NotFinite(&'static str),
+    /// The shutter interval is not within [0, 1] or closes before it opens.
+    #[error("shutter must be [open, close] with 0 <= open <= close <= 1, got [{0}, {1}]")]
+    Shutter(f32, f32),
 }
 
 /// A camera ready to generate rays for an image of a given size.
@@ -82,6 +90,9 @@ pub struct Camera {
     pixel_dv: Vec3,
     defocus_u: Vec3,
     defocus_v: Vec3,
+    /// When the shutter opens, and for how long.
+    shutter_open: f32,
+    shutter_span: f32,
     /// The orthonormal basis (u, v, w).
     pub basis: [Vec3; 3],
 }
@@ -97,6 +108,7 @@ impl Camera {
             ("vup", s.vup.is_finite()),
             ("defocus_angle", s.defocus_angle.is_finite()),
             ("focus_dist", s.focus_dist.is_finite()),
+            ("shutter", s.shutter.iter().all(|t| t.is_finite())),
         ] {
             if !ok {
                 return Err(CameraError::NotFinite(name));
@@ -116,6 +128,10 @@ impl Camera {
         }
         if !(s.defocus_angle >= 0.0 && s.defocus_angle < 180.0) {
             return Err(CameraError::DefocusAngle(s.defocus_angle));
+        }
+        let [open, close] = s.shutter;
+        if !(0.0 <= open && open <= close && close <= 1.0) {
+            return Err(CameraError::Shutter(open, close));
         }
         if width == 0 || height == 0 {
             return Err(CameraError::EmptyImage(width, height));
@@ -153,20 +169,27 @@ impl Camera {
             pixel_dv,
             defocus_u: defocus_radius * u,
             defocus_v: defocus_radius * v,
+            shutter_open: open,
+            shutter_span: close - open,
             basis: [u, v, w],
         })
     }
 
     /// The ray from the centre of the lens through the centre of pixel
-    /// `(x, y)`: the axis of the pixel's camera rays.
+    /// `(x, y)`, as the shutter opens: the axis of the pixel's camera rays.
     #[inline]
     pub fn central_ray(&self, x: u32, y: u32) -> Ray {
         let target = self.pixel00 + x as f32 * self.pixel_du + y as f32 * self.pixel_dv;
-        Ray::new(self.center, (target - self.center).normalize())
+        Ray::timed(
+            self.center,
+            (target - self.center).normalize(),
+            self.shutter_open,
+        )
     }
 
     /// The ray through pixel `(x, y)` at sub-pixel offset `(dx, dy)` ∈ [-0.5, 0.5)²
-    /// from the pixel centre, leaving the lens at a point drawn from `sampler`.
+    /// from the pixel centre, leaving the lens at a point and at a time in
+    /// the shutter interval drawn from `sampler`.
     #[inline]
     pub fn ray(&self, x: u32, y: u32, dx: f32, dy: f32, sampler: &mut impl Sampler) -> Ray {
         let target =
@@ -177,7 +200,12 @@ impl Camera {
             let p = sampling::in_unit_disk(sampler, Dim::Lens);
             self.center + p.x * self.defocus_u + p.y * self.defocus_v
         };
-        Ray::new(origin, (target - origin).normalize())
+        let time = if self.shutter_span > 0.0 {
+            self.shutter_open + self.shutter_span * sampler.get_1d(Dim::Time)
+        } else {
+            self.shutter_open
+        };
+        Ray::timed(origin, (target - origin).normalize(), time)
     }
 }
 
@@ -194,6 +222,7 @@ mod tests {
             vup: Vec3::Y,
             defocus_angle: 0.0,
             focus_dist: 1.0,
+            shutter: [0.0, 0.0],
         }
     }
 

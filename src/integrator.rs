@@ -7,8 +7,10 @@ use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
 use crate::material::{reflect, Material};
 use crate::math::{Color, Interval, Point3, Vec3};
+use crate::medium::{Medium, ISOTROPIC_PDF};
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
+use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
 use std::f32::consts::FRAC_1_PI;
 
@@ -121,6 +123,13 @@ fn step(
     path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Step {
+    sampler.start_bounce(depth);
+    if !scene.media.is_empty() {
+        let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+        if let Some((t, i)) = scene.medium_event(ray, t_max, sampler) {
+            return scatter_in_medium(scene, ray, t, &scene.media[i], depth, path, sampler);
+        }
+    }
     let Some(hit) = hit else {
         let mut sky = path.throughput * scene.background.color(ray.direction);
         if let Some((_, bsdf_pdf)) = path.sampled_from {
@@ -140,13 +149,27 @@ fn step(
         }
         return Step::Done(path.radiance + emitted);
     }
-    sampler.start_bounce(depth);
     let lambertian = match material {
         Material::Diffuse(d) if samples_lights(scene, depth) && d.is_lambertian() => Some(d.albedo),
         _ => None,
     };
     if let Some(albedo) = lambertian {
-        let (light, traced) = direct_light(scene, &record, albedo, sampler);
+        // The light must be on the side the path came from, by the true
+        // surface.
+        let pdf = |wi: Vec3| {
+            if record.normal.dot(wi) <= 0.0 {
+                0.0
+            } else {
+                lambertian_pdf(&record, wi)
+            }
+        };
+        let spawn = |wi: Vec3| record.spawn_origin(wi);
+        let at = Vertex {
+            point: record.point,
+            time: ray.time,
+            albedo,
+        };
+        let (light, traced) = direct_light(scene, &at, pdf, spawn, sampler);
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
@@ -156,6 +179,63 @@ fn step(
     path.sampled_from =
         lambertian.map(|_| (record.point, lambertian_pdf(&record, scatter.direction)));
     path.throughput *= scatter.attenuation;
+    let next = Ray::timed(
+        record.spawn_origin(scatter.direction),
+        scatter.direction,
+        ray.time,
+    );
+    go_on(scene, depth, path, sampler, next)
+}
+
+/// A path meets a particle of `medium` at distance `t` along `ray` (the end
+/// of segment `depth`): with the `path` integrator it samples a light from
+/// there, and it goes on in a direction drawn from the isotropic phase
+/// function, its throughput multiplied by the medium's albedo.
+#[inline(never)]
+fn scatter_in_medium(
+    scene: &Scene,
+    ray: &Ray,
+    t: f32,
+    medium: &Medium,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+) -> Step {
+    let point = ray.at(t);
+    let nee = samples_lights(scene, depth);
+    if nee {
+        let at = Vertex {
+            point,
+            time: ray.time,
+            albedo: medium.albedo,
+        };
+        let (light, traced) = direct_light(scene, &at, |_| ISOTROPIC_PDF, |_| point, sampler);
+        path.radiance += path.throughput * light;
+        path.shadow_rays += u64::from(traced);
+    }
+    let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
+    path.sampled_from = nee.then_some((point, ISOTROPIC_PDF));
+    path.throughput *= medium.albedo;
+    go_on(
+        scene,
+        depth,
+        path,
+        sampler,
+        Ray::timed(point, direction, ray.time),
+    )
+}
+
+/// The path, its throughput updated by the scattering at the end of segment
+/// `depth`, goes on along `next`, unless nothing is left of it or Russian
+/// roulette ends it.
+#[inline(always)]
+fn go_on(
+    scene: &Scene,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+    next: Ray,
+) -> Step {
     if path.throughput == Color::ZERO {
         return Step::Done(path.radiance);
     }
@@ -170,10 +250,7 @@ fn step(
             path.throughput /= p;
         }
     }
-    Step::Continue(Ray::new(
-        record.spawn_origin(scatter.direction),
-        scatter.direction,
-    ))
+    Step::Continue(next)
 }
 
 /// Bounces from which the `path` integrator plays Russian roulette: the
@@ -198,27 +275,38 @@ fn samples_lights(scene: &Scene, depth: u32) -> bool {
         && depth + 1 < scene.settings.max_depth
 }
 
-/// The light arriving at a Lambertian surface of `albedo` from a point
-/// sampled on a light, reflected towards the path, weighted by the power
-/// heuristic against the bounce's own chance of finding it; and whether a
-/// shadow ray was traced.
+/// A point where a path scatters and samples a light: a surface or a
+/// particle of a medium.
+struct Vertex {
+    point: Point3,
+    time: f32,
+    /// The fraction of light it scatters.
+    albedo: Color,
+}
+
+/// The light arriving at `at` from a point sampled on a light, scattered
+/// towards the path, weighted by the power heuristic against the path's own
+/// chance of finding it by scattering; and whether a shadow ray was traced.
+///
+/// Both scattering models that sample lights reflect what they would carry
+/// along a direction: the albedo times the density `pdf` with which they
+/// scatter there (cos θ / π for a Lambertian surface, 1/4π for a particle),
+/// 0 where they cannot. `spawn` gives where a ray leaving along a direction
+/// starts (a surface's rounding bound off it).
 #[inline(never)]
 fn direct_light(
     scene: &Scene,
-    record: &HitRecord,
-    albedo: Color,
+    at: &Vertex,
+    pdf: impl Fn(Vec3) -> f32,
+    spawn: impl Fn(Vec3) -> Point3,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
-    let Some(sample) = scene.lights.sample(record.point, sampler) else {
+    let Some(sample) = scene.lights.sample(at.point, sampler) else {
         return (Color::ZERO, false);
     };
     let wi = sample.direction;
-    // The light must be on the side the path came from, by the true surface.
-    // The surface reflects towards it what a bounce would carry there: the
-    // albedo times the bounce's density (cos θ / π about the shading normal,
-    // with the mirrored directions of a smooth surface).
-    let bsdf_pdf = lambertian_pdf(record, wi);
-    if record.normal.dot(wi) <= 0.0 || !(bsdf_pdf > 0.0) || sample.radiance == Color::ZERO {
+    let scatter_pdf = pdf(wi);
+    if !(scatter_pdf > 0.0) || sample.radiance == Color::ZERO {
         return (Color::ZERO, false);
     }
     // The shadow ray starts off the surface (moved by its rounding bound)
@@ -227,14 +315,14 @@ fn direct_light(
     // meet a light's plane before the point, and the light would shadow
     // itself (far from the origin, where the rounding bounds grow). The
     // environment is infinitely far along `wi`.
-    let origin = record.spawn_origin(wi);
+    let origin = spawn(wi);
     let (shadow, end) = if sample.distance.is_infinite() {
-        (Ray::new(origin, wi), f32::INFINITY)
+        (Ray::timed(origin, wi, at.time), f32::INFINITY)
     } else {
         let to = sample.point - origin;
         let length = to.length();
         let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
-        (Ray::new(origin, to / length), end)
+        (Ray::timed(origin, to / length, at.time), end)
     };
     if !(end > scene.settings.epsilon) {
         // Closer than the nearest hit a bounce can make: out of reach.
@@ -243,8 +331,11 @@ fn direct_light(
     if scene.occluded(&shadow, Interval::new(scene.settings.epsilon, end)) {
         return (Color::ZERO, true);
     }
-    let weight = power_heuristic(sample.pdf, bsdf_pdf);
-    let light = sample.radiance * albedo * (bsdf_pdf * weight / sample.pdf);
+    let weight = power_heuristic(sample.pdf, scatter_pdf);
+    let mut light = sample.radiance * at.albedo * (scatter_pdf * weight / sample.pdf);
+    if !scene.media.is_empty() {
+        light *= scene.transmittance(&shadow, end);
+    }
     (light, true)
 }
 

@@ -16,7 +16,8 @@
 //! - [`light`]: emissive surfaces and the background, gathered to be aimed at
 //!   (next-event estimation); [`distribution`]: drawing in proportion to a
 //!   table of weights.
-//! - [`texture`]: images read from files.
+//! - [`medium`]: fog and smoke of constant density.
+//! - [`texture`]: solid colours, checkers, images and noise.
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampler`]: the numbers behind every random decision of a path
@@ -61,6 +62,7 @@ pub mod lanes;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod medium;
 pub mod mesh;
 pub mod output;
 pub mod progressive;

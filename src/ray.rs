@@ -14,13 +14,26 @@ pub struct Ray {
     pub origin: Point3,
     /// The direction B.
     pub direction: Vec3,
+    /// The moment the ray is traced at, within the camera's shutter
+    /// interval: where moving objects are (0 when nothing moves).
+    pub time: f32,
 }
 
 impl Ray {
-    /// Creates the ray A + tB.
+    /// Creates the ray A + tB at time 0.
     #[inline]
     pub fn new(origin: Point3, direction: Vec3) -> Self {
-        Self { origin, direction }
+        Self::timed(origin, direction, 0.0)
+    }
+
+    /// Creates the ray A + tB at `time`.
+    #[inline]
+    pub fn timed(origin: Point3, direction: Vec3, time: f32) -> Self {
+        Self {
+            origin,
+            direction,
+            time,
+        }
     }
 
     /// The point p(t) = A + tB.

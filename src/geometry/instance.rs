@@ -3,11 +3,16 @@
 //! instances over it, each a box in the world and a transform (a two-level
 //! BVH). A ray meeting an instance is taken into the object's space and
 //! traced through the shared tree there.
+//!
+//! An instance may also move: placed by its transform at time 0, it is
+//! carried along `motion` in a straight line, reaching the end at time 1
+//! (motion blur, as the moving spheres of *The Next Week*). A ray at time t
+//! sees it moved by t · `motion`.
 
 use crate::geometry::bvh::{Bvh, SLACK};
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::Transform;
-use crate::math::Interval;
+use crate::math::{Interval, Point3, Vec3};
 use crate::ray::Ray;
 use std::sync::Arc;
 
@@ -18,17 +23,69 @@ pub struct Instance {
     pub transform: Transform,
     /// The tree, in object space (it holds no instances itself).
     pub bvh: Arc<Bvh>,
+    /// How far it moves, in the world, from time 0 to time 1 (zero for an
+    /// instance that stays put).
+    pub motion: Vec3,
 }
 
 impl Instance {
     /// Places `bvh` by `transform`.
     pub fn new(transform: Transform, bvh: Arc<Bvh>) -> Self {
-        Instance { transform, bvh }
+        Self::moving(transform, Vec3::ZERO, bvh)
     }
 
-    /// The world box of the placed tree.
+    /// Places `bvh` by `transform` at time 0, moving by `motion` until
+    /// time 1.
+    pub fn moving(transform: Transform, motion: Vec3, bvh: Arc<Bvh>) -> Self {
+        Instance {
+            transform,
+            bvh,
+            motion,
+        }
+    }
+
+    /// The world box of the placed tree, over the whole of its movement
+    /// from time 0 to time 1.
     pub fn bounds(&self) -> Aabb {
-        self.transform.bounds(&self.bvh.bounds())
+        let start = self.transform.bounds(&self.bvh.bounds());
+        if self.motion == Vec3::ZERO || !start.min.cmple(start.max).all() {
+            return start;
+        }
+        let end = Aabb {
+            min: start.min + self.motion,
+            max: start.max + self.motion,
+        };
+        // Widened by the rounding of the moved point (see `object_ray`).
+        let margin = f32::EPSILON * (start.min.abs().max(start.max.abs()) + self.motion.abs());
+        let mut all = start;
+        all.grow(&end);
+        all.min -= margin;
+        all.max += margin;
+        all
+    }
+
+    /// The world ray `ray` in the tree's space at the ray's time, with the
+    /// scale between distances there and in the world (see
+    /// [`Transform::to_object_ray`]).
+    #[inline]
+    pub fn object_ray(&self, ray: &Ray) -> (Ray, f32) {
+        if self.motion == Vec3::ZERO {
+            return self.transform.to_object_ray(ray);
+        }
+        // Moving the ray back is moving the instance forward.
+        let back = Ray::timed(ray.origin - ray.time * self.motion, ray.direction, ray.time);
+        self.transform.to_object_ray(&back)
+    }
+
+    /// Where the instance's point `p` (placed at time 0) is at `time`.
+    #[inline]
+    pub fn world_point(&self, p: Point3, time: f32) -> Point3 {
+        let placed = self.transform.point(p);
+        if self.motion == Vec3::ZERO {
+            placed
+        } else {
+            placed + time * self.motion
+        }
     }
 
     /// The nearest hit of the world ray `ray` strictly beyond `t_min` and
@@ -42,7 +99,7 @@ impl Instance {
     /// nearest hit does not depend on the order of the visit.
     #[inline]
     pub fn hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
-        let (object_ray, scale) = self.transform.to_object_ray(ray);
+        let (object_ray, scale) = self.object_ray(ray);
         let interval = Interval::new(t_min * scale, t_max * scale * SLACK);
         let hit = self.bvh.hit(&object_ray, interval)?;
         let t = hit.t / scale;
@@ -52,7 +109,7 @@ impl Instance {
     /// Whether the world ray hits the instance strictly inside `interval`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
-        let (object_ray, scale) = self.transform.to_object_ray(ray);
+        let (object_ray, scale) = self.object_ray(ray);
         let within = Interval::new(interval.min * scale, interval.max * scale);
         self.bvh.occluded(&object_ray, within)
     }

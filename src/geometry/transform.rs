@@ -278,7 +278,7 @@ impl Transform {
     /// direction by [`vector`](Self::vector), not normalised.
     #[inline]
     pub fn ray(&self, ray: &Ray) -> Ray {
-        Ray::new(self.point(ray.origin), self.vector(ray.direction))
+        Ray::timed(self.point(ray.origin), self.vector(ray.direction), ray.time)
     }
 
     /// The world ray `ray` in object space, with a unit-length direction, and
@@ -298,7 +298,7 @@ impl Transform {
         let origin = self.to_object.transform_point3a(ray.origin);
         let direction = self.to_object.transform_vector3a(ray.direction);
         let scale = direction.length();
-        (Ray::new(origin, direction / scale), scale)
+        (Ray::timed(origin, direction / scale, ray.time), scale)
     }
 
     /// A world box containing the transformed `bounds`: it contains

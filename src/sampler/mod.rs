@@ -54,6 +54,8 @@ pub enum Dim {
     Light,
     /// Whether Russian roulette ends the path (1-D).
     Roulette,
+    /// How far a ray gets into a medium (1-D).
+    Medium,
 }
 
 /// Slots of one bounce (or of the camera) that are named by a [`Dim`]; a
@@ -70,6 +72,7 @@ impl Dim {
             Dim::LightChoice => 3,
             Dim::Light => 4,
             Dim::Roulette => 5,
+            Dim::Medium => 6,
         }
     }
 }

@@ -1,13 +1,14 @@
 //! The built-in scenes: every figure of the notes, in their order, the
-//! book's cover image, and the figures of *The Next Week* that follow it.
+//! book's cover image, and the figures of *The Next Week* and *The Rest of
+//! Your Life* that follow it.
 //!
 //! Each scene is a [`SceneDesc`], the same data a scene file holds, so any of
 //! them can be exported and edited.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, ColorDesc, IntegratorDesc,
-    MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, SceneDesc, ShadingDesc,
-    TextureDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
+    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
+    SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple,
 };
 use crate::rng::Rng;
 
@@ -30,6 +31,8 @@ pub enum Book {
     OneWeekend,
     /// *Ray Tracing: The Next Week*.
     NextWeek,
+    /// *Ray Tracing: The Rest of Your Life*.
+    RestOfYourLife,
 }
 
 impl Book {
@@ -38,6 +41,7 @@ impl Book {
         match self {
             Book::OneWeekend => "Ray Tracing in One Weekend",
             Book::NextWeek => "Ray Tracing: The Next Week",
+            Book::RestOfYourLife => "Ray Tracing: The Rest of Your Life",
         }
     }
 }
@@ -105,11 +109,18 @@ scenes! {
     "cover", "The cover: a random field of spheres, glass, diffuse and metal" => cover;
   }
   NextWeek {
+    "bouncing-spheres", "The Next Week: the cover's diffuse spheres bouncing while the shutter is open (motion blur)" => bouncing_spheres;
     "checkered-spheres", "The Next Week: two spheres under a 3-D checker texture" => checkered_spheres;
+    "earth", "The Next Week: a planet's map wrapped on a sphere by its (u, v) (a made-up planet: lumen ships no photograph)" => earth;
     "perlin-spheres", "The Next Week: Perlin-noise marble on a ground sphere and a ball" => perlin_spheres;
     "quads", "The Next Week: five coloured quads, the sides of an open box, seen from the front" => quads;
     "simple-light", "The Next Week: Perlin marble lit by a ball and a panel of light in the dark" => simple_light;
     "cornell-box", "The Next Week: the Cornell box, its ceiling light found only by chance (noisy; --integrator path aims at it)" => cornell_box;
+    "cornell-smoke", "The Next Week: the Cornell box's two blocks as black smoke and white fog" => cornell_smoke;
+    "next-week-final", "The Next Week's final scene: boxes, a moving ball, glass, fog, a planet, marble and a cluster of spheres" => next_week_final;
+  }
+  RestOfYourLife {
+    "cornell-glass-sphere", "The Rest of Your Life: the Cornell box with a glass ball, its light sampled directly (next-event estimation)" => cornell_glass_sphere;
   }
 }
 
@@ -152,6 +163,23 @@ impl Builder {
         self
     }
 
+    /// A sphere at `center` at time 0 that moves by `motion` until time 1.
+    fn moving_sphere(
+        mut self,
+        center: Triple,
+        radius: f64,
+        material: &str,
+        motion: Triple,
+    ) -> Self {
+        self.desc.objects.push(ObjectDesc::Sphere {
+            center,
+            radius,
+            material: material.to_string(),
+            transform: vec![TransformDesc::Motion(motion)],
+        });
+        self
+    }
+
     fn quad(mut self, corner: Triple, u: Triple, v: Triple, material: &str) -> Self {
         self.desc.objects.push(ObjectDesc::Quad {
             corner,
@@ -170,13 +198,40 @@ impl Builder {
             min: [0.0; 3],
             max: size,
             material: material.to_string(),
-            transform: vec![
-                TransformDesc::Rotate {
-                    axis: [0.0, 1.0, 0.0],
-                    degrees,
-                },
-                TransformDesc::Translate(offset),
-            ],
+            transform: turn_and_move(degrees, offset),
+        });
+        self
+    }
+
+    /// Constant-density fog of `albedo` filling the box from the origin to
+    /// `size`, turned and moved as [`turned_box`](Self::turned_box) does.
+    fn turned_fog(
+        mut self,
+        size: Triple,
+        degrees: f64,
+        offset: Triple,
+        density: f64,
+        albedo: Triple,
+    ) -> Self {
+        self.desc.objects.push(ObjectDesc::Medium {
+            boundary: BoundaryDesc::Box {
+                min: [0.0; 3],
+                max: size,
+            },
+            density,
+            albedo,
+            transform: turn_and_move(degrees, offset),
+        });
+        self
+    }
+
+    /// Constant-density fog of `albedo` filling a ball.
+    fn fog_ball(mut self, center: Triple, radius: f64, density: f64, albedo: Triple) -> Self {
+        self.desc.objects.push(ObjectDesc::Medium {
+            boundary: BoundaryDesc::Sphere { center, radius },
+            density,
+            albedo,
+            transform: Vec::new(),
         });
         self
     }
@@ -194,6 +249,17 @@ impl Builder {
     fn build(self) -> SceneDesc {
         self.desc
     }
+}
+
+/// Turned by `degrees` about the y axis, then moved by `offset`.
+fn turn_and_move(degrees: f64, offset: Triple) -> Vec<TransformDesc> {
+    vec![
+        TransformDesc::Rotate {
+            axis: [0.0, 1.0, 0.0],
+            degrees,
+        },
+        TransformDesc::Translate(offset),
+    ]
 }
 
 /// Settings of a figure: a single sample goes through the pixel's centre, as
@@ -429,6 +495,7 @@ fn positioned(defocus_angle: f64) -> SceneDesc {
         vup: [0.0, 1.0, 0.0],
         defocus_angle,
         focus_dist: Some(3.4),
+        ..CameraDesc::default()
     })
     .build()
 }
@@ -445,17 +512,36 @@ pub fn cover() -> SceneDesc {
 /// A cover-style field on a (2·half)² grid of small spheres; `half = 11` is the
 /// cover itself. Used to measure how cost grows with the number of spheres.
 pub fn cover_with_grid(half: i32) -> SceneDesc {
+    sphere_field(
+        figure(RenderDesc {
+            width: 1200,
+            samples_per_pixel: 500,
+            max_depth: 50,
+            sampler: SamplingDesc::Independent,
+            ..RenderDesc::default()
+        }),
+        half,
+        false,
+        0.6,
+    )
+}
+
+/// The first figure of *The Next Week*: the cover's field, its diffuse
+/// spheres bouncing up by a random height of up to half a unit while the
+/// shutter is open.
+fn bouncing_spheres() -> SceneDesc {
+    sphere_field(next_week(400, 100, 16.0 / 9.0), 11, true, 0.02)
+}
+
+/// The cover's random field of small spheres around three big ones on a
+/// (2·half)² grid, with `render` settings and lens `defocus_angle`; the
+/// diffuse spheres move up when `bouncing`.
+fn sphere_field(render: RenderDesc, half: i32, bouncing: bool, defocus_angle: f64) -> SceneDesc {
     let mut rng = Rng::new(COVER_LAYOUT_SEED);
-    let mut b = Builder::new(figure(RenderDesc {
-        width: 1200,
-        samples_per_pixel: 500,
-        max_depth: 50,
-        sampler: SamplingDesc::Independent,
-        ..RenderDesc::default()
-    }))
-    .material("ground", lambertian([0.5, 0.5, 0.5]))
-    .material("glass", glass_material(1.5, false))
-    .sphere([0.0, -1000.0, 0.0], 1000.0, "ground");
+    let mut b = Builder::new(render)
+        .material("ground", lambertian([0.5, 0.5, 0.5]))
+        .material("glass", glass_material(1.5, false))
+        .sphere([0.0, -1000.0, 0.0], 1000.0, "ground");
     let mut count = 0usize;
     for a in -half..half {
         for c in -half..half {
@@ -469,21 +555,26 @@ pub fn cover_with_grid(half: i32) -> SceneDesc {
             if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() <= 0.9 {
                 continue;
             }
-            let name = if choose < 0.8 {
+            if choose < 0.8 {
                 let albedo = [0; 3].map(|_| rng.next_f64() * rng.next_f64());
                 let name = format!("diffuse{count}");
                 b = b.material(&name, lambertian(albedo));
-                name
+                b = if bouncing {
+                    let up = 0.5 * rng.next_f64();
+                    b.moving_sphere(center, 0.2, &name, [0.0, up, 0.0])
+                } else {
+                    b.sphere(center, 0.2, &name)
+                };
             } else if choose < 0.95 {
                 let albedo = [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64());
                 let fuzz = 0.5 * rng.next_f64();
                 let name = format!("metal{count}");
-                b = b.material(&name, metal(albedo, fuzz));
-                name
+                b = b
+                    .material(&name, metal(albedo, fuzz))
+                    .sphere(center, 0.2, &name);
             } else {
-                "glass".to_string()
-            };
-            b = b.sphere(center, 0.2, &name);
+                b = b.sphere(center, 0.2, "glass");
+            }
             count += 1;
         }
     }
@@ -497,8 +588,9 @@ pub fn cover_with_grid(half: i32) -> SceneDesc {
             lookfrom: [13.0, 2.0, 3.0],
             lookat: [0.0, 0.0, 0.0],
             vup: [0.0, 1.0, 0.0],
-            defocus_angle: 0.6,
+            defocus_angle,
             focus_dist: Some(10.0),
+            ..CameraDesc::default()
         })
         .build()
 }
@@ -524,6 +616,7 @@ fn pinhole(vfov: f64, lookfrom: Triple, lookat: Triple) -> CameraDesc {
         vup: [0.0, 1.0, 0.0],
         defocus_angle: 0.0,
         focus_dist: None,
+        ..CameraDesc::default()
     }
 }
 
@@ -558,6 +651,25 @@ fn checkered_spheres() -> SceneDesc {
         .sphere([0.0, 10.0, 0.0], 10.0, "checker")
         .background(NEXT_WEEK_SKY)
         .camera(pinhole(20.0, [13.0, 2.0, 3.0], [0.0; 3]))
+        .build()
+}
+
+/// The planet texture built into lumen.
+const EARTH_MAP: &str = "lumen:earth.png";
+
+/// A globe of radius 2 wrapped in the planet map, seen from the front.
+fn earth() -> SceneDesc {
+    Builder::new(next_week(400, 100, 16.0 / 9.0))
+        .texture(
+            "earth",
+            TextureDesc::Image {
+                file: EARTH_MAP.to_string(),
+            },
+        )
+        .material("earth", textured("earth"))
+        .sphere([0.0; 3], 2.0, "earth")
+        .background(NEXT_WEEK_SKY)
+        .camera(pinhole(20.0, [0.0, 0.0, 12.0], [0.0; 3]))
         .build()
 }
 
@@ -649,15 +761,36 @@ fn simple_light() -> SceneDesc {
 /// ceiling (emitting from both sides, as the book's diffuse light does), and
 /// two white boxes turned about their corners.
 pub fn cornell_box() -> SceneDesc {
-    Builder::new(next_week(600, 200, 1.0))
+    let light = (
+        [343.0, 554.0, 332.0],
+        [-130.0, 0.0, 0.0],
+        [0.0, 0.0, -105.0],
+    );
+    cornell_walls(next_week(600, 200, 1.0), 15.0, true, light)
+        .turned_box([165.0, 330.0, 165.0], 15.0, [265.0, 0.0, 295.0], "white")
+        .turned_box([165.0; 3], -18.0, [130.0, 0.0, 65.0], "white")
+        .build()
+}
+
+/// The empty Cornell box with `render` settings: its five walls (red,
+/// green, three white), the quad `light` (corner, u, v) of `radiance`,
+/// `two_sided` or emitting along u × v, a black background and the books'
+/// camera.
+fn cornell_walls(
+    render: RenderDesc,
+    radiance: f64,
+    two_sided: bool,
+    (corner, u, v): (Triple, Triple, Triple),
+) -> Builder {
+    Builder::new(render)
         .material("red", lambertian([0.65, 0.05, 0.05]))
         .material("white", lambertian([0.73, 0.73, 0.73]))
         .material("green", lambertian([0.12, 0.45, 0.15]))
         .material(
             "light",
             MaterialDesc::Emissive {
-                radiance: [15.0; 3].into(),
-                two_sided: true,
+                radiance: [radiance; 3].into(),
+                two_sided,
             },
         )
         .quad(
@@ -667,12 +800,7 @@ pub fn cornell_box() -> SceneDesc {
             "green",
         )
         .quad([0.0; 3], [0.0, 555.0, 0.0], [0.0, 0.0, 555.0], "red")
-        .quad(
-            [343.0, 554.0, 332.0],
-            [-130.0, 0.0, 0.0],
-            [0.0, 0.0, -105.0],
-            "light",
-        )
+        .quad(corner, u, v, "light")
         .quad([0.0; 3], [555.0, 0.0, 0.0], [0.0, 0.0, 555.0], "white")
         .quad([555.0; 3], [-555.0, 0.0, 0.0], [0.0, 0.0, -555.0], "white")
         .quad(
@@ -681,10 +809,129 @@ pub fn cornell_box() -> SceneDesc {
             [0.0, 555.0, 0.0],
             "white",
         )
-        .turned_box([165.0, 330.0, 165.0], 15.0, [265.0, 0.0, 295.0], "white")
-        .turned_box([165.0; 3], -18.0, [130.0, 0.0, 65.0], "white")
         .background(BackgroundDesc::Solid { color: [0.0; 3] })
         .camera(pinhole(40.0, [278.0, 278.0, -800.0], [278.0, 278.0, 0.0]))
+}
+
+/// The Cornell box filled with smoke and fog: the two boxes of
+/// [`cornell_box`] as constant media of density 0.01, black and white, and
+/// a larger, dimmer light (330 × 305, radiance 7).
+fn cornell_smoke() -> SceneDesc {
+    let light = ([113.0, 554.0, 127.0], [330.0, 0.0, 0.0], [0.0, 0.0, 305.0]);
+    cornell_walls(next_week(600, 200, 1.0), 7.0, true, light)
+        .turned_fog(
+            [165.0, 330.0, 165.0],
+            15.0,
+            [265.0, 0.0, 295.0],
+            0.01,
+            [0.0; 3],
+        )
+        .turned_fog([165.0; 3], -18.0, [130.0, 0.0, 65.0], 0.01, [1.0; 3])
+        .build()
+}
+
+/// Seed of the final scene's random boxes and spheres.
+const FINAL_LAYOUT_SEED: u64 = 0x00F1_7A1E;
+
+/// The last figure of *The Next Week*, at the book's quality (800 × 800,
+/// 10,000 samples, 40 bounces): a floor of 20 × 20 boxes of random height,
+/// a light above, a ball moving sideways, glass, fuzzy metal, a glass ball
+/// full of blue smoke, a thin fog over everything, the planet, Perlin
+/// marble, and 1,000 small white spheres in a turned cube.
+fn next_week_final() -> SceneDesc {
+    let mut rng = Rng::new(FINAL_LAYOUT_SEED);
+    let mut b = Builder::new(figure(RenderDesc {
+        width: 800,
+        aspect_ratio: 1.0,
+        samples_per_pixel: 10_000,
+        max_depth: 40,
+        sampler: SamplingDesc::Independent,
+        ..RenderDesc::default()
+    }))
+    .material("ground", lambertian([0.48, 0.83, 0.53]));
+    for i in 0..20 {
+        for j in 0..20 {
+            let (x0, z0) = (
+                -1000.0 + 100.0 * f64::from(i),
+                -1000.0 + 100.0 * f64::from(j),
+            );
+            let y1 = 1.0 + 100.0 * rng.next_f64();
+            b.desc.objects.push(ObjectDesc::Box {
+                min: [x0, 0.0, z0],
+                max: [x0 + 100.0, y1, z0 + 100.0],
+                material: "ground".to_string(),
+                transform: Vec::new(),
+            });
+        }
+    }
+    b = b
+        .material(
+            "light",
+            MaterialDesc::Emissive {
+                radiance: [7.0; 3].into(),
+                two_sided: true,
+            },
+        )
+        .quad(
+            [123.0, 554.0, 147.0],
+            [300.0, 0.0, 0.0],
+            [0.0, 0.0, 265.0],
+            "light",
+        )
+        .material("orange", lambertian([0.7, 0.3, 0.1]))
+        .moving_sphere([400.0, 400.0, 200.0], 50.0, "orange", [30.0, 0.0, 0.0])
+        .material("glass", glass_material(1.5, false))
+        .sphere([260.0, 150.0, 45.0], 50.0, "glass")
+        .material("fuzzy", metal([0.8, 0.8, 0.9], 1.0))
+        .sphere([0.0, 150.0, 145.0], 50.0, "fuzzy")
+        .sphere([360.0, 150.0, 145.0], 70.0, "glass")
+        .fog_ball([360.0, 150.0, 145.0], 70.0, 0.2, [0.2, 0.4, 0.9])
+        .fog_ball([0.0; 3], 5000.0, 0.0001, [1.0; 3])
+        .texture(
+            "earth",
+            TextureDesc::Image {
+                file: EARTH_MAP.to_string(),
+            },
+        )
+        .material("earth", textured("earth"))
+        .sphere([400.0, 200.0, 400.0], 100.0, "earth")
+        .texture(
+            "marble",
+            TextureDesc::Noise {
+                scale: 0.1,
+                pattern: NoisePatternDesc::Marble,
+                seed: 0,
+            },
+        )
+        .material("marble", textured("marble"))
+        .sphere([220.0, 280.0, 300.0], 80.0, "marble")
+        .material("white", lambertian([0.73; 3]));
+    for _ in 0..1000 {
+        let center = [0; 3].map(|_| 165.0 * rng.next_f64());
+        b.desc.objects.push(ObjectDesc::Sphere {
+            center,
+            radius: 10.0,
+            material: "white".to_string(),
+            transform: turn_and_move(15.0, [-100.0, 270.0, 395.0]),
+        });
+    }
+    b.background(BackgroundDesc::Solid { color: [0.0; 3] })
+        .camera(pinhole(40.0, [478.0, 278.0, -600.0], [278.0, 278.0, 0.0]))
+        .build()
+}
+
+/// The last figure of *The Rest of Your Life*: the Cornell box with the tall
+/// box and a glass ball of radius 90 in place of the short box, lit by a
+/// one-sided light facing down, traced with next-event estimation (the
+/// book aims part of its samples at the light, as this does).
+fn cornell_glass_sphere() -> SceneDesc {
+    let mut render = next_week(600, 100, 1.0);
+    render.integrator = IntegratorDesc::Path;
+    let light = ([213.0, 554.0, 227.0], [130.0, 0.0, 0.0], [0.0, 0.0, 105.0]);
+    cornell_walls(render, 15.0, false, light)
+        .material("glass", glass_material(1.5, false))
+        .turned_box([165.0, 330.0, 165.0], 15.0, [265.0, 0.0, 295.0], "white")
+        .sphere([190.0, 90.0, 190.0], 90.0, "glass")
         .build()
 }
 

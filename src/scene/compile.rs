@@ -3,11 +3,11 @@
 //! placed once in world space or shared by instances.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, ColorDesc, MaterialDesc, ObjectDesc, ScaleDesc,
-    TransformDesc,
+    AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc,
+    ScaleDesc, TransformDesc,
 };
 use super::textures::{read_image, ColorRef, TextureTable};
-use super::world::{Group, Mesh, Shapes, Surface, World};
+use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
 use super::{
     invalid, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings, MAX_COORDINATE,
     MAX_PIXELS,
@@ -18,6 +18,7 @@ use crate::geometry::{Quad, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
 use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Emissive, Material, Metal};
 use crate::math::{Color, Vec3};
+use crate::medium::{Boundary, Medium};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
 use crate::texture::Texture;
 use std::collections::HashMap;
@@ -91,7 +92,9 @@ impl Scene {
     /// relative to `base` (the scene file's directory).
     pub fn from_desc_in(desc: &SceneDesc, base: &Path) -> Result<Scene, SceneError> {
         let settings = compile_settings(desc)?;
-        let camera = compile_camera(desc, &settings)?;
+        // Checked before the objects are read (which may be slow); built
+        // when it is known whether anything moves.
+        compile_camera(desc, &settings, true)?;
         let mut materials = Vec::with_capacity(desc.materials.len());
         let mut material_textures = Vec::with_capacity(desc.materials.len());
         let mut material_index = HashMap::with_capacity(desc.materials.len());
@@ -116,6 +119,7 @@ impl Scene {
             spheres: Vec::with_capacity(desc.objects.len()),
             groups: Vec::new(),
             instances: Vec::new(),
+            media: Vec::new(),
             models: HashMap::new(),
             placements: Vec::new(),
             sources,
@@ -134,10 +138,13 @@ impl Scene {
             spheres,
             groups,
             instances,
+            media,
             sources,
             mut stats,
             ..
         } = objects;
+        let moves = instances.iter().any(|p| p.motion != Vec3::ZERO);
+        let camera = compile_camera(desc, &settings, moves)?;
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
@@ -169,6 +176,7 @@ impl Scene {
             stats,
             lights,
             light_ids,
+            media,
             world,
         })
     }
@@ -210,13 +218,20 @@ fn compile_background(
     })
 }
 
-fn compile_camera(desc: &SceneDesc, settings: &Settings) -> Result<Camera, SceneError> {
+/// The camera of `desc`. Where nothing `moves`, every ray is traced as the
+/// shutter opens: drawing a time would change nothing but the samples.
+fn compile_camera(
+    desc: &SceneDesc,
+    settings: &Settings,
+    moves: bool,
+) -> Result<Camera, SceneError> {
     let cam = &desc.camera;
     finite("camera.vfov", &[cam.vfov])?;
     finite("camera.lookfrom", &cam.lookfrom)?;
     finite("camera.lookat", &cam.lookat)?;
     finite("camera.vup", &cam.vup)?;
     finite("camera.defocus_angle", &[cam.defocus_angle])?;
+    finite("camera.shutter", &cam.shutter)?;
     let focus_dist = match cam.focus_dist {
         Some(d) => {
             finite("camera.focus_dist", &[d])?;
@@ -238,6 +253,11 @@ fn compile_camera(desc: &SceneDesc, settings: &Settings) -> Result<Camera, Scene
             vup: vec3(cam.vup),
             defocus_angle: cam.defocus_angle as f32,
             focus_dist,
+            shutter: if moves {
+                cam.shutter.map(|t| t as f32)
+            } else {
+                [cam.shutter[0] as f32; 2]
+            },
         },
         settings.width,
         settings.height,
@@ -260,6 +280,8 @@ struct Placement {
     transform: Transform,
     /// The material that replaces the file's, if the object names one.
     material: Option<u32>,
+    /// How far it moves from time 0 to time 1.
+    motion: Vec3,
     /// The object that places it.
     object: usize,
 }
@@ -276,7 +298,8 @@ struct Objects<'a> {
     top: Shapes,
     spheres: Vec<Sphere>,
     groups: Vec<Group>,
-    instances: Vec<(u32, Transform, Option<u32>)>,
+    instances: Vec<PlacedGroup>,
+    media: Vec<Medium>,
     models: HashMap<PathBuf, LoadedModel>,
     placements: Vec<Placement>,
     sources: Vec<MeshSource>,
@@ -303,7 +326,49 @@ impl<'a> Objects<'a> {
     }
 
     fn add(&mut self, i: usize, object: &'a ObjectDesc) -> Result<(), SceneError> {
-        let transform = compile_transform(i, object.transform())?;
+        let (transform, motion) = compile_transform(i, object.transform())?;
+        if motion == Vec3::ZERO || matches!(object, ObjectDesc::Mesh { .. }) {
+            return self.add_placed(i, object, &transform, motion);
+        }
+        if matches!(object, ObjectDesc::Medium { .. }) {
+            return Err(invalid(
+                format!("objects[{i}].transform"),
+                "a medium cannot move: a `motion` step is for surfaces",
+            ));
+        }
+        // A moving shape is traced in a tree of its own, which an instance
+        // carries: its shapes are gathered apart from the scene's.
+        let top = std::mem::take(&mut self.top);
+        let (spheres, instances) = (self.spheres.len(), self.instances.len());
+        let added = self.add_placed(i, object, &transform, motion);
+        let shapes = std::mem::replace(&mut self.top, top);
+        added?;
+        self.spheres.truncate(spheres);
+        for placed in &mut self.instances[instances..] {
+            placed.motion = motion;
+        }
+        if !(shapes.spheres.is_empty() && shapes.quads.is_empty()) {
+            self.groups.push(Group::new(shapes));
+            self.instances.push(PlacedGroup {
+                group: self.groups.len() as u32 - 1,
+                transform: Transform::IDENTITY,
+                material: None,
+                motion,
+            });
+        }
+        Ok(())
+    }
+
+    /// Adds object `i` placed by `transform`; a mesh moves by `motion`
+    /// (other shapes are moved by [`add`](Self::add)).
+    fn add_placed(
+        &mut self,
+        i: usize,
+        object: &'a ObjectDesc,
+        transform: &Transform,
+        motion: Vec3,
+    ) -> Result<(), SceneError> {
+        let transform = *transform;
         match object {
             ObjectDesc::Sphere {
                 center,
@@ -359,8 +424,12 @@ impl<'a> Objects<'a> {
                         // another: (u, v) always.
                         shapes.spheres.push(Surface::new(&sphere, m, true));
                         self.groups.push(Group::new(shapes));
-                        self.instances
-                            .push((self.groups.len() as u32 - 1, transform, None));
+                        self.instances.push(PlacedGroup {
+                            group: self.groups.len() as u32 - 1,
+                            transform,
+                            material: None,
+                            motion: Vec3::ZERO,
+                        });
                     }
                 }
             }
@@ -395,6 +464,54 @@ impl<'a> Objects<'a> {
                     self.top.quads.push((quad, m));
                 }
             }
+            ObjectDesc::Medium {
+                boundary,
+                density,
+                albedo: colour,
+                ..
+            } => {
+                let field = |name: &str| format!("objects[{i}].{name}");
+                finite(field("density"), &[*density])?;
+                if !(*density as f32 > 0.0) {
+                    return Err(invalid(
+                        field("density"),
+                        format!("must be greater than 0, got {density}"),
+                    ));
+                }
+                let albedo = albedo(&field("albedo"), *colour)?;
+                let shape = match boundary {
+                    BoundaryDesc::Sphere { center, radius } => {
+                        finite(field("boundary.center"), center)?;
+                        finite(field("boundary.radius"), &[*radius])?;
+                        if !(*radius as f32 > 0.0) {
+                            return Err(invalid(
+                                field("boundary.radius"),
+                                format!("must be greater than 0, got {radius}"),
+                            ));
+                        }
+                        Boundary::Sphere {
+                            center: vec3(*center),
+                            radius: *radius as f32,
+                        }
+                    }
+                    BoundaryDesc::Box { min, max } => {
+                        finite(field("boundary.min"), min)?;
+                        finite(field("boundary.max"), max)?;
+                        if !(0..3).all(|k| (min[k] as f32) < (max[k] as f32)) {
+                            return Err(invalid(
+                                field("boundary.max"),
+                                format!("must be greater than min on every axis, got min {min:?} and max {max:?}"),
+                            ));
+                        }
+                        Boundary::Box {
+                            min: vec3(*min),
+                            max: vec3(*max),
+                        }
+                    }
+                };
+                self.media
+                    .push(Medium::new(shape, transform, *density as f32, albedo));
+            }
             ObjectDesc::Mesh {
                 file,
                 material,
@@ -424,6 +541,7 @@ impl<'a> Objects<'a> {
                         key: (path.clone(), *mesh, *smooth),
                         transform: placed,
                         material: override_material,
+                        motion,
                         object: i,
                     });
                 }
@@ -509,7 +627,10 @@ impl<'a> Objects<'a> {
         for key in order {
             let placed = &by_key[key];
             let (path, mesh_index, smooth) = key;
-            if let [only] = placed.as_slice() {
+            // A mesh placed once and still goes into the scene's tree; a
+            // moving one is carried by an instance.
+            let still = placed.len() == 1 && placed[0].motion == Vec3::ZERO;
+            if let (true, [only]) = (still, placed.as_slice()) {
                 let mesh = self.scene_mesh(path, *mesh_index, only.material, *smooth);
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
@@ -534,8 +655,12 @@ impl<'a> Objects<'a> {
                 }
                 self.groups.push(group);
                 let group = self.groups.len() as u32 - 1;
-                self.instances
-                    .extend(placed.iter().map(|p| (group, p.transform, p.material)));
+                self.instances.extend(placed.iter().map(|p| PlacedGroup {
+                    group,
+                    transform: p.transform,
+                    material: p.material,
+                    motion: p.motion,
+                }));
             }
         }
         Ok(())
@@ -667,23 +792,51 @@ fn mat4_transform(m: &glam::Mat4) -> Option<Transform> {
     Transform::from_steps(&[TransformStep::Matrix(rows)]).ok()
 }
 
-/// The transform of object `i`'s steps.
-fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<Transform, SceneError> {
-    let steps: Vec<TransformStep> = steps
-        .iter()
-        .map(|s| match s {
-            TransformDesc::Translate(t) => TransformStep::Translate(*t),
-            TransformDesc::Rotate { axis, degrees } => TransformStep::Rotate {
-                axis: *axis,
-                degrees: *degrees,
-            },
-            TransformDesc::Scale(ScaleDesc::Uniform(s)) => TransformStep::Scale([*s; 3]),
-            TransformDesc::Scale(ScaleDesc::PerAxis(s)) => TransformStep::Scale(*s),
-            TransformDesc::Matrix(m) => TransformStep::Matrix(*m),
+/// The transform of object `i`'s steps (its place at time 0), and how far
+/// its `motion` steps move it by time 1, in the world.
+fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<(Transform, Vec3), SceneError> {
+    let placing = |steps: &[TransformDesc]| -> Vec<(usize, TransformStep)> {
+        steps
+            .iter()
+            .enumerate()
+            .filter_map(|(k, s)| {
+                let step = match s {
+                    TransformDesc::Translate(t) => TransformStep::Translate(*t),
+                    TransformDesc::Rotate { axis, degrees } => TransformStep::Rotate {
+                        axis: *axis,
+                        degrees: *degrees,
+                    },
+                    TransformDesc::Scale(ScaleDesc::Uniform(s)) => TransformStep::Scale([*s; 3]),
+                    TransformDesc::Scale(ScaleDesc::PerAxis(s)) => TransformStep::Scale(*s),
+                    TransformDesc::Matrix(m) => TransformStep::Matrix(*m),
+                    TransformDesc::Motion(_) => return None,
+                };
+                Some((k, step))
+            })
+            .collect()
+    };
+    let build = |offset: usize, steps: &[TransformDesc]| {
+        let (index, steps): (Vec<usize>, Vec<TransformStep>) = placing(steps).into_iter().unzip();
+        Transform::from_steps(&steps).map_err(|e| {
+            invalid(
+                format!("objects[{i}].transform[{}]", offset + index[e.index]),
+                e.message,
+            )
         })
-        .collect();
-    Transform::from_steps(&steps)
-        .map_err(|e| invalid(format!("objects[{i}].transform[{}]", e.index), e.message))
+    };
+    let transform = build(0, steps)?;
+    let mut motion = Vec3::ZERO;
+    for (k, step) in steps.iter().enumerate() {
+        if let TransformDesc::Motion(m) = step {
+            finite(format_args!("objects[{i}].transform[{k}].motion"), m)?;
+            // Carried by the steps after it, as the object is.
+            motion += build(k + 1, &steps[k + 1..])?.vector(vec3(*m));
+        }
+    }
+    if !motion.is_finite() {
+        return Err(out_of_range(i));
+    }
+    Ok((transform, motion))
 }
 
 fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {

@@ -9,9 +9,9 @@
 //! users alike.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, CameraDesc, ColorDesc, IntegratorDesc,
-    MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc,
-    ShadingDesc, TextureDesc, TransformDesc, Triple,
+    AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
+    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
+    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple,
 };
 use super::hint;
 use super::source::{Entry, Node, Value};
@@ -209,9 +209,19 @@ fn u32_field(node: &Node, path: &str, min: u32) -> Result<u32> {
 }
 
 fn triple(node: &Node, path: &str) -> Result<Triple> {
+    numbers(node, path, "an array of 3 numbers [x, y, z]")
+}
+
+/// A shutter interval.
+fn pair(node: &Node, path: &str) -> Result<[f64; 2]> {
+    numbers(node, path, "an array of 2 numbers [open, close]")
+}
+
+/// An array of exactly `N` numbers; `expected` says which in messages.
+fn numbers<const N: usize>(node: &Node, path: &str, expected: &str) -> Result<[f64; N]> {
     let got = match &node.value {
-        Value::Array(items) if items.len() == 3 => {
-            let mut t = [0.0; 3];
+        Value::Array(items) if items.len() == N => {
+            let mut t = [0.0; N];
             for (i, item) in items.iter().enumerate() {
                 t[i] = float(item, &format!("{path}[{i}]"))?;
             }
@@ -222,7 +232,7 @@ fn triple(node: &Node, path: &str) -> Result<Triple> {
     Err(error(
         path,
         &node.span,
-        format!("expected an array of 3 numbers [x, y, z], got {got}"),
+        format!("expected {expected}, got {got}"),
     ))
 }
 
@@ -486,6 +496,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "vup",
             "defocus_angle",
             "focus_dist",
+            "shutter",
         ],
         &[],
     )?;
@@ -499,6 +510,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             .optional("defocus_angle", float)?
             .unwrap_or(d.defocus_angle),
         focus_dist: t.optional("focus_dist", float)?,
+        shutter: t.optional("shutter", pair)?.unwrap_or(d.shutter),
     })
 }
 
@@ -779,6 +791,7 @@ enum ObjectKind {
     Quad,
     Box,
     Mesh,
+    Medium,
 }
 
 const OBJECTS: &[Kind<ObjectKind>] = &[
@@ -841,7 +854,53 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             ("max", "boxes"),
         ],
     },
+    Kind {
+        name: "medium",
+        kind: ObjectKind::Medium,
+        what: "a medium",
+        fields: &["type", "boundary", "density", "albedo", "transform"],
+        elsewhere: &[
+            ("center", "spheres (a medium's sphere goes in `boundary`)"),
+            ("radius", "spheres (a medium's sphere goes in `boundary`)"),
+            ("min", "boxes (a medium's box goes in `boundary`)"),
+            ("max", "boxes (a medium's box goes in `boundary`)"),
+            ("material", "surfaces (a medium has `albedo`)"),
+        ],
+    },
 ];
+
+const BOUNDARIES: &[Kind<bool>] = &[
+    Kind {
+        name: "sphere",
+        kind: true,
+        what: "a sphere boundary",
+        fields: &["type", "center", "radius"],
+        elsewhere: &[("min", "boxes"), ("max", "boxes")],
+    },
+    Kind {
+        name: "box",
+        kind: false,
+        what: "a box boundary",
+        fields: &["type", "min", "max"],
+        elsewhere: &[("center", "spheres"), ("radius", "spheres")],
+    },
+];
+
+/// A medium's boundary: a sphere or a box.
+fn boundary(node: &Node, path: &str) -> Result<BoundaryDesc> {
+    let (sphere, what, t) = tagged(node, path, "a boundary", BOUNDARIES)?;
+    Ok(if sphere {
+        BoundaryDesc::Sphere {
+            center: t.require("center", what, triple)?,
+            radius: t.require("radius", what, float)?,
+        }
+    } else {
+        BoundaryDesc::Box {
+            min: t.require("min", what, triple)?,
+            max: t.require("max", what, triple)?,
+        }
+    })
+}
 
 fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
     let (kind, what, t) = tagged(node, path, "an object", OBJECTS)?;
@@ -873,10 +932,16 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             smooth: t.optional("smooth", boolean)?.unwrap_or(true),
             transform,
         },
+        ObjectKind::Medium => ObjectDesc::Medium {
+            boundary: t.require("boundary", what, boundary)?,
+            density: t.require("density", what, float)?,
+            albedo: t.require("albedo", what, triple)?,
+            transform,
+        },
     })
 }
 
-const TRANSFORM_STEPS: &[&str] = &["translate", "rotate", "scale", "matrix"];
+const TRANSFORM_STEPS: &[&str] = &["translate", "rotate", "scale", "matrix", "motion"];
 
 /// A `transform` list: tables of one step each.
 fn transforms(node: &Node, path: &str) -> Result<Vec<TransformDesc>> {
@@ -935,6 +1000,7 @@ fn transform_step(node: &Node, path: &str) -> Result<TransformDesc> {
                 ))
             }
         }),
+        "motion" => TransformDesc::Motion(triple(n, &p)?),
         _ => TransformDesc::Matrix(matrix(n, &p)?),
     })
 }

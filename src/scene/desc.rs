@@ -169,6 +169,21 @@ pub struct CameraDesc {
     /// Distance to the plane in focus; when absent, the distance to `lookat`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub focus_dist: Option<f64>,
+    /// The interval of time the shutter is open, within [0, 1]: moving
+    /// objects are blurred along the part of their motion it covers.
+    #[serde(default = "full_shutter", skip_serializing_if = "is_full_shutter")]
+    pub shutter: [f64; 2],
+}
+
+/// The default shutter: open from time 0 to time 1.
+pub const FULL_SHUTTER: [f64; 2] = [0.0, 1.0];
+
+fn full_shutter() -> [f64; 2] {
+    FULL_SHUTTER
+}
+
+fn is_full_shutter(s: &[f64; 2]) -> bool {
+    *s == FULL_SHUTTER
 }
 
 impl Default for CameraDesc {
@@ -180,6 +195,7 @@ impl Default for CameraDesc {
             vup: [0.0, 1.0, 0.0],
             defocus_angle: 0.0,
             focus_dist: None,
+            shutter: FULL_SHUTTER,
         }
     }
 }
@@ -443,6 +459,40 @@ pub enum ObjectDesc {
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
     },
+    /// Fog or smoke of constant density filling a sphere or a box, which
+    /// scatters light equally in every direction. The boundary is not a
+    /// surface.
+    Medium {
+        /// The region it fills.
+        boundary: BoundaryDesc,
+        /// The chance per unit length that a ray meets a particle, > 0.
+        density: f64,
+        /// The fraction of light a particle scatters, per channel, in [0, 1].
+        albedo: Triple,
+        /// Placement of the boundary, applied in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
+}
+
+/// The region a medium fills.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum BoundaryDesc {
+    /// A ball.
+    Sphere {
+        /// Centre.
+        center: Triple,
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// An axis-aligned box from `min` to `max`.
+    Box {
+        /// The lowest corner.
+        min: Triple,
+        /// The highest corner: above `min` on every axis.
+        max: Triple,
+    },
 }
 
 fn yes() -> bool {
@@ -460,7 +510,8 @@ impl ObjectDesc {
             ObjectDesc::Sphere { transform, .. }
             | ObjectDesc::Quad { transform, .. }
             | ObjectDesc::Box { transform, .. }
-            | ObjectDesc::Mesh { transform, .. } => transform,
+            | ObjectDesc::Mesh { transform, .. }
+            | ObjectDesc::Medium { transform, .. } => transform,
         }
     }
 }
@@ -484,6 +535,11 @@ pub enum TransformDesc {
     Scale(ScaleDesc),
     /// A 4×4 affine matrix, row by row; the last row must be [0, 0, 0, 1].
     Matrix([[f64; 4]; 4]),
+    /// Motion: the object is where the other steps place it at time 0, and
+    /// moves in a straight line by this vector (turned and scaled by the
+    /// steps after this one) until time 1. The camera's shutter shows part
+    /// of that movement, blurred.
+    Motion(Triple),
 }
 
 /// A scale factor: one for every axis, or one per axis.

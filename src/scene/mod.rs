@@ -21,7 +21,9 @@ pub use crate::light::LightSelection;
 use crate::light::{Environment, Lights};
 use crate::material::Material;
 use crate::math::Interval;
+use crate::medium::Medium;
 use crate::ray::Ray;
+use crate::sampler::{Dim, Sampler};
 use crate::texture::Texture;
 use desc::{IntegratorDesc, SamplingDesc, ShadingDesc};
 use thiserror::Error;
@@ -76,6 +78,7 @@ impl SceneError {
                 CameraError::EmptyImage(..) => "render".into(),
                 CameraError::Overflow => "camera".into(),
                 CameraError::NotFinite(name) => format!("camera.{name}"),
+                CameraError::Shutter(..) => "camera.shutter".into(),
             },
             SceneError::Invalid { field, .. } | SceneError::UnknownMaterial { field, .. } => {
                 field.clone()
@@ -180,6 +183,8 @@ pub struct Scene {
     /// next-event estimation.
     pub lights: Lights,
     light_ids: LightIds,
+    /// The fog and smoke of the scene.
+    pub media: Vec<Medium>,
     world: World,
 }
 
@@ -260,6 +265,41 @@ impl Scene {
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
         self.world.bvh.occluded(ray, interval)
+    }
+
+    /// Where `ray`, before distance `t_max`, first meets a particle of one
+    /// of the scene's media, and which medium: each medium draws the
+    /// distance a ray gets into it, and the nearest event counts (the first
+    /// of several independent exponential laws follows their sum's).
+    #[inline]
+    pub fn medium_event(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        sampler: &mut impl Sampler,
+    ) -> Option<(f32, usize)> {
+        let mut nearest: Option<(f32, usize)> = None;
+        for (i, medium) in self.media.iter().enumerate() {
+            let limit = nearest.map_or(t_max, |(t, _)| t);
+            if medium.span(ray, limit).is_none() {
+                continue;
+            }
+            let u = sampler.get_1d(Dim::Medium);
+            if let Some(t) = medium.sample_distance(ray, limit, u) {
+                nearest = Some((t, i));
+            }
+        }
+        nearest
+    }
+
+    /// The fraction of light that crosses the scene's media along `ray`
+    /// from 0 to `t_max` (1 where there are none).
+    #[inline]
+    pub fn transmittance(&self, ray: &Ray, t_max: f32) -> f32 {
+        self.media
+            .iter()
+            .map(|m| m.transmittance(ray, t_max))
+            .product()
     }
 
     /// The nearest hit within `interval` of each ray `rays[lanes[k]]` (1 to

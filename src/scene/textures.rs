@@ -161,8 +161,20 @@ fn positive(field: &str, value: f64) -> Result<f32, SceneError> {
     Ok(value as f32)
 }
 
-/// Reads the image `file` (relative to `base`) of field `field`, and
-/// records it in `sources`.
+/// How a scene names an image built into lumen, as `lumen:earth.png`.
+pub const EMBEDDED_PREFIX: &str = "lumen:";
+
+/// The images built into lumen (for the built-in scenes, which must render
+/// anywhere without files): name and file bytes.
+const EMBEDDED: &[(&str, &[u8])] = &[("earth.png", include_bytes!("../../assets/earth.png"))];
+
+/// The bytes of the built-in image `name`.
+fn embedded(name: &str) -> Option<&'static [u8]> {
+    EMBEDDED.iter().find(|(n, _)| *n == name).map(|(_, b)| *b)
+}
+
+/// Reads the image `file` (relative to `base`, or built in when it starts
+/// with [`EMBEDDED_PREFIX`]) of field `field`, and records it in `sources`.
 pub(crate) fn read_image(
     field: &str,
     base: &Path,
@@ -171,8 +183,22 @@ pub(crate) fn read_image(
 ) -> Result<Image, SceneError> {
     let path = base.join(file);
     let fail = |message: String| invalid(field, message);
-    let bytes =
-        std::fs::read(&path).map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?;
+    let bytes = match file.strip_prefix(EMBEDDED_PREFIX) {
+        Some(name) => embedded(name)
+            .ok_or_else(|| {
+                let known: Vec<String> = EMBEDDED
+                    .iter()
+                    .map(|(n, _)| format!("{EMBEDDED_PREFIX}{n}"))
+                    .collect();
+                fail(format!(
+                    "{file}: lumen has no such image (it has {})",
+                    known.join(", ")
+                ))
+            })?
+            .to_vec(),
+        None => std::fs::read(&path)
+            .map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?,
+    };
     let image =
         Image::decode(&bytes, &path.display().to_string()).map_err(|e| fail(e.to_string()))?;
     if !sources.iter().any(|s| s.file == file) {

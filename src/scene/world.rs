@@ -290,6 +290,19 @@ impl Group {
     }
 }
 
+/// A group placed in the world: what an instance is made from.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PlacedGroup {
+    /// The group placed.
+    pub(crate) group: u32,
+    /// Object to world at time 0.
+    pub(crate) transform: Transform,
+    /// The material replacing the group's own, if any.
+    pub(crate) material: Option<u32>,
+    /// How far it moves from time 0 to time 1.
+    pub(crate) motion: Vec3,
+}
+
 /// What the record of a hit in an instance needs beyond the instance.
 #[derive(Clone, Copy, Debug)]
 struct Placed {
@@ -315,17 +328,20 @@ pub(crate) struct World {
 
 impl World {
     /// Builds the tree over `top` and the placements `instances` of
-    /// `groups` (group, transform, material replacing the group's own).
+    /// `groups`.
     pub(crate) fn new(
         top: Shapes,
         groups: Vec<Group>,
-        instances: &[(u32, Transform, Option<u32>)],
+        instances: &[PlacedGroup],
         error_scale: f32,
     ) -> World {
         let mut items = top.primitives();
         let trees: Vec<Instance> = instances
             .iter()
-            .map(|(g, transform, _)| Instance::new(*transform, groups[*g as usize].bvh.clone()))
+            .map(|p| {
+                let bvh = groups[p.group as usize].bvh.clone();
+                Instance::moving(p.transform, p.motion, bvh)
+            })
             .collect();
         items.extend(
             trees
@@ -338,11 +354,11 @@ impl World {
         );
         let placed = instances
             .iter()
-            .map(|&(group, transform, material)| Placed {
-                group,
-                material,
+            .map(|p| Placed {
+                group: p.group,
+                material: p.material,
                 stretch: [Vec3::X, Vec3::Y, Vec3::Z]
-                    .map(|e| transform.vector(e).length_squared())
+                    .map(|e| p.transform.vector(e).length_squared())
                     .iter()
                     .sum::<f32>()
                     .sqrt(),
@@ -403,9 +419,10 @@ impl World {
     #[inline(never)]
     fn instance_record(&self, ray: &Ray, hit: Hit, i: usize) -> HitRecord {
         let placed = self.placed[i];
-        let transform = &self.bvh.instances()[i].transform;
+        let instance = &self.bvh.instances()[i];
+        let transform = &instance.transform;
         let group = &self.groups[placed.group as usize];
-        let (object_ray, scale) = transform.to_object_ray(ray);
+        let (object_ray, scale) = instance.object_ray(ray);
         let shape = group
             .shapes
             .locate(hit.sub as usize)
@@ -414,7 +431,7 @@ impl World {
             group
                 .shapes
                 .record(&object_ray, hit.t * scale, shape, hit.sub, self.error_scale);
-        let point = transform.point(inner.point);
+        let point = instance.world_point(inner.point, ray.time);
         let (normal, front_face) = face_normal(ray, transform.normal(inner.outward_normal()));
         let shading_normal = if inner.is_smooth() {
             facing(transform.normal(inner.shading_normal), normal)
@@ -517,7 +534,10 @@ impl World {
             let any = meshes.iter().any(|mesh| {
                 (0..mesh.data.triangles.len()).any(|k| material(mesh.material(k)).is_some())
             });
-            if !any || !group.shapes.spheres.is_empty() || !group.shapes.quads.is_empty() {
+            // A moving light is found by the bounces only: its samples would
+            // have to be drawn where it is at each path's time.
+            let moves = self.bvh.instances()[i].motion != Vec3::ZERO;
+            if !any || moves || !group.shapes.spheres.is_empty() || !group.shapes.quads.is_empty() {
                 ids.instance_first.push(NO_LIGHT);
                 continue;
             }
