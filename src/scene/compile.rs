@@ -828,13 +828,14 @@ fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<(Transform, Ve
     let mut motion = Vec3::ZERO;
     for (k, step) in steps.iter().enumerate() {
         if let TransformDesc::Motion(m) = step {
-            finite(format_args!("objects[{i}].transform[{k}].motion"), m)?;
+            let field = format!("objects[{i}].transform[{k}].motion");
+            finite(&field, m)?;
             // Carried by the steps after it, as the object is.
             motion += build(k + 1, &steps[k + 1..])?.vector(vec3(*m));
+            if !motion.is_finite() {
+                return Err(invalid(field, "moves the object beyond the range of f32"));
+            }
         }
-    }
-    if !motion.is_finite() {
-        return Err(out_of_range(i));
     }
     Ok((transform, motion))
 }
