@@ -160,6 +160,7 @@ impl Distribution2D {
 mod tests {
     use super::*;
     use crate::rng::Rng;
+    use crate::testing::{chi_square, chi_square_bound};
 
     #[test]
     fn refuses_weights_of_no_total() {
@@ -184,35 +185,6 @@ mod tests {
         assert_eq!(d.sample(0.125), 2);
         assert_eq!(d.sample(0.5), 3);
         assert_eq!(d.sample(ONE_BELOW), 3);
-    }
-
-    /// Pearson's χ² of `counts` against `expected` counts, over cells
-    /// expected to hold at least 5 (the rest pooled into one cell).
-    fn chi_square(counts: &[u64], expected: &[f64]) -> (f64, usize) {
-        let (mut chi2, mut cells) = (0.0, 0);
-        let (mut pooled_n, mut pooled_e) = (0.0, 0.0);
-        for (&n, &e) in counts.iter().zip(expected) {
-            if e < 5.0 {
-                pooled_n += n as f64;
-                pooled_e += e;
-                continue;
-            }
-            chi2 += (n as f64 - e).powi(2) / e;
-            cells += 1;
-        }
-        if pooled_e > 0.0 {
-            chi2 += (pooled_n - pooled_e).powi(2) / pooled_e;
-            cells += 1;
-        }
-        (chi2, cells)
-    }
-
-    /// The χ² bound that a correct sampler exceeds with probability about
-    /// 10⁻⁴ for `dof` degrees of freedom (Wilson–Hilferty, z = 3.72).
-    fn chi_square_bound(dof: usize) -> f64 {
-        let k = dof as f64;
-        let z = 3.72;
-        k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
     }
 
     /// Points drawn from a 2-D table fall into a finer grid of cells as
@@ -256,10 +228,10 @@ mod tests {
             (total / n as f64 - 1.0).abs() < 1e-5,
             "density integrates to 1"
         );
-        let (chi2, cells) = chi_square(&counts, &expected);
+        let (chi2, dof) = chi_square(&counts, &expected);
         assert!(
-            chi2 < chi_square_bound(cells - 1),
-            "χ² {chi2} over {cells} cells"
+            chi2 < chi_square_bound(dof),
+            "χ² {chi2} with {dof} degrees of freedom"
         );
         // No sample in a cell of no weight.
         for (c, &e) in counts.iter().zip(&expected) {

@@ -4,15 +4,13 @@
 
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
-use crate::geometry::HitRecord;
-use crate::material::{reflect, Material};
+use crate::material::Material;
 use crate::math::{Color, Interval, Point3, Vec3};
 use crate::medium::{Medium, ISOTROPIC_PDF};
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
-use std::f32::consts::FRAC_1_PI;
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -89,31 +87,15 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     }
 }
 
-/// The density per unit solid angle with which a Lambertian bounce at
-/// `record` leaves along unit `w`: cosine-distributed about the shading
-/// normal, and on a smoothly shaded surface also the directions that fell
-/// below the true surface and were mirrored above it (see
-/// [`HitRecord::reflected_above`]).
-#[inline]
-fn lambertian_pdf(record: &HitRecord, w: Vec3) -> f32 {
-    let mut cos = record.shading_normal.dot(w).max(0.0);
-    if record.is_smooth() {
-        cos += record
-            .shading_normal
-            .dot(reflect(w, record.normal))
-            .max(0.0);
-    }
-    cos * FRAC_1_PI
-}
-
 /// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
 /// `hit` (or nothing, and the background lights it). The surface's emission
 /// is added to what the path gathered; its material absorbs the path or
 /// scatters it (bounce `depth`), multiplying the throughput by its
-/// attenuation. With the `path` integrator, a Lambertian surface also
-/// samples a light (next-event estimation): a shadow ray towards a point
-/// chosen on it, the light it brings weighted against the chance that the
-/// bounce would have found the same light (multiple importance sampling).
+/// attenuation. With the `path` integrator, a surface whose scattering has
+/// a density (see [`Material::has_density`]) also samples a light
+/// (next-event estimation): a shadow ray towards a point chosen on it, the
+/// light it brings weighted against the chance that the bounce would have
+/// found the same light (multiple importance sampling).
 #[inline(always)]
 fn step(
     scene: &Scene,
@@ -139,8 +121,8 @@ fn step(
     };
     let record = scene.record(ray, hit);
     let material = &scene.material_at(&record);
-    if let Material::Emissive(light) = material {
-        let mut emitted = path.throughput * light.emitted(&record);
+    if let Material::Emissive(_) = material {
+        let mut emitted = path.throughput * material.emitted(&record);
         if let (Some((from, bsdf_pdf)), Some(i)) = (path.sampled_from, scene.light_of(&hit)) {
             let light_pdf = scene
                 .lights
@@ -149,35 +131,25 @@ fn step(
         }
         return Step::Done(path.radiance + emitted);
     }
-    let lambertian = match material {
-        Material::Diffuse(d) if samples_lights(scene, depth) && d.is_lambertian() => Some(d.albedo),
-        _ => None,
-    };
-    if let Some(albedo) = lambertian {
-        // The light must be on the side the path came from, by the true
-        // surface.
-        let pdf = |wi: Vec3| {
-            if record.normal.dot(wi) <= 0.0 {
-                0.0
-            } else {
-                lambertian_pdf(&record, wi)
-            }
-        };
-        let spawn = |wi: Vec3| record.spawn_origin(wi);
-        let at = Vertex {
-            point: record.point,
-            time: ray.time,
-            albedo,
-        };
-        let (light, traced) = direct_light(scene, &at, pdf, spawn, sampler);
+    let wo = ray.direction;
+    let nee = samples_lights(scene, depth) && material.has_density();
+    if nee {
+        let (light, traced) = direct_light(
+            scene,
+            record.point,
+            ray.time,
+            |wi| material.eval(&record, wo, wi),
+            |wi| material.pdf(&record, wo, wi),
+            |wi| record.spawn_origin(wi),
+            sampler,
+        );
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
-    let Some(scatter) = material.scatter(ray.direction, &record, sampler) else {
+    let Some(scatter) = material.scatter(wo, &record, sampler) else {
         return Step::Done(path.radiance);
     };
-    path.sampled_from =
-        lambertian.map(|_| (record.point, lambertian_pdf(&record, scatter.direction)));
+    path.sampled_from = nee.then(|| (record.point, material.pdf(&record, wo, scatter.direction)));
     path.throughput *= scatter.attenuation;
     let next = Ray::timed(
         record.spawn_origin(scatter.direction),
@@ -204,12 +176,15 @@ fn scatter_in_medium(
     let point = ray.at(t);
     let nee = samples_lights(scene, depth);
     if nee {
-        let at = Vertex {
+        let (light, traced) = direct_light(
+            scene,
             point,
-            time: ray.time,
-            albedo: medium.albedo,
-        };
-        let (light, traced) = direct_light(scene, &at, |_| ISOTROPIC_PDF, |_| point, sampler);
+            ray.time,
+            |_| medium.albedo * ISOTROPIC_PDF,
+            |_| ISOTROPIC_PDF,
+            |_| point,
+            sampler,
+        );
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
@@ -275,33 +250,27 @@ fn samples_lights(scene: &Scene, depth: u32) -> bool {
         && depth + 1 < scene.settings.max_depth
 }
 
-/// A point where a path scatters and samples a light: a surface or a
-/// particle of a medium.
-struct Vertex {
-    point: Point3,
-    time: f32,
-    /// The fraction of light it scatters.
-    albedo: Color,
-}
-
-/// The light arriving at `at` from a point sampled on a light, scattered
-/// towards the path, weighted by the power heuristic against the path's own
-/// chance of finding it by scattering; and whether a shadow ray was traced.
+/// The light arriving at `point` (at `time`) from a point sampled on a
+/// light, scattered towards the path, weighted by the power heuristic
+/// against the path's own chance of finding it by scattering; and whether a
+/// shadow ray was traced.
 ///
-/// Both scattering models that sample lights reflect what they would carry
-/// along a direction: the albedo times the density `pdf` with which they
-/// scatter there (cos θ / π for a Lambertian surface, 1/4π for a particle),
-/// 0 where they cannot. `spawn` gives where a ray leaving along a direction
-/// starts (a surface's rounding bound off it).
+/// `eval` gives what the scattering (a surface's or a particle's) sends
+/// towards the path per unit light arriving from a direction (f · |cos θ|
+/// for a surface), `pdf` the density with which it would scatter there
+/// itself (0 where it cannot), `spawn` where a ray leaving along a
+/// direction starts (a surface's rounding bound off it).
 #[inline(never)]
 fn direct_light(
     scene: &Scene,
-    at: &Vertex,
+    point: Point3,
+    time: f32,
+    eval: impl Fn(Vec3) -> Color,
     pdf: impl Fn(Vec3) -> f32,
     spawn: impl Fn(Vec3) -> Point3,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
-    let Some(sample) = scene.lights.sample(at.point, sampler) else {
+    let Some(sample) = scene.lights.sample(point, sampler) else {
         return (Color::ZERO, false);
     };
     let wi = sample.direction;
@@ -317,12 +286,12 @@ fn direct_light(
     // environment is infinitely far along `wi`.
     let origin = spawn(wi);
     let (shadow, end) = if sample.distance.is_infinite() {
-        (Ray::timed(origin, wi, at.time), f32::INFINITY)
+        (Ray::timed(origin, wi, time), f32::INFINITY)
     } else {
         let to = sample.point - origin;
         let length = to.length();
         let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
-        (Ray::timed(origin, to / length, at.time), end)
+        (Ray::timed(origin, to / length, time), end)
     };
     if !(end > scene.settings.epsilon) {
         // Closer than the nearest hit a bounce can make: out of reach.
@@ -332,7 +301,7 @@ fn direct_light(
         return (Color::ZERO, true);
     }
     let weight = power_heuristic(sample.pdf, scatter_pdf);
-    let mut light = sample.radiance * at.albedo * (scatter_pdf * weight / sample.pdf);
+    let mut light = sample.radiance * eval(wi) * (weight / sample.pdf);
     if !scene.media.is_empty() {
         light *= scene.transmittance(&shadow, end);
     }

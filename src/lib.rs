@@ -72,4 +72,6 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+#[cfg(test)]
+mod testing;
 pub mod texture;

@@ -64,7 +64,10 @@ def empty_scene():
     return scene
 
 
-def configure(scene, width, height, spp, max_depth, seed=0, threads=2, rr=True, pattern=None):
+def configure(scene, width, height, spp, max_depth, seed=0, threads=2, rr=True, pattern=None,
+              bounces=None):
+    """`bounces` (if given) sets Cycles' max_bounces instead of max_depth - 1
+    (cycles_cornell.py: max_depth - 2, see there)."""
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
@@ -80,7 +83,7 @@ def configure(scene, width, height, spp, max_depth, seed=0, threads=2, rr=True, 
     c.blur_glossy = 0.0
     c.caustics_reflective = True
     c.caustics_refractive = True
-    b = max_depth - 1
+    b = max_depth - 1 if bounces is None else bounces
     c.max_bounces = b
     c.diffuse_bounces = b
     c.glossy_bounces = b

@@ -139,12 +139,15 @@ def main(argv=None):
                     help="Russian roulette from this depth (Mitsuba's default: 5); 'off' (default)")
     ap.add_argument("--timed", action="store_true", help="warm up, then time each seed's render")
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--threads", type=int, default=0, help="Dr.Jit worker threads (default: all cores)")
     args = ap.parse_args(argv)
     scene = read_scene(args.scene, args.one_sided)
 
     import drjit as dr
     import mitsuba as mi
     mi.set_variant(args.variant)
+    if args.threads > 0:
+        dr.set_thread_count(args.threads)
     rr_depth = None if args.rr_depth == "off" else int(args.rr_depth)
     ms = build_scene(mi, scene, args.spp, args.seeds[0], args.width, args.sampler, rr_depth)
 
@@ -163,7 +166,7 @@ def main(argv=None):
     if args.timed:
         result = {"renderer": "mitsuba", "version": mi.__version__, "variant": mi.variant(),
                   "scene": Path(args.scene).name, "spp": args.spp, "sampler": args.sampler,
-                  "rr_depth": args.rr_depth}
+                  "rr_depth": args.rr_depth, "threads": dr.thread_count()}
         result.update(peerlib.timed_renders(render, args.seeds, save))
         peerlib.print_json(result)
     else:

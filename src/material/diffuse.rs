@@ -88,6 +88,23 @@ impl Diffuse {
     }
 }
 
+/// The density per unit solid angle with which a Lambertian bounce at
+/// `hit` leaves along unit `w`: cosine-distributed about the shading
+/// normal, and on a smoothly shaded surface also the directions that fell
+/// below the true surface and were mirrored above it (see
+/// [`HitRecord::reflected_above`]).
+#[inline]
+pub fn lambertian_pdf(hit: &HitRecord, w: Vec3) -> f32 {
+    let mut cos = hit.shading_normal.dot(w).max(0.0);
+    if hit.is_smooth() {
+        cos += hit
+            .shading_normal
+            .dot(super::reflect(w, hit.normal))
+            .max(0.0);
+    }
+    cos * std::f32::consts::FRAC_1_PI
+}
+
 /// A unit bounce direction around unit `normal` following `model`.
 #[inline(always)]
 pub fn bounce_direction(model: BounceModel, normal: Vec3, sampler: &mut impl Sampler) -> Vec3 {

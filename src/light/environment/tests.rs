@@ -1,5 +1,6 @@
 use super::*;
 use crate::rng::Rng;
+use crate::testing::{chi_square, chi_square_bound};
 
 /// z for a two-sided bound that a correct estimate exceeds about once in
 /// 10⁴ runs.
@@ -22,33 +23,6 @@ fn test_map(rotation: f32) -> EnvironmentMap {
         })
         .collect();
     EnvironmentMap::new(Image::new(w, h, texels), rotation, 1.5).expect("a map of light")
-}
-
-/// Pearson's χ² of `counts` against `expected`, cells expected to hold
-/// fewer than 5 pooled; and the degrees of freedom.
-fn chi_square(counts: &[u64], expected: &[f64]) -> (f64, usize) {
-    let (mut chi2, mut cells, mut pooled_n, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
-    for (&n, &e) in counts.iter().zip(expected) {
-        if e < 5.0 {
-            pooled_n += n as f64;
-            pooled_e += e;
-        } else {
-            chi2 += (n as f64 - e).powi(2) / e;
-            cells += 1;
-        }
-    }
-    if pooled_e > 0.0 {
-        chi2 += (pooled_n - pooled_e).powi(2) / pooled_e;
-        cells += 1;
-    }
-    (chi2, cells - 1)
-}
-
-/// The χ² a correct sampler exceeds with probability about 10⁻⁴
-/// (Wilson–Hilferty).
-fn chi_square_bound(dof: usize) -> f64 {
-    let k = dof as f64;
-    k * (1.0 - 2.0 / (9.0 * k) + 3.72 * (2.0 / (9.0 * k)).sqrt()).powi(3)
 }
 
 /// Directions drawn from `env` fall into cells of equal solid angle
