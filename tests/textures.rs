@@ -1,10 +1,10 @@
 //! Textures as a scene uses them: the colour a ray finds where it hits
 //! (checker cells in space, an image by a quad's, a sphere's and a mesh's
-//! (u, v), noise), textured lights, and the messages for bad textures.
+//! (u, v), noise), textured lights (sampled by their texture), and the messages for bad textures.
 
 mod common;
 
-use common::{compile_file, scene_file_error, scratch_dir};
+use common::{compile_file, pixel_stats, scene_file_error, scratch_dir, tiles_agree};
 use lumen::material::Material;
 use lumen::math::{Color, Interval, Vec3};
 use lumen::ray::Ray;
@@ -292,7 +292,7 @@ transform = [{ translate = [0, 0, 10] }]
 }
 
 #[test]
-fn a_textured_light_emits_its_texture_and_is_found_by_bounces() {
+fn a_textured_light_emits_its_texture_and_is_sampled() {
     let dir = scratch_dir("tex-light");
     let scene = compile_file(
         &dir,
@@ -333,8 +333,77 @@ material = "bulb"
         colour_at(&scene, Vec3::new(1.5, 0.0, 0.5), up),
         Color::splat(4.0)
     );
-    // The bulb is sampled; the textured lamp is not (nor the gradient sky).
-    assert_eq!(scene.lights.len(), 1);
+    // The bulb and the textured lamp are sampled (not the gradient sky).
+    assert_eq!(scene.lights.len(), 2);
+}
+
+/// A floor lit only by a lamp whose radiance is a checker (bright and dark
+/// cells) and by a sphere of Perlin-noise light: the `path` integrator,
+/// which samples both by their texture where the sample lands, converges
+/// to the image of the `bsdf` integrator, which finds them by chance.
+#[test]
+fn textured_lights_sampled_agree_with_textured_lights_found() {
+    let dir = scratch_dir("tex-light-agree");
+    let text = |integrator: &str, spp: u32| {
+        format!(
+            r#"
+[render]
+width = 32
+height = 32
+samples_per_pixel = {spp}
+integrator = "{integrator}"
+gamma = 1.0
+seed = 4
+[camera]
+lookfrom = [0, 5, 6]
+lookat = [0, 0, 0]
+vfov = 60
+[background]
+type = "solid"
+color = [0, 0, 0]
+[textures.stripes]
+type = "checker"
+scale = 0.5
+even = [6, 5, 4]
+odd = [0.2, 0.2, 0.2]
+[textures.cloud]
+type = "noise"
+scale = 4
+[materials.lamp]
+type = "emissive"
+radiance = "stripes"
+two_sided = true
+[materials.glow]
+type = "emissive"
+radiance = "cloud"
+[materials.floor]
+type = "diffuse"
+albedo = [0.7, 0.7, 0.7]
+[[objects]]
+type = "quad"
+corner = [-3, 0, -3]
+u = [0, 0, 6]
+v = [6, 0, 0]
+material = "floor"
+[[objects]]
+type = "quad"
+corner = [-1.5, 2.5, -2.5]
+u = [3, 0, 0]
+v = [0, 0, 2]
+material = "lamp"
+[[objects]]
+type = "sphere"
+center = [1.5, 0.8, 1]
+radius = 0.5
+material = "glow"
+"#
+        )
+    };
+    let scene = compile_file(&dir, "path.toml", &text("path", 128));
+    assert_eq!(scene.lights.len(), 2, "both textured lights are sampled");
+    let path = pixel_stats(&scene);
+    let bsdf = pixel_stats(&compile_file(&dir, "bsdf.toml", &text("bsdf", 512)));
+    tiles_agree("textured lights", &path, &bsdf);
 }
 
 #[test]

@@ -2,7 +2,11 @@
 # Efficiency (1 / (variance x seconds per render)) of lumen and its peer
 # renderers on one scene at one sample count: docs/peers.md, "Efficiency".
 #
-#   scripts/peers/efficiency.sh bunny|spheres SPP [CONFIG...]
+#   scripts/peers/efficiency.sh bunny|spheres|cornell SPP [CONFIG...]
+#
+# cornell: `lumen scenes export cornell-box` with its light one-sided, the
+# `path` integrator and width CORNELL_WIDTH (mitsuba_cornell.py,
+# cycles_cornell.py; docs/peers.md, "Lights").
 #
 # CONFIG (default: all of them):
 #   lumen:SAMPLER[:RR]             lumen with --sampler SAMPLER (sobol, independent,
@@ -12,9 +16,10 @@
 #                                  from the fifth bounce)
 #   mitsuba:SAMPLER:RR             SAMPLER independent|multijitter|ldsampler|stratified,
 #                                  RR rr5 (Mitsuba's default rr_depth 5) or off
-#   cycles:PATTERN:RR              PATTERN startup (the bpy startup scene's, Tabulated
+#   cycles:PATTERN:RR[:LT]         PATTERN startup (the bpy startup scene's, Tabulated
 #                                  Sobol) or AUTOMATIC (a new scene's default: blue noise)
-#                                  or another Cycles sampling_pattern; RR on (default) or off
+#                                  or another Cycles sampling_pattern; RR on (default) or off;
+#                                  LT (cornell only) light tree on (default) or off
 #
 # Each configuration renders the scene once to warm up (JIT compilation, scene
 # upload), then once per seed (SEEDS, default "1 2"), timing each render
@@ -34,6 +39,8 @@
 #   SEEDS="1 2"                the two seeds
 #   MESH=assets/bunny_235k.glb the bunny mesh (bunny scene)
 #   LUMEN=target/release/lumen the lumen binary
+#   THREADS=2                  worker threads of every renderer
+#   CORNELL_WIDTH=300          image width of the cornell scene
 #   MAX_LOAD=1.5 WAIT=600      wait up to WAIT s before each configuration for the
 #   BUSY_MAX=0.3               1-minute load average to fall below MAX_LOAD (or, as
 #                              it decays slowly after the previous measurement, for
@@ -51,11 +58,14 @@ set -euo pipefail
 
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/../.." && pwd)
-SCENE=${1:?usage: efficiency.sh bunny|spheres SPP [CONFIG...]}
-SPP=${2:?usage: efficiency.sh bunny|spheres SPP [CONFIG...]}
+SCENE=${1:?usage: efficiency.sh bunny|spheres|cornell SPP [CONFIG...]}
+SPP=${2:?usage: efficiency.sh bunny|spheres|cornell SPP [CONFIG...]}
 shift 2
 CONFIGS=("$@")
-if [[ ${#CONFIGS[@]} -eq 0 ]]; then
+if [[ ${#CONFIGS[@]} -eq 0 && $SCENE == cornell ]]; then
+    CONFIGS=(lumen:sobol:rr5 mitsuba:multijitter:rr5 cycles:startup:on cycles:AUTOMATIC:on
+             cycles:SOBOL_BURLEY:on cycles:startup:on:off)
+elif [[ ${#CONFIGS[@]} -eq 0 ]]; then
     CONFIGS=(lumen:independent lumen:sobol
              mitsuba:independent:rr5 mitsuba:multijitter:rr5 mitsuba:ldsampler:rr5
              mitsuba:independent:off mitsuba:multijitter:off mitsuba:ldsampler:off
@@ -71,9 +81,11 @@ BUSY_MAX=${BUSY_MAX:-0.3}
 OTHER_MAX=${OTHER_MAX:-0.15}
 RETRIES=${RETRIES:-2}
 WAIT=${WAIT:-600}
+THREADS=${THREADS:-2}
+CORNELL_WIDTH=${CORNELL_WIDTH:-300}
 mkdir -p "$OUT"
 
-case $SCENE in bunny|spheres) ;; *) echo "efficiency.sh: scene must be bunny or spheres" >&2; exit 2 ;; esac
+case $SCENE in bunny|spheres|cornell) ;; *) echo "efficiency.sh: scene must be bunny, spheres or cornell" >&2; exit 2 ;; esac
 
 need_mitsuba=0; need_cycles=0
 for c in "${CONFIGS[@]}"; do
@@ -97,6 +109,12 @@ fi
 if [[ $SCENE == bunny ]]; then
     LUMEN_SCENE=$OUT/bunny-scene-$(basename "$MESH" .glb).toml
     sed "s|^file = .*|file = \"$MESH\"|" "$HERE/bunny-scene.toml" >"$LUMEN_SCENE"
+elif [[ $SCENE == cornell ]]; then
+    LUMEN_SCENE=$OUT/cornell-scene-$CORNELL_WIDTH.toml
+    "$LUMEN" scenes export cornell-box -o "$LUMEN_SCENE.tmp" >/dev/null
+    sed 's/two_sided = true/two_sided = false/; s/integrator = "bsdf"/integrator = "path"/;'" s/^width = .*/width = $CORNELL_WIDTH/" \
+        "$LUMEN_SCENE.tmp" >"$LUMEN_SCENE"
+    rm -f "$LUMEN_SCENE.tmp"
 else
     LUMEN_SCENE=$HERE/spheres-scene.toml
 fi
@@ -140,7 +158,8 @@ run_config() {
     local c=$1 tag=$2 log="$OUT/$2.log"
     IMG_A="$OUT/$tag-s$SEED_A.pfm"; IMG_B="$OUT/$tag-s$SEED_B.pfm"
     local tmpl="$OUT/$tag-s{seed}.pfm" r s rr
-    IFS=: read -r r s rr <<<"$c"
+    local lt
+    IFS=: read -r r s rr lt <<<"$c"
     case $r in
     lumen)
         # lumen's own "time" line: the render passes, without scene loading;
@@ -149,11 +168,13 @@ run_config() {
         rr=${rr:-off}
         [ "$rr" = rr5 ] && integrator=path
         "$LUMEN" render "$LUMEN_SCENE" -o "$OUT/$tag-warmup.pfm" --spp "$SPP" --seed "$SEED_A" \
-            --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h >"$log" 2>&1
+            --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h \
+            --threads "$THREADS" >"$log" 2>&1
         for seed in "$SEED_A" "$SEED_B"; do
             children_cpu_s >"$OUT/.c"; c0=$(cat "$OUT/.c")
             "$LUMEN" render "$LUMEN_SCENE" -o "$OUT/$tag-s$seed.pfm" --spp "$SPP" --seed "$seed" \
-                --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h >>"$log" 2>&1
+                --sampler "${s:-independent}" --integrator "$integrator" --checkpoint-interval 100h \
+                --threads "$THREADS" >>"$log" 2>&1
             children_cpu_s >"$OUT/.c"
             cpus+=("$(awk -v a="$c0" -v b="$(cat "$OUT/.c")" 'BEGIN { printf "%.2f", b - a }')")
             times+=("$(grep -o '^time [0-9.]* s' "$log" | tail -n1 | awk '{print $2}')")
@@ -165,31 +186,39 @@ run_config() {
         local rrarg=off; [[ $rr == rr5 ]] && rrarg=5
         if [[ $SCENE == bunny ]]; then
             "$LUMEN_PEERS_PYTHON" "$HERE/mitsuba_bunny.py" "$MESH" --spp "$SPP" --sampler "$s" \
-                --rr-depth "$rrarg" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" >"$log" 2>&1
+                --rr-depth "$rrarg" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" \
+                --threads "$THREADS" >"$log" 2>&1
+        elif [[ $SCENE == cornell ]]; then
+            "$LUMEN_PEERS_PYTHON" "$HERE/mitsuba_cornell.py" "$LUMEN_SCENE" --spp "$SPP" --sampler "$s" \
+                --rr-depth "$rrarg" --timed --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" \
+                --threads "$THREADS" >"$log" 2>&1
         else
             "$LUMEN_PEERS_PYTHON" "$HERE/mitsuba_spheres.py" "$HERE/spheres-scene.toml" --spp "$SPP" \
                 --sampler "$s" --rr-depth "$rrarg" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" \
-                >"$log" 2>&1
+                --threads "$THREADS" >"$log" 2>&1
         fi
         read -r SECS_A SECS_B CPU_A CPU_B < <(tail -n1 "$log" | "$PY" -c 'import json,sys; d=json.load(sys.stdin); print(*d["times_s"], *d["cpu_s"])')
         ;;
     cycles)
-        local script=cycles_spheres.py arg=$HERE/spheres-scene.toml
+        local script=cycles_spheres.py arg=$HERE/spheres-scene.toml extra=()
         [[ $SCENE == bunny ]] && { script=cycles_bunny.py; arg=$MESH; }
+        [[ $SCENE == cornell ]] && { script=cycles_cornell.py; arg=$LUMEN_SCENE; extra=(--timed); }
+        [[ -n $lt ]] && extra+=(--light-tree "$lt")
         "$LUMEN_CYCLES_PYTHON" "$HERE/$script" "$arg" --spp "$SPP" --pattern "$s" --rr "$rr" \
-            --threads 2 --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" >"$log" 2>&1
+            --threads "$THREADS" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" "${extra[@]}" >"$log" 2>&1
         read -r SECS_A SECS_B CPU_A CPU_B < <(grep '^{' "$log" | tail -n1 | "$PY" -c 'import json,sys; d=json.load(sys.stdin); print(*d["times_s"], *d["cpu_s"])')
         ;;
     *) echo "efficiency.sh: unknown configuration $c" >&2; return 2 ;;
     esac
 }
 
-printf '%-8s %-12s %-4s %-8s %5s %9s %12s %11s %8s %9s %6s %6s %5s %5s\n' \
+printf '%-8s %-15s %-4s %-8s %5s %9s %12s %11s %8s %9s %6s %6s %5s %5s\n' \
     renderer sampler rr scene spp s/render variance efficiency cpu-s eff/cpu-s load0 load1 busy0 other
 for c in "${CONFIGS[@]}"; do
-    IFS=: read -r r s rr <<<"$c"
+    IFS=: read -r r s rr lt <<<"$c"
     [[ $r == lumen ]] && { s=${s:-independent}; rr=${rr:-off}; }
-    tag="$SCENE-$SPP-$r-$s-$rr"
+    tag="$SCENE-$SPP-$r-$s-$rr${lt:+-lt$lt}"
+    [[ -n $lt ]] && s="$s:lt-$lt"
     for try in $(seq 0 "$RETRIES"); do
         wait_for_low_load
         LOAD_START=$(load1)
@@ -210,7 +239,7 @@ for c in "${CONFIGS[@]}"; do
     read -r SECS VAR EFF < <(echo "$J" | "$PY" -c 'import json,sys; d=json.load(sys.stdin); print(d["seconds"], d["variance"], d["efficiency"])')
     CPU=$(awk -v a="$CPU_A" -v b="$CPU_B" 'BEGIN { printf "%.3f", (a + b) / 2 }')
     EFFCPU=$(awk -v v="$VAR" -v c="$CPU" 'BEGIN { printf "%.5g", 1 / (v * c) }')
-    printf '%-8s %-12s %-4s %-8s %5s %9.3f %12.5g %11.5g %8s %9s %6s %6s %5s %5s%s\n' \
+    printf '%-8s %-15s %-4s %-8s %5s %9.3f %12.5g %11.5g %8s %9s %6s %6s %5s %5s%s\n' \
         "$r" "$s" "$rr" "$SCENE" "$SPP" "$SECS" "$VAR" "$EFF" "$CPU" "$EFFCPU" "$LOAD_START" "$LOAD_END" "$BUSY" "$OTHER" "$mark"
     echo "$J" | "$PY" -c 'import json,sys; d=json.load(sys.stdin); d.update(zip(("renderer","sampler","rr","scene","spp","times_s","cpu_s","load_start","load_end","busy_cores_start","other_cores","host_cores"), sys.argv[1:])); print(json.dumps(d))' \
         "$r" "$s" "$rr" "$SCENE" "$SPP" "$SECS_A $SECS_B" "$CPU_A $CPU_B" "$LOAD_START" "$LOAD_END" "$BUSY" "$OTHER" "$(nproc)" >>"$OUT/results.jsonl"

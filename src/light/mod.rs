@@ -17,10 +17,12 @@ pub mod environment;
 pub use environment::{Environment, EnvironmentMap};
 
 use crate::distribution::Distribution1D;
+use crate::geometry::Sphere;
 use crate::material::Emissive;
 use crate::math::{Color, Point3, Vec3};
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
+use crate::texture::Texture;
 use std::f32::consts::PI;
 
 /// The shape of a light, in world space.
@@ -68,18 +70,81 @@ impl Shape {
 pub struct Light {
     /// Where it is.
     pub shape: Shape,
-    /// What it emits, and to which sides.
+    /// What it emits, and to which sides (the radiance is the texture's
+    /// where it has one).
     pub emission: Emissive,
+    /// The texture of its radiance, if it has one.
+    pub texture: Option<LightTexture>,
+}
+
+/// The radiance of a light given by a texture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightTexture {
+    /// The texture, in the table given to [`Lights::new`].
+    pub texture: u32,
+    /// A triangle's texture coordinates at its corners (unused for other
+    /// shapes, whose coordinates follow from the point).
+    pub uvs: [[f32; 2]; 3],
 }
 
 impl Light {
     /// Its power, up to a constant factor: what [`Lights`] chooses by.
-    fn power(&self) -> f64 {
+    fn power(&self, textures: &[Texture]) -> f64 {
         let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        f64::from(luminance(self.emission.radiance))
+        f64::from(self.mean_luminance(textures))
             * f64::from(self.shape.area())
             * std::f64::consts::PI
             * sides
+    }
+
+    /// The luminance of its radiance averaged over its area: a textured
+    /// light's over a 16 × 16 grid of points spread evenly by area.
+    fn mean_luminance(&self, textures: &[Texture]) -> f32 {
+        if self.texture.is_none() {
+            return luminance(self.emission.radiance);
+        }
+        let n = 16;
+        let mut total = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let uv = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+                let (point, outward, st) = sample_area(&self.shape, uv);
+                total += luminance(self.radiance_at(textures, point, outward, st));
+            }
+        }
+        total / (n * n) as f32
+    }
+
+    /// Its radiance at `point` of its surface (outward normal `outward`,
+    /// parameters `st` as [`sample_area`] gives them), before the side.
+    #[inline]
+    fn radiance_at(
+        &self,
+        textures: &[Texture],
+        point: Point3,
+        outward: Vec3,
+        st: [f32; 2],
+    ) -> Color {
+        let Some(t) = self.texture else {
+            return self.emission.radiance;
+        };
+        let uv = match self.shape {
+            Shape::Sphere { .. } => Sphere::uv(outward),
+            Shape::Quad { .. } => st,
+            Shape::Triangle { .. } => {
+                let [p, q, r] = t.uvs;
+                let (b1, b2) = (st[0], st[1]);
+                let b0 = 1.0 - b1 - b2;
+                [
+                    b0 * p[0] + b1 * q[0] + b2 * r[0],
+                    b0 * p[1] + b1 * q[1] + b2 * r[1],
+                ]
+            }
+        };
+        // Emitted light is not clamped as an albedo is, but never negative.
+        textures[t.texture as usize]
+            .value(textures, uv, point)
+            .max(Color::ZERO)
     }
 }
 
@@ -125,6 +190,8 @@ pub enum LightSelection {
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
     lights: Vec<Light>,
+    /// The textures of textured lights.
+    textures: Vec<Texture>,
     /// The environment, chosen as light number `lights.len()`.
     environment: Option<Environment>,
     /// The choice of a light: `lights`, then the environment.
@@ -133,11 +200,13 @@ pub struct Lights {
 
 impl Lights {
     /// The list of `lights`, in order (a light's index is its place in
-    /// `lights`), and the `environment` seen by rays that escape a scene
-    /// whose bounding sphere has radius `scene_radius`. Lights of no power
-    /// are never chosen; when nothing sheds any light the list is empty.
+    /// `lights`), whose textures are in `textures`, and the `environment`
+    /// seen by rays that escape a scene whose bounding sphere has radius
+    /// `scene_radius`. Lights of no power are never chosen; when nothing
+    /// sheds any light the list is empty.
     pub fn new(
         lights: Vec<Light>,
+        textures: Vec<Texture>,
         environment: Option<Environment>,
         scene_radius: f32,
         selection: LightSelection,
@@ -149,7 +218,7 @@ impl Lights {
         let environment = environment
             .map(|e| (e.integral(), e))
             .filter(|(integral, _)| *integral > 0.0);
-        let mut powers: Vec<f64> = lights.iter().map(Light::power).collect();
+        let mut powers: Vec<f64> = lights.iter().map(|l| l.power(&textures)).collect();
         powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
         let environment = environment.map(|(_, e)| e);
         if selection == LightSelection::Uniform {
@@ -160,8 +229,15 @@ impl Lights {
         let Some(choice) = Distribution1D::new(&powers) else {
             return Lights::default();
         };
+        // Only the textures of textured lights are looked up.
+        let textures = if lights.iter().any(|l| l.texture.is_some()) {
+            textures
+        } else {
+            Vec::new()
+        };
         Lights {
             lights,
+            textures,
             environment,
             choice,
         }
@@ -204,9 +280,10 @@ impl Lights {
                 pdf,
             });
         };
-        let (target, outward) = match light.shape {
+        let (target, outward, st) = match light.shape {
             Shape::Sphere { center, radius } if !inside(center, radius, point) => {
-                sample_cap(center, radius, point, uv)
+                let (target, outward) = sample_cap(center, radius, point, uv);
+                (target, outward, uv)
             }
             shape => sample_area(&shape, uv),
         };
@@ -221,7 +298,11 @@ impl Lights {
             point: target,
             direction,
             distance,
-            radiance: light.emission.towards(outward.dot(direction) < 0.0),
+            radiance: if outward.dot(direction) < 0.0 || light.emission.two_sided {
+                light.radiance_at(&self.textures, target, outward, st)
+            } else {
+                Color::ZERO
+            },
             pdf,
         })
     }
@@ -284,14 +365,16 @@ fn cap_solid_angle(sin2: f32) -> f32 {
     2.0 * PI * sin2 / (1.0 + cos)
 }
 
-/// A uniform point on the area of `shape`, and its outward unit normal.
-fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3) {
+/// A uniform point on the area of `shape`, its outward unit normal, and its
+/// parameters: a quad's (α, β), a triangle's barycentrics (b₁, b₂) of its
+/// second and third corners (a sphere's follow from the normal).
+fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
     match *shape {
         Shape::Sphere { center, radius } => {
             let outward = sampling::unit_vector([s, t]);
-            (center + radius * outward, outward)
+            (center + radius * outward, outward, [s, t])
         }
-        Shape::Quad { corner, u, v } => (corner + s * u + t * v, u.cross(v).normalize()),
+        Shape::Quad { corner, u, v } => (corner + s * u + t * v, u.cross(v).normalize(), [s, t]),
         Shape::Triangle {
             vertices: [a, b, c],
         } => {
@@ -304,6 +387,7 @@ fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3) {
             (
                 a + s * (b - a) + t * (c - a),
                 (b - a).cross(c - a).normalize(),
+                [s, t],
             )
         }
     }

@@ -12,6 +12,7 @@ fn emitting(shape: Shape, radiance: Color, two_sided: bool) -> Light {
             radiance,
             two_sided,
         },
+        texture: None,
     }
 }
 
@@ -21,7 +22,7 @@ fn light(shape: Shape) -> Light {
 
 /// `lights` without an environment, chosen by power.
 fn area_lights(lights: Vec<Light>) -> Lights {
-    Lights::new(lights, None, 0.0, LightSelection::Power)
+    Lights::new(lights, Vec::new(), None, 0.0, LightSelection::Power)
 }
 
 /// Mean and standard error of `f` over `n` samples.
@@ -211,6 +212,7 @@ fn lights_and_the_sky_are_chosen_by_power_or_uniformly() {
     let sky = Environment::Solid(Color::splat(0.5));
     let by_power = Lights::new(
         lights.clone(),
+        Vec::new(),
         Some(sky.clone()),
         2.0,
         LightSelection::Power,
@@ -221,7 +223,13 @@ fn lights_and_the_sky_are_chosen_by_power_or_uniformly() {
     assert!((by_power.chance(0) - expected).abs() < 1e-6);
     assert_eq!(by_power.chance(1), 0.0);
     assert!((by_power.chance(2) - (1.0 - expected)).abs() < 1e-6);
-    let uniform = Lights::new(lights.clone(), Some(sky), 2.0, LightSelection::Uniform);
+    let uniform = Lights::new(
+        lights.clone(),
+        Vec::new(),
+        Some(sky),
+        2.0,
+        LightSelection::Uniform,
+    );
     assert_eq!(
         [uniform.chance(0), uniform.chance(1), uniform.chance(2)],
         [0.5, 0.0, 0.5]
@@ -229,6 +237,7 @@ fn lights_and_the_sky_are_chosen_by_power_or_uniformly() {
     // A black sky is no light; nothing at all is no list.
     let black = Lights::new(
         lights,
+        Vec::new(),
         Some(Environment::Solid(Color::ZERO)),
         2.0,
         LightSelection::Power,
@@ -236,6 +245,7 @@ fn lights_and_the_sky_are_chosen_by_power_or_uniformly() {
     assert_eq!((black.len(), black.chance(0)), (2, 1.0));
     assert_eq!(black.environment_pdf(Vec3::Y), 0.0);
     let none = Lights::new(
+        Vec::new(),
         Vec::new(),
         Some(Environment::Solid(Color::ZERO)),
         2.0,
@@ -259,6 +269,7 @@ fn a_sky_sample_is_infinitely_far_and_weighted_by_its_chance() {
     };
     let lights = Lights::new(
         vec![light(quad)],
+        Vec::new(),
         Some(sky.clone()),
         1.0,
         LightSelection::Uniform,

@@ -148,7 +148,7 @@ impl Scene {
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
-        let (lights, light_ids) = world.lights(&materials);
+        let (lights, light_ids) = world.lights(&materials, &material_textures);
         // A smooth sky is found as well by the bounces, which follow the
         // surface's cosine, as by a shadow ray drawn over the whole sphere;
         // the shadow rays would cost time for nothing (half the efficiency
@@ -160,6 +160,7 @@ impl Scene {
             .unwrap_or(matches!(background, Environment::Map(_)));
         let lights = Lights::new(
             lights,
+            textures.clone(),
             sampled.then(|| background.clone()),
             world.bounding_radius(),
             settings.light_selection,

@@ -12,7 +12,7 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
 use crate::geometry::{Bvh, HitRecord, Instance, Primitive, Quad, Sphere, Triangle};
-use crate::light::{Light, Shape as LightShape};
+use crate::light::{Light, LightTexture, Shape as LightShape};
 use crate::material::{Emissive, Material};
 use crate::math::{Color, Point3, Vec3};
 use crate::mesh::TriangleMesh;
@@ -465,6 +465,21 @@ pub(crate) struct LightIds {
 
 const NO_LIGHT: u32 = u32::MAX;
 
+/// What a material emits: its emission, and the texture of its radiance.
+type Emission = (Emissive, Option<u32>);
+
+/// The texture coordinates a triangle without any has at its corners (its
+/// record's (u, v) are then the barycentrics (b₁, b₂)).
+const CORNER_UVS: [[f32; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+
+/// The texture coordinates at the corners of triangle `k` of `mesh`.
+fn corner_uvs(mesh: &Mesh, k: usize) -> [[f32; 2]; 3] {
+    match &mesh.data.uvs {
+        Some(uvs) => mesh.data.triangles[k].map(|i| uvs[i as usize]),
+        None => CORNER_UVS,
+    }
+}
+
 impl LightIds {
     /// The light that `hit` met, if it met one that can be sampled.
     #[inline]
@@ -487,17 +502,35 @@ impl LightIds {
 impl World {
     /// Every emissive primitive as a light in world space, and where each
     /// primitive's light is. A light's radiance and sides are its
-    /// material's; an instance holding any light gets one entry per
+    /// material's, its radiance a texture where `material_textures` gives
+    /// the material one; an instance holding any light gets one entry per
     /// primitive of its tree (black for the others), so that a hit's light
     /// is found by arithmetic.
-    pub(crate) fn lights(&self, materials: &[Material]) -> (Vec<Light>, LightIds) {
-        let emitter = |m: u32| materials[m as usize].light();
+    pub(crate) fn lights(
+        &self,
+        materials: &[Material],
+        material_textures: &[Option<u32>],
+    ) -> (Vec<Light>, LightIds) {
+        // What material `m` emits: its emission and texture, if any.
+        let emitter = |m: u32| -> Option<Emission> {
+            let texture = material_textures.get(m as usize).copied().flatten();
+            match materials[m as usize] {
+                Material::Emissive(e) if texture.is_some() => Some((e, texture)),
+                other => other.light().map(|e| (e, None)),
+            }
+        };
         let mut lights = Vec::new();
         let mut ids = LightIds::default();
-        let add = |shape: LightShape, emission: Emissive, lights: &mut Vec<Light>| {
-            lights.push(Light { shape, emission });
-            (lights.len() - 1) as u32
-        };
+        let add =
+            |shape: LightShape, (emission, texture): Emission, uvs, lights: &mut Vec<Light>| {
+                let texture = texture.map(|texture| LightTexture { texture, uvs });
+                lights.push(Light {
+                    shape,
+                    emission,
+                    texture,
+                });
+                (lights.len() - 1) as u32
+            };
         let top = &self.top;
         for s in &top.spheres {
             ids.top.push(emitter(s.material).map_or(NO_LIGHT, |e| {
@@ -505,7 +538,7 @@ impl World {
                     center: s.center,
                     radius: s.radius,
                 };
-                add(shape, e, &mut lights)
+                add(shape, e, CORNER_UVS, &mut lights)
             }));
         }
         for (q, material) in &top.quads {
@@ -515,7 +548,7 @@ impl World {
                     u: q.u,
                     v: q.v,
                 };
-                add(shape, e, &mut lights)
+                add(shape, e, CORNER_UVS, &mut lights)
             }));
         }
         for mesh in &top.meshes {
@@ -523,7 +556,8 @@ impl World {
                 ids.top
                     .push(emitter(mesh.material(k)).map_or(NO_LIGHT, |e| {
                         let vertices = mesh.triangle(k).vertices;
-                        add(LightShape::Triangle { vertices }, e, &mut lights)
+                        let uvs = corner_uvs(mesh, k);
+                        add(LightShape::Triangle { vertices }, e, uvs, &mut lights)
                     }));
             }
         }
@@ -547,19 +581,21 @@ impl World {
                 for k in 0..mesh.data.triangles.len() {
                     let tri = mesh.triangle(k);
                     let [a, b, c] = tri.vertices.map(|p| transform.point(p));
+                    let [p, q, r] = corner_uvs(mesh, k);
                     // Keep the outward side the hit record's: a mirroring
                     // transform reverses the corners' order.
                     let outward = transform.normal(tri.area_normal());
-                    let vertices = if (b - a).cross(c - a).dot(outward) < 0.0 {
-                        [a, c, b]
+                    let (vertices, uvs) = if (b - a).cross(c - a).dot(outward) < 0.0 {
+                        ([a, c, b], [p, r, q])
                     } else {
-                        [a, b, c]
+                        ([a, b, c], [p, q, r])
                     };
-                    let e = material(mesh.material(k)).unwrap_or(Emissive {
+                    let black = Emissive {
                         radiance: Color::ZERO,
                         two_sided: false,
-                    });
-                    add(LightShape::Triangle { vertices }, e, &mut lights);
+                    };
+                    let e = material(mesh.material(k)).unwrap_or((black, None));
+                    add(LightShape::Triangle { vertices }, e, uvs, &mut lights);
                 }
             }
         }
