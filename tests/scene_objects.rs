@@ -410,3 +410,73 @@ fn the_command_exports_scene_files_with_every_kind() {
     assert!(png.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A mirroring transform keeps the outside of quads and boxes outside:
+/// rays from outside meet the front face, a one-sided light still shines
+/// the way it did (a mirror in x leaves a light facing down facing down),
+/// and a glass box mirrored onto itself refracts as the box does.
+#[test]
+fn mirroring_keeps_the_outside_of_quads_and_boxes() {
+    use lumen::math::{Interval, Vec3};
+    use lumen::ray::Ray;
+    let dir = scratch_dir("mirrored-quads");
+    let range = Interval::new(1e-4, f32::INFINITY);
+    for mirror in [
+        "{ scale = [-1, 1, 1] }",
+        "{ matrix = [[0, 1, 0, 0], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] }",
+    ] {
+        let text = format!(
+            r#"
+[materials.glass]
+type = "dielectric"
+ior = 1.5
+[materials.lamp]
+type = "emissive"
+radiance = [2, 2, 2]
+[[objects]]
+type = "box"
+min = [-1, -1, -1]
+max = [1, 1, 1]
+material = "glass"
+transform = [{mirror}]
+[[objects]]
+type = "quad"
+corner = [-1, 3, -1]
+u = [2, 0, 0]
+v = [0, 0, 2]
+material = "lamp"
+transform = [{{ scale = [-1, 1, 1] }}]
+"#
+        );
+        let scene = scene_file(&dir, "m.toml", &text)
+            .compile(&Overrides::default())
+            .unwrap();
+        for (from, towards) in [
+            (Vec3::new(0.2, 0.1, 5.0), -Vec3::Z),
+            (Vec3::new(5.0, 0.1, 0.3), -Vec3::X),
+            (Vec3::new(0.1, -5.0, 0.2), Vec3::Y),
+        ] {
+            let hit = scene.hit(&Ray::new(from, towards), range).unwrap();
+            assert!(
+                hit.front_face,
+                "{mirror}: the box is hit from inside along {towards}"
+            );
+            assert!(
+                (hit.outward_normal() + towards).length() < 1e-5,
+                "{mirror}: outward normal {} for a ray along {towards}",
+                hit.outward_normal()
+            );
+        }
+        // The lamp, u × v = −y, faces down both before and after a mirror
+        // that keeps y.
+        let up = Ray::new(Vec3::new(0.3, 2.0, 0.3), Vec3::Y);
+        let lamp = scene.hit(&up, range).unwrap();
+        assert!(lamp.front_face, "the lamp is seen from behind");
+        let mut sampler = lumen::rng::Rng::new(1);
+        let sample = scene
+            .lights
+            .sample(Vec3::new(0.0, 2.0, 0.0), &mut sampler)
+            .expect("a light sample");
+        assert!(sample.radiance.x > 0.0, "the lamp does not shine down");
+    }
+}

@@ -24,7 +24,8 @@ pub struct Quad {
     pub u: Vec3,
     /// The second edge v.
     pub v: Vec3,
-    /// Unit normal along u × v.
+    /// Unit normal: along u × v, or against it for a quad placed by a
+    /// mirroring transform ([`Quad::flipped`]). Its side is the outside.
     pub normal: Vec3,
     /// (u × v)/|u × v|², which turns a point of the plane into (α, β).
     pub w: Vec3,
@@ -50,6 +51,22 @@ impl Quad {
             w: n / n2,
             d: normal.dot(corner),
         })
+    }
+
+    /// The same parallelogram with its outside on the other side: what a
+    /// mirroring transform makes of it, which reverses u × v relative to
+    /// the surface's true outside. Its (α, β) coordinates are unchanged.
+    pub fn flipped(self) -> Quad {
+        Quad {
+            normal: -self.normal,
+            d: -self.d,
+            ..self
+        }
+    }
+
+    /// Whether its outside is against u × v (see [`Quad::flipped`]).
+    pub fn is_flipped(&self) -> bool {
+        self.normal.dot(self.u.cross(self.v)) < 0.0
     }
 
     /// The axis-aligned bounding box `(min, max)`.

@@ -82,8 +82,9 @@ pub struct Light {
 pub struct LightTexture {
     /// The texture, in the table given to [`Lights::new`].
     pub texture: u32,
-    /// A triangle's texture coordinates at its corners (unused for other
-    /// shapes, whose coordinates follow from the point).
+    /// The texture coordinates at a triangle's corners a, b, c, or at a
+    /// quad's corner Q, Q + u and Q + v (unused for spheres, whose
+    /// coordinates follow from the normal).
     pub uvs: [[f32; 2]; 3],
 }
 
@@ -130,14 +131,14 @@ impl Light {
         };
         let uv = match self.shape {
             Shape::Sphere { .. } => Sphere::uv(outward),
-            Shape::Quad { .. } => st,
-            Shape::Triangle { .. } => {
+            // Affine in (s, t) from the coordinates at the corner and at the
+            // ends of the two edges (a triangle's barycentrics b₁, b₂).
+            Shape::Quad { .. } | Shape::Triangle { .. } => {
                 let [p, q, r] = t.uvs;
-                let (b1, b2) = (st[0], st[1]);
-                let b0 = 1.0 - b1 - b2;
+                let [s, t] = st;
                 [
-                    b0 * p[0] + b1 * q[0] + b2 * r[0],
-                    b0 * p[1] + b1 * q[1] + b2 * r[1],
+                    p[0] + s * (q[0] - p[0]) + t * (r[0] - p[0]),
+                    p[1] + s * (q[1] - p[1]) + t * (r[1] - p[1]),
                 ]
             }
         };

@@ -746,7 +746,14 @@ fn place_quad(
     if !(q.is_finite() && u.is_finite() && v.is_finite()) {
         return Err(out_of_range(i));
     }
-    Quad::new(q, u, v).ok_or_else(|| out_of_range(i))
+    let quad = Quad::new(q, u, v).ok_or_else(|| out_of_range(i))?;
+    // A mirroring transform reverses u × v: the outside stays the outside.
+    let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
+    Ok(if x.cross(y).dot(z) < 0.0 {
+        quad.flipped()
+    } else {
+        quad
+    })
 }
 
 /// The six faces (corner, u, v) of the box from `min` to `max`, each with

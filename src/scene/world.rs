@@ -543,12 +543,25 @@ impl World {
         }
         for (q, material) in &top.quads {
             ids.top.push(emitter(*material).map_or(NO_LIGHT, |e| {
-                let shape = LightShape::Quad {
-                    corner: q.corner,
-                    u: q.u,
-                    v: q.v,
+                // A light's outside is along u × v: a flipped quad is the
+                // same parallelogram from its far corner along u, its
+                // (α, β) then 1 − s and t of the sample's (s, t).
+                let (shape, uvs) = if q.is_flipped() {
+                    let shape = LightShape::Quad {
+                        corner: q.corner + q.u,
+                        u: -q.u,
+                        v: q.v,
+                    };
+                    (shape, [[1.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+                } else {
+                    let shape = LightShape::Quad {
+                        corner: q.corner,
+                        u: q.u,
+                        v: q.v,
+                    };
+                    (shape, CORNER_UVS)
                 };
-                add(shape, e, CORNER_UVS, &mut lights)
+                add(shape, e, uvs, &mut lights)
             }));
         }
         for mesh in &top.meshes {
