@@ -5,7 +5,7 @@
 mod common;
 
 use common::{scene_file, scratch_dir};
-use lumen::scene::desc::{MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc};
+use lumen::scene::desc::{BoundaryDesc, MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc};
 use lumen::scene::file::{export, Format, SceneFile};
 use lumen::scene::{Overrides, SceneDesc};
 use std::process::Command;
@@ -26,6 +26,7 @@ max_depth = 4
 [camera]
 lookfrom = [0, 1, 6]
 lookat = [0, 0, 0]
+shutter = [0.25, 0.75]
 
 [materials.grey]
 type = "diffuse"
@@ -41,7 +42,20 @@ type = "sphere"
 center = [0, 0, 0]
 radius = 1
 material = "gold"
-transform = [{ scale = [1, 2, 1] }, { translate = [-2, 0, 0] }]
+transform = [{ scale = [1, 2, 1] }, { translate = [-2, 0, 0] }, { motion = [0, 0.5, 0] }]
+
+[[objects]]
+type = "medium"
+boundary = { type = "box", min = [-1, -1, -1], max = [1, 1, 1] }
+density = 0.5
+albedo = [0.9, 0.9, 1]
+transform = [{ translate = [0, 0, -3] }]
+
+[[objects]]
+type = "medium"
+boundary = { type = "sphere", center = [1, 0, -1], radius = 0.5 }
+density = 2
+albedo = [0, 0, 0]
 
 [[objects]]
 type = "quad"
@@ -82,14 +96,18 @@ scale = 2
 const ALL_JSON: &str = r#"{
   "caption": "every object kind and transform step",
   "render": { "width": 24, "height": 16, "samples_per_pixel": 2, "max_depth": 4 },
-  "camera": { "lookfrom": [0, 1, 6], "lookat": [0, 0, 0] },
+  "camera": { "lookfrom": [0, 1, 6], "lookat": [0, 0, 0], "shutter": [0.25, 0.75] },
   "materials": {
     "grey": { "type": "diffuse", "albedo": [0.5, 0.5, 0.5] },
     "gold": { "type": "metal", "albedo": [0.8, 0.6, 0.2], "fuzz": 0.1 }
   },
   "objects": [
     { "type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold",
-      "transform": [{ "scale": [1, 2, 1] }, { "translate": [-2, 0, 0] }] },
+      "transform": [{ "scale": [1, 2, 1] }, { "translate": [-2, 0, 0] }, { "motion": [0, 0.5, 0] }] },
+    { "type": "medium", "boundary": { "type": "box", "min": [-1, -1, -1], "max": [1, 1, 1] },
+      "density": 0.5, "albedo": [0.9, 0.9, 1], "transform": [{ "translate": [0, 0, -3] }] },
+    { "type": "medium", "boundary": { "type": "sphere", "center": [1, 0, -1], "radius": 0.5 },
+      "density": 2, "albedo": [0, 0, 0] },
     { "type": "quad", "corner": [-5, -1, -5], "u": [10, 0, 0], "v": [0, 0, 10], "material": "grey" },
     { "type": "box", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5], "material": "grey",
       "transform": [
@@ -117,6 +135,7 @@ fn expected() -> SceneDesc {
     desc.render.max_depth = 4;
     desc.camera.lookfrom = [0.0, 1.0, 6.0];
     desc.camera.lookat = [0.0, 0.0, 0.0];
+    desc.camera.shutter = [0.25, 0.75];
     desc.materials.insert(
         "grey".into(),
         MaterialDesc::Diffuse {
@@ -140,7 +159,26 @@ fn expected() -> SceneDesc {
             transform: vec![
                 TransformDesc::Scale(ScaleDesc::PerAxis([1.0, 2.0, 1.0])),
                 TransformDesc::Translate([-2.0, 0.0, 0.0]),
+                TransformDesc::Motion([0.0, 0.5, 0.0]),
             ],
+        },
+        ObjectDesc::Medium {
+            boundary: BoundaryDesc::Box {
+                min: [-1.0; 3],
+                max: [1.0; 3],
+            },
+            density: 0.5,
+            albedo: [0.9, 0.9, 1.0],
+            transform: vec![TransformDesc::Translate([0.0, 0.0, -3.0])],
+        },
+        ObjectDesc::Medium {
+            boundary: BoundaryDesc::Sphere {
+                center: [1.0, 0.0, -1.0],
+                radius: 0.5,
+            },
+            density: 2.0,
+            albedo: [0.0; 3],
+            transform: vec![],
         },
         ObjectDesc::Quad {
             corner: [-5.0, -1.0, -5.0],
@@ -261,6 +299,11 @@ fn every_step_form_reads_alone() {
                 [0.0, 0.0, 1.0, 3.5],
                 [0.0, 0.0, 0.0, 1.0],
             ]),
+        ),
+        (
+            "{ motion = [0, 0.5, -1] }",
+            r#"{"motion": [0, 0.5, -1]}"#,
+            TransformDesc::Motion([0.0, 0.5, -1.0]),
         ),
     ];
     let mats = "[materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n";
