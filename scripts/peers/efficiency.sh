@@ -111,10 +111,10 @@ if [[ $SCENE == bunny ]]; then
     sed "s|^file = .*|file = \"$MESH\"|" "$HERE/bunny-scene.toml" >"$LUMEN_SCENE"
 elif [[ $SCENE == cornell ]]; then
     LUMEN_SCENE=$OUT/cornell-scene-$CORNELL_WIDTH.toml
-    "$LUMEN" scenes export cornell-box -o "$LUMEN_SCENE.tmp" >/dev/null
+    "$LUMEN" scenes export cornell-box -o "$OUT/cornell-export.toml" >/dev/null
     sed 's/two_sided = true/two_sided = false/; s/integrator = "bsdf"/integrator = "path"/;'" s/^width = .*/width = $CORNELL_WIDTH/" \
-        "$LUMEN_SCENE.tmp" >"$LUMEN_SCENE"
-    rm -f "$LUMEN_SCENE.tmp"
+        "$OUT/cornell-export.toml" >"$LUMEN_SCENE"
+    rm -f "$OUT/cornell-export.toml"
 else
     LUMEN_SCENE=$HERE/spheres-scene.toml
 fi

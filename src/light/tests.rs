@@ -132,6 +132,75 @@ fn a_triangle_is_sampled_uniformly_by_area() {
     assert_close("triangle", e, exact);
 }
 
+/// Points drawn on a triangle light fall equally often into the n² equal
+/// triangles of its regular subdivision, and points on a quad into the
+/// cells of an n × n grid of it (χ², fixed seed): uniform by area.
+#[test]
+fn triangle_and_quad_points_are_uniform_by_area() {
+    use crate::testing::{chi_square, chi_square_bound};
+    let n = 12usize;
+    let (a, b, c) = (
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.5),
+        Vec3::new(-1.0, 0.2, 1.0),
+    );
+    let triangle = Shape::Triangle {
+        vertices: [a, b, c],
+    };
+    let (corner, u, v) = (
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(2.0, 0.0, 0.5),
+        Vec3::new(0.0, 0.3, 1.0),
+    );
+    let quad = Shape::Quad { corner, u, v };
+    for (what, shape) in [("triangle", triangle), ("quad", quad)] {
+        let draws = 200_000u64;
+        let mut counts = vec![0u64; 2 * n * n];
+        let mut rng = Rng::new(41);
+        for _ in 0..draws {
+            let (point, _, _) = sample_area(&shape, rng.next_2d());
+            // The point's coordinates along the two edges, solved from it.
+            let (e1, e2, origin) = match shape {
+                Shape::Triangle { .. } => (b - a, c - a, a),
+                _ => (u, v, corner),
+            };
+            let p = point - origin;
+            let (g11, g12, g22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+            let (r1, r2) = (p.dot(e1), p.dot(e2));
+            let det = g11 * g22 - g12 * g12;
+            let (s, t) = ((r1 * g22 - r2 * g12) / det, (r2 * g11 - r1 * g12) / det);
+            let (fs, ft) = (s * n as f32, t * n as f32);
+            let (i, j) = ((fs as usize).min(n - 1), (ft as usize).min(n - 1));
+            let upper = usize::from(fs - i as f32 + ft - j as f32 >= 1.0);
+            counts[(i * n + j) * 2 + upper] += 1;
+        }
+        // A quad's cell is two halves of equal area; a triangle holds the
+        // n² small triangles with i + j + upper < n.
+        let cells: Vec<bool> = (0..2 * n * n)
+            .map(|k| match shape {
+                Shape::Triangle { .. } => (k / 2) / n + (k / 2) % n + k % 2 < n,
+                _ => true,
+            })
+            .collect();
+        let inside = cells.iter().filter(|&&c| c).count() as f64;
+        let expected: Vec<f64> = cells
+            .iter()
+            .map(|&c| if c { draws as f64 / inside } else { 0.0 })
+            .collect();
+        assert_eq!(
+            counts
+                .iter()
+                .zip(&cells)
+                .filter(|(&k, &c)| k > 0 && !c)
+                .count(),
+            0,
+            "{what}: points outside"
+        );
+        let (chi2, dof) = chi_square(&counts, &expected);
+        assert!(chi2 < chi_square_bound(dof), "{what}: χ² {chi2}, {dof} dof");
+    }
+}
+
 #[test]
 fn lights_are_chosen_in_proportion_to_their_power() {
     let quad = |x: f32, side: f32| Shape::Quad {
