@@ -26,6 +26,9 @@ pub struct Instance {
     /// How far it moves, in the world, from time 0 to time 1 (zero for an
     /// instance that stays put).
     pub motion: Vec3,
+    /// Whether it only moves (its transform is the identity): a moving
+    /// shape's ray needs no transform, only the shift.
+    only_moves: bool,
 }
 
 impl Instance {
@@ -41,6 +44,7 @@ impl Instance {
             transform,
             bvh,
             motion,
+            only_moves: motion != Vec3::ZERO && transform.is_identity(),
         }
     }
 
@@ -74,12 +78,18 @@ impl Instance {
         }
         // Moving the ray back is moving the instance forward.
         let back = Ray::timed(ray.origin - ray.time * self.motion, ray.direction, ray.time);
+        if self.only_moves {
+            return (back, 1.0);
+        }
         self.transform.to_object_ray(&back)
     }
 
     /// Where the instance's point `p` (placed at time 0) is at `time`.
     #[inline]
     pub fn world_point(&self, p: Point3, time: f32) -> Point3 {
+        if self.only_moves {
+            return p + time * self.motion;
+        }
         let placed = self.transform.point(p);
         if self.motion == Vec3::ZERO {
             placed
