@@ -52,10 +52,11 @@ width 1 px (uniform over the pixel, as lumen), no adaptive sampling, no
 denoising, no clamping, view transform Standard (the image read back from a
 32-bit float EXR: linear radiance), light tree on (--light-tree off to turn
 it off) and MIS as Cycles' defaults (light threshold 0.01 at its default:
-an unbiased roulette on shadow rays), Russian roulette --rr on (Cycles'
-default) or off. Sampling pattern --pattern: `startup` keeps the bpy startup
-scene's TABULATED_SOBOL; AUTOMATIC (a new scene's default: blue noise in
-final renders), BLUE_NOISE, or SOBOL_BURLEY (Owen-scrambled Sobol computed
+an unbiased roulette on shadow rays; --light-threshold to change it, 0 = no
+roulette), Russian roulette --rr on (Cycles' default) or off. Sampling
+pattern --pattern: `startup` keeps the bpy startup scene's TABULATED_SOBOL;
+AUTOMATIC (a new scene's default: blue noise in final renders), BLUE_NOISE,
+or SOBOL_BURLEY (Owen-scrambled Sobol computed
 on the fly, one of Cycles' debug-only patterns; the Cycles debug preference
 is turned on in this process to select it).
 
@@ -220,7 +221,8 @@ def set_pattern(scene, pattern):
     scene.cycles.sampling_pattern = pattern
 
 
-def build(lscene, width, spp, seed, threads, rr, pattern, max_depth, light_tree, emission_sampling):
+def build(lscene, width, spp, seed, threads, rr, pattern, max_depth, light_tree, emission_sampling,
+          light_threshold=None):
     r = lscene["render"]
     width = width or r["width"]
     height = max(1, r["height"] * width // r["width"])
@@ -231,6 +233,8 @@ def build(lscene, width, spp, seed, threads, rr, pattern, max_depth, light_tree,
                  bounces=max_depth - 2)
     set_pattern(scene, pattern)
     scene.cycles.use_light_tree = light_tree
+    if light_threshold is not None:
+        scene.cycles.light_sampling_threshold = light_threshold
     cc.world_color(scene, [0.0, 0.0, 0.0], 0.0)
     cam = lscene["camera"]
     cc.camera(scene, cam["lookfrom"], cam["lookat"], cam["vup"], float(cam["vfov"]))
@@ -285,8 +289,10 @@ def main(argv=None):
     ap.add_argument("--emission-sampling", default="FRONT",
                     choices=["AUTO", "FRONT", "BACK", "FRONT_BACK", "NONE"],
                     help="the one-sided lights' emission sampling (default FRONT; Blender's: AUTO)")
+    ap.add_argument("--light-threshold", type=float,
+                    help="Cycles' light sampling threshold (its default 0.01; 0: no roulette on shadow rays)")
     ap.add_argument("--check-depth", action="store_true",
-                    help="compare image means with lumen at max_depth 1, 2, 3 (bounce counting)")
+                    help="compare image means with lumen at max_depth 2, 3, 4 (bounce counting)")
     ap.add_argument("--lumen", default=str(Path(__file__).resolve().parents[2] / "target/release/lumen"),
                     help="lumen binary for --check-depth")
     args = ap.parse_args(cc.argv_after_dashdash() if argv is None else argv)
@@ -302,7 +308,7 @@ def main(argv=None):
     depth = args.max_depth or lscene["render"]["max_depth"]
     scene, width, height = build(lscene, args.width, args.spp, args.seeds[0], args.threads,
                                  args.rr == "on", args.pattern, depth, args.light_tree == "on",
-                                 args.emission_sampling)
+                                 args.emission_sampling, args.light_threshold)
 
     def render(seed):
         scene.cycles.seed = seed
@@ -323,7 +329,8 @@ def main(argv=None):
     result = {"renderer": "cycles", "blender": bpy.app.version_string,
               "scene": Path(args.scene).name, "width": width, "height": height, "spp": args.spp,
               "max_depth": depth, "rr": args.rr, "pattern": args.pattern,
-              "light_tree": args.light_tree, "emission_sampling": args.emission_sampling}
+              "light_tree": args.light_tree, "emission_sampling": args.emission_sampling,
+              "light_threshold": scene.cycles.light_sampling_threshold}
     result.update(peerlib.timed_renders(render, args.seeds, save, warmup=args.timed))
     result["settings"] = cc.settings_summary(scene)
     peerlib.print_json(result)
