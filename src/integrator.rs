@@ -138,8 +138,7 @@ fn step(
             scene,
             record.point,
             ray.time,
-            |wi| material.eval(&record, wo, wi),
-            |wi| material.pdf(&record, wo, wi),
+            |wi| material.eval_and_pdf(&record, wo, wi),
             |wi| record.spawn_origin(wi),
             sampler,
         );
@@ -180,8 +179,7 @@ fn scatter_in_medium(
             scene,
             point,
             ray.time,
-            |_| medium.albedo * ISOTROPIC_PDF,
-            |_| ISOTROPIC_PDF,
+            |_| (medium.albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
             |_| point,
             sampler,
         );
@@ -255,18 +253,17 @@ fn samples_lights(scene: &Scene, depth: u32) -> bool {
 /// against the path's own chance of finding it by scattering; and whether a
 /// shadow ray was traced.
 ///
-/// `eval` gives what the scattering (a surface's or a particle's) sends
-/// towards the path per unit light arriving from a direction (f · |cos θ|
-/// for a surface), `pdf` the density with which it would scatter there
-/// itself (0 where it cannot), `spawn` where a ray leaving along a
+/// `scatter` gives, for a direction, what the scattering (a surface's or a
+/// particle's) sends towards the path per unit light arriving from it
+/// (f · |cos θ| for a surface) and the density with which it would scatter
+/// there itself (0 where it cannot); `spawn` where a ray leaving along a
 /// direction starts (a surface's rounding bound off it).
 #[inline(never)]
 fn direct_light(
     scene: &Scene,
     point: Point3,
     time: f32,
-    eval: impl Fn(Vec3) -> Color,
-    pdf: impl Fn(Vec3) -> f32,
+    scatter: impl Fn(Vec3) -> (Color, f32),
     spawn: impl Fn(Vec3) -> Point3,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
@@ -274,7 +271,7 @@ fn direct_light(
         return (Color::ZERO, false);
     };
     let wi = sample.direction;
-    let scatter_pdf = pdf(wi);
+    let (value, scatter_pdf) = scatter(wi);
     if !(scatter_pdf > 0.0) || sample.radiance == Color::ZERO {
         return (Color::ZERO, false);
     }
@@ -301,7 +298,7 @@ fn direct_light(
         return (Color::ZERO, true);
     }
     let weight = power_heuristic(sample.pdf, scatter_pdf);
-    let mut light = sample.radiance * eval(wi) * (weight / sample.pdf);
+    let mut light = sample.radiance * value * (weight / sample.pdf);
     if !scene.media.is_empty() {
         light *= scene.transmittance(&shadow, end);
     }

@@ -109,7 +109,13 @@ impl Medium {
     /// exponential law past the entry point, if that falls inside.
     #[inline]
     pub fn sample_distance(&self, ray: &Ray, t_max: f32, u: f32) -> Option<f32> {
-        let (start, end) = self.span(ray, t_max)?;
+        self.distance_within(self.span(ray, t_max)?, u)
+    }
+
+    /// [`sample_distance`](Self::sample_distance) for a ray whose
+    /// [`span`](Self::span) is already known.
+    #[inline]
+    pub fn distance_within(&self, (start, end): (f32, f32), u: f32) -> Option<f32> {
         let t = start - (1.0 - u).ln() / self.density;
         (t < end).then_some(t)
     }

@@ -98,9 +98,17 @@ impl Material {
     /// without a density ([`has_density`](Self::has_density)).
     #[inline(always)]
     pub fn eval(&self, hit: &HitRecord, wo: Vec3, wi: Vec3) -> Color {
+        self.eval_and_pdf(hit, wo, wi).0
+    }
+
+    /// [`eval`](Self::eval) and [`pdf`](Self::pdf) together, the density
+    /// worked out once.
+    #[inline(always)]
+    pub fn eval_and_pdf(&self, hit: &HitRecord, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        let pdf = self.pdf(hit, wo, wi);
         match self {
-            Material::Diffuse(d) if d.is_lambertian() => d.albedo * self.pdf(hit, wo, wi),
-            _ => Color::ZERO,
+            Material::Diffuse(d) if d.is_lambertian() => (d.albedo * pdf, pdf),
+            _ => (Color::ZERO, pdf),
         }
     }
 

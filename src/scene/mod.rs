@@ -281,11 +281,11 @@ impl Scene {
         let mut nearest: Option<(f32, usize)> = None;
         for (i, medium) in self.media.iter().enumerate() {
             let limit = nearest.map_or(t_max, |(t, _)| t);
-            if medium.span(ray, limit).is_none() {
+            let Some(span) = medium.span(ray, limit) else {
                 continue;
-            }
+            };
             let u = sampler.get_1d(Dim::Medium);
-            if let Some(t) = medium.sample_distance(ray, limit, u) {
+            if let Some(t) = medium.distance_within(span, u) {
                 nearest = Some((t, i));
             }
         }
