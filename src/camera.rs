@@ -311,7 +311,7 @@ mod tests {
         let focus_point = reference.at(3.0 / -reference.direction.z);
         for _ in 0..100 {
             let r = cam.ray(4, 6, 0.0, 0.0, &mut rng);
-            assert!(r.origin.length() <= radius * 1.0001);
+            assert!(r.origin().length() <= radius * 1.0001);
             let p = r.at(3.0 / -r.direction.z);
             assert!((p - focus_point).length() < 1e-4);
         }

@@ -4,6 +4,7 @@
 
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
+use crate::geometry::HitRecord;
 use crate::material::Material;
 use crate::math::{Color, Interval, Point3, Vec3};
 use crate::medium::{Medium, ISOTROPIC_PDF};
@@ -105,11 +106,9 @@ fn step(
     path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Step {
-    sampler.start_bounce(depth);
     if !scene.media.is_empty() {
-        let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-        if let Some((t, i)) = scene.medium_event(ray, t_max, sampler) {
-            return scatter_in_medium(scene, ray, t, &scene.media[i], depth, path, sampler);
+        if let Some(step) = meet_media(scene, ray, hit, depth, path, sampler) {
+            return step;
         }
     }
     let Some(hit) = hit else {
@@ -120,28 +119,15 @@ fn step(
         return Step::Done(path.radiance + sky);
     };
     let record = scene.record(ray, hit);
-    let material = &scene.material_at(&record);
+    let material = scene.material_at(&record);
     if let Material::Emissive(_) = material {
-        let mut emitted = path.throughput * material.emitted(&record);
-        if let (Some((from, bsdf_pdf)), Some(i)) = (path.sampled_from, scene.light_of(&hit)) {
-            let light_pdf = scene
-                .lights
-                .pdf(i, from, record.point, record.outward_normal());
-            emitted *= power_heuristic(bsdf_pdf, light_pdf);
-        }
-        return Step::Done(path.radiance + emitted);
+        return Step::Done(path.radiance + emission(scene, &record, &hit, material, path));
     }
+    sampler.start_bounce(depth);
     let wo = ray.direction;
     let nee = samples_lights(scene, depth) && material.has_density();
     if nee {
-        let (light, traced) = direct_light(
-            scene,
-            record.point,
-            ray.time,
-            |wi| material.eval_and_pdf(&record, wo, wi),
-            |wi| record.spawn_origin(wi),
-            sampler,
-        );
+        let (light, traced) = light_at_surface(scene, &record, material, wo, ray.time(), sampler);
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
@@ -150,19 +136,90 @@ fn step(
     };
     path.sampled_from = nee.then(|| (record.point, material.pdf(&record, wo, scatter.direction)));
     path.throughput *= scatter.attenuation;
-    let next = Ray::timed(
+    if !goes_on(scene, depth, path, sampler) {
+        return Step::Done(path.radiance);
+    }
+    Step::Continue(Ray::timed(
         record.spawn_origin(scatter.direction),
         scatter.direction,
-        ray.time,
-    );
-    go_on(scene, depth, path, sampler, next)
+        ray.time(),
+    ))
+}
+
+/// The light a path brings back from an emitter it met at `record` (`hit`):
+/// its emission times the path's throughput, weighted against the chance
+/// that the light would have been sampled from where the segment started.
+#[inline(never)]
+fn emission(
+    scene: &Scene,
+    record: &HitRecord,
+    hit: &Hit,
+    material: Material,
+    path: &PathState,
+) -> Color {
+    let emitted = path.throughput * material.emitted(record);
+    match (path.sampled_from, scene.light_of(hit)) {
+        (Some((from, bsdf_pdf)), Some(i)) => {
+            let light_pdf = scene
+                .lights
+                .pdf(i, from, record.point, record.outward_normal());
+            emitted * power_heuristic(bsdf_pdf, light_pdf)
+        }
+        _ => emitted,
+    }
+}
+
+/// [`direct_light`] at a surface point `record` of `material`, seen along
+/// `wo`.
+#[inline(never)]
+fn light_at_surface(
+    scene: &Scene,
+    record: &HitRecord,
+    material: Material,
+    wo: Vec3,
+    time: f32,
+    sampler: &mut impl Sampler,
+) -> (Color, bool) {
+    direct_light(
+        scene,
+        record.point,
+        time,
+        |wi| material.eval_and_pdf(record, wo, wi),
+        |wi| record.spawn_origin(wi),
+        sampler,
+    )
+}
+
+/// Whether `ray` meets a particle of the scene's media before `hit`: if it
+/// does, the path scatters there (see [`scatter_in_medium`]).
+#[inline(never)]
+fn meet_media(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+) -> Option<Step> {
+    sampler.start_bounce(depth);
+    let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+    let (t, i) = scene.medium_event(ray, t_max, sampler)?;
+    Some(scatter_in_medium(
+        scene,
+        ray,
+        t,
+        &scene.media[i],
+        depth,
+        path,
+        sampler,
+    ))
 }
 
 /// A path meets a particle of `medium` at distance `t` along `ray` (the end
 /// of segment `depth`): with the `path` integrator it samples a light from
 /// there, and it goes on in a direction drawn from the isotropic phase
 /// function, its throughput multiplied by the medium's albedo.
-#[inline(never)]
+#[inline(always)]
 fn scatter_in_medium(
     scene: &Scene,
     ray: &Ray,
@@ -178,7 +235,7 @@ fn scatter_in_medium(
         let (light, traced) = direct_light(
             scene,
             point,
-            ray.time,
+            ray.time(),
             |_| (medium.albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
             |_| point,
             sampler,
@@ -189,28 +246,19 @@ fn scatter_in_medium(
     let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
     path.sampled_from = nee.then_some((point, ISOTROPIC_PDF));
     path.throughput *= medium.albedo;
-    go_on(
-        scene,
-        depth,
-        path,
-        sampler,
-        Ray::timed(point, direction, ray.time),
-    )
+    if !goes_on(scene, depth, path, sampler) {
+        return Step::Done(path.radiance);
+    }
+    Step::Continue(Ray::timed(point, direction, ray.time()))
 }
 
-/// The path, its throughput updated by the scattering at the end of segment
-/// `depth`, goes on along `next`, unless nothing is left of it or Russian
+/// Whether the path, its throughput updated by the scattering at the end
+/// of segment `depth`, goes on: not if nothing is left of it, or if Russian
 /// roulette ends it.
 #[inline(always)]
-fn go_on(
-    scene: &Scene,
-    depth: u32,
-    path: &mut PathState,
-    sampler: &mut impl Sampler,
-    next: Ray,
-) -> Step {
+fn goes_on(scene: &Scene, depth: u32, path: &mut PathState, sampler: &mut impl Sampler) -> bool {
     if path.throughput == Color::ZERO {
-        return Step::Done(path.radiance);
+        return false;
     }
     // Russian roulette: a path whose throughput has fallen below 1 goes on
     // with that probability, and is counted 1/p times as much when it does.
@@ -218,12 +266,12 @@ fn go_on(
         let p = path.throughput.max_element().sqrt();
         if p < 1.0 {
             if sampler.get_1d(Dim::Roulette) >= p {
-                return Step::Done(path.radiance);
+                return false;
             }
             path.throughput /= p;
         }
     }
-    Step::Continue(next)
+    true
 }
 
 /// Bounces from which the `path` integrator plays Russian roulette: the

@@ -38,7 +38,7 @@ impl Boundary {
     /// The parameters `(t0, t1)` between which the line `origin + t·direction`
     /// (any direction length) is inside, if it ever is.
     fn span(&self, ray: &Ray) -> Option<(f32, f32)> {
-        let (o, d) = (ray.origin, ray.direction);
+        let (o, d) = (ray.origin(), ray.direction);
         match *self {
             Boundary::Sphere { center, radius } => {
                 let f = o - center;

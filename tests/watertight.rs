@@ -290,7 +290,7 @@ impl Mesh {
     /// δ ≪ ε along ky hits, by an independent `f64` Möller–Trumbore test.
     fn displaced_hits(&self, ray: &Ray, eps: f64, delta: f64) -> Vec<(f64, usize)> {
         let [kx, ky, _] = TriangleRay::axes_of(ray.direction);
-        let mut o = d3(ray.origin);
+        let mut o = d3(ray.origin());
         o[kx] += eps;
         o[ky] += delta;
         let d = d3(ray.direction);
@@ -324,7 +324,7 @@ impl Mesh {
     /// for the integer meshes and dyadic rays.
     fn naive_hits(&self, ray: &Ray) -> Vec<(f64, usize)> {
         let [kx, ky, kz] = TriangleRay::axes_of(ray.direction);
-        let (o, d) = (d3(ray.origin), d3(ray.direction));
+        let (o, d) = (d3(ray.origin()), d3(ray.direction));
         let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         self.triangles
             .iter()
@@ -659,7 +659,7 @@ fn integer_mesh_rays(mesh: &Mesh, seed: u64) -> (Tally, usize) {
             let d = vec_i(dirs[rng.below(dirs.len())]);
             let origin = p - k * d;
             let ray = Ray::new(origin, d);
-            assert_eq!(ray.origin + k * d, p, "the origin is computed exactly");
+            assert_eq!(ray.origin() + k * d, p, "the origin is computed exactly");
             let what = || format!("ray from {origin} along {d} at {what} {p}");
             check_aimed(
                 mesh,

@@ -560,7 +560,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             "ray direction {} is not unit length",
             ray.direction
         );
-        let (o, inv) = (ray.origin, ray.direction.recip());
+        let (o, inv) = (ray.origin(), ray.direction.recip());
         let (axes, triangle) = if !SPHERES && bvh.has_triangles() {
             let axes = TriangleRay::axes_of(ray.direction);
             (axes, TriangleRay::new(ray, axes, interval.min))

@@ -95,7 +95,7 @@ impl RayBundle {
             debug_assert!((ray.direction.length_squared() - 1.0).abs() < 1e-4);
             let inverse = ray.direction.recip();
             for axis in 0..3 {
-                b.origin[axis][lane] = ray.origin[axis];
+                b.origin[axis][lane] = ray.origin()[axis];
                 b.direction[axis][lane] = ray.direction[axis];
                 b.inverse[axis][lane] = inverse[axis];
             }
@@ -242,7 +242,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
                 usize::from(ref_inv.y < 0.0),
                 usize::from(ref_inv.z < 0.0),
             ],
-            ref_origin: reference.origin.to_array().map(Vec4::splat),
+            ref_origin: reference.origin().to_array().map(Vec4::splat),
             ref_inv: ref_inv.to_array().map(Vec4::splat),
             triangle,
             is_axis,

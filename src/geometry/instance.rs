@@ -77,7 +77,11 @@ impl Instance {
             return self.transform.to_object_ray(ray);
         }
         // Moving the ray back is moving the instance forward.
-        let back = Ray::timed(ray.origin - ray.time * self.motion, ray.direction, ray.time);
+        let back = Ray::timed(
+            ray.origin() - ray.time() * self.motion,
+            ray.direction,
+            ray.time(),
+        );
         if self.only_moves {
             return (back, 1.0);
         }

@@ -278,7 +278,11 @@ impl Transform {
     /// direction by [`vector`](Self::vector), not normalised.
     #[inline]
     pub fn ray(&self, ray: &Ray) -> Ray {
-        Ray::timed(self.point(ray.origin), self.vector(ray.direction), ray.time)
+        Ray::timed(
+            self.point(ray.origin()),
+            self.vector(ray.direction),
+            ray.time(),
+        )
     }
 
     /// The world ray `ray` in object space, with a unit-length direction, and
@@ -295,10 +299,10 @@ impl Transform {
     /// `ray.direction` must be non-zero.
     #[inline]
     pub fn to_object_ray(&self, ray: &Ray) -> (Ray, f32) {
-        let origin = self.to_object.transform_point3a(ray.origin);
+        let origin = self.to_object.transform_point3a(ray.origin());
         let direction = self.to_object.transform_vector3a(ray.direction);
         let scale = direction.length();
-        (Ray::timed(origin, direction / scale, ray.time), scale)
+        (Ray::timed(origin, direction / scale, ray.time()), scale)
     }
 
     /// A world box containing the transformed `bounds`: it contains
@@ -801,7 +805,7 @@ mod tests {
 
     /// The nearest hit of the ellipsoid Σ((x − c)ᵢ/sᵢ)² = 1, in `f64`.
     fn ellipsoid_hit(ray: &Ray, c: DVec3, s: DVec3) -> Option<f64> {
-        let o = (ray.origin.as_dvec3() - c) / s;
+        let o = (ray.origin().as_dvec3() - c) / s;
         let d = ray.direction.as_dvec3() / s;
         let (a, half_b, k) = (d.dot(d), o.dot(d), o.dot(o) - 1.0);
         let disc = half_b * half_b - a * k;

@@ -93,7 +93,7 @@ impl TriangleRay<f32> {
     pub fn new(ray: &Ray, axes: [usize; 3], t_min: f32) -> Self {
         let d = axes.map(|k| ray.direction[k]);
         TriangleRay {
-            origin: axes.map(|k| ray.origin[k]),
+            origin: axes.map(|k| ray.origin()[k]),
             shear: [d[0] / d[2], d[1] / d[2], 1.0 / d[2]],
             t_min,
         }

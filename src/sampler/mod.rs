@@ -88,7 +88,8 @@ pub trait Sampler {
         below(self.get_1d(dim), n)
     }
     /// Marks the start of bounce `bounce` (0 at the first surface a camera
-    /// ray meets): the dimensions drawn next are that bounce's.
+    /// ray meets): the dimensions drawn next are that bounce's. Marking the
+    /// same bounce again changes nothing.
     fn start_bounce(&mut self, bounce: u32);
 }
 
@@ -265,9 +266,13 @@ impl Sampler for PixelSample {
 
     #[inline(always)]
     fn start_bounce(&mut self, bounce: u32) {
-        self.bounce = bounce + 1;
-        self.used = 0;
-        self.again = 0;
+        // Started again for the same bounce (a path that passed through a
+        // medium before meeting a surface), it keeps the slots drawn.
+        if self.bounce != bounce + 1 {
+            self.bounce = bounce + 1;
+            self.used = 0;
+            self.again = 0;
+        }
     }
 }
 

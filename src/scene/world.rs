@@ -431,7 +431,7 @@ impl World {
             group
                 .shapes
                 .record(&object_ray, hit.t * scale, shape, hit.sub, self.error_scale);
-        let point = instance.world_point(inner.point, ray.time);
+        let point = instance.world_point(inner.point, ray.time());
         let (normal, front_face) = face_normal(ray, transform.normal(inner.outward_normal()));
         let shading_normal = if inner.is_smooth() {
             facing(transform.normal(inner.shading_normal), normal)
