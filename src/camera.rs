@@ -73,6 +73,26 @@ pub enum CameraError {
     /// The set-up's numbers are too large for `f32` arithmetic.
     #[error("lookfrom, lookat and focus_dist are too large for f32 arithmetic (keep them below about 1e18)")]
     Overflow,
+    /// Neighbouring pixels' rays are closer than `f32` can tell apart at
+    /// the camera's coordinates: the rays would coincide (or vanish, and
+    /// every sample be NaN).
+    #[error(
+        "focus_dist {focus_dist:e} with vfov {vfov} puts neighbouring pixels {step:e} apart at \
+         coordinates up to {scale:e}, closer than f32 can tell apart: make focus_dist at least \
+         {needed:e} (left out, it is the distance to lookat)"
+    )]
+    Unresolved {
+        /// The focus distance given.
+        focus_dist: f32,
+        /// The field of view given.
+        vfov: f32,
+        /// The distance between neighbouring pixels in the focus plane.
+        step: f32,
+        /// The largest coordinate of the camera and its focus plane.
+        scale: f32,
+        /// The smallest focus distance that resolves the pixels.
+        needed: f32,
+    },
     /// A value is NaN or infinite.
     #[error("camera {0} is not a finite number")]
     NotFinite(&'static str),
@@ -162,6 +182,48 @@ impl Camera {
         if !(derived.iter().all(|d| d.is_finite()) && defocus_radius.is_finite()) {
             return Err(CameraError::Overflow);
         }
+        // A pixel's ray aims at its point of the focus plane, whose
+        // coordinates are rounded to within ε/2 of the largest (`scale`):
+        // for neighbouring pixels to get rays of their own, the points must
+        // be further apart than that. Two units of ε·scale leave a margin
+        // for the rounding of the sums that place them. Coordinates count as
+        // at least 1e-12 in size: the squares taken to normalise a ray's
+        // direction must stay within f32's normal range (tiny directions
+        // normalise to NaN).
+        let corners = [
+            s.lookfrom,
+            upper_left,
+            upper_left + viewport_u,
+            upper_left + viewport_v,
+            upper_left + viewport_u + viewport_v,
+        ];
+        let scale = corners
+            .iter()
+            .map(|c| c.abs().max_element())
+            .fold(1e-12, f32::max);
+        // Largest components, not lengths: their squares could underflow.
+        let step = pixel_du
+            .abs()
+            .max_element()
+            .min(pixel_dv.abs().max_element());
+        let resolution = 2.0 * f32::EPSILON * scale;
+        if !(step > resolution) {
+            return Err(CameraError::Unresolved {
+                focus_dist: s.focus_dist,
+                vfov: s.vfov,
+                step,
+                scale,
+                // The step grows with the focus distance; where it has
+                // vanished, pixels are 2h / height apart per unit of focus
+                // distance, the largest component at least 1/√3 of that.
+                needed: 1.01
+                    * if step > 1e-30 {
+                        s.focus_dist * (resolution / step)
+                    } else {
+                        resolution * 3f32.sqrt() / (2.0 * h / height as f32)
+                    },
+            });
+        }
         Ok(Camera {
             center: s.lookfrom,
             pixel00,
@@ -224,6 +286,53 @@ mod tests {
             focus_dist: 1.0,
             shutter: [0.0, 0.0],
         }
+    }
+
+    /// A focus plane so close that the pixels' points round together is
+    /// refused (it made every ray NaN and the image black), and the focus
+    /// distance the message asks for works.
+    #[test]
+    fn focus_planes_closer_than_f32_resolves_are_refused() {
+        let mut s = settings();
+        s.lookfrom = Vec3::new(3.0, 2.0, 1.0);
+        s.lookat = Vec3::ZERO;
+        for focus_dist in [1e-30, 1e-9, 1e-6] {
+            s.focus_dist = focus_dist;
+            let Err(CameraError::Unresolved { needed, .. }) = Camera::new(&s, 400, 300) else {
+                panic!("focus_dist {focus_dist} accepted");
+            };
+            assert!(needed > focus_dist && needed < 1e-3, "{needed}");
+            s.focus_dist = needed;
+            let camera = Camera::new(&s, 400, 300).expect("the distance asked for works");
+            let mut rng = crate::rng::Rng::new(1);
+            for (x, y) in [(0, 0), (200, 150), (399, 299)] {
+                let ray = camera.ray(x, y, 0.3, -0.2, &mut rng);
+                assert!(ray.direction.is_finite(), "{focus_dist}: {ray:?}");
+                let next = camera.ray(x + 1, y, 0.3, -0.2, &mut rng);
+                assert_ne!(ray.direction, next.direction, "pixels told apart");
+            }
+        }
+        // At the origin, a tiny focus plane makes directions too short to
+        // normalise.
+        s.lookfrom = Vec3::ZERO;
+        s.lookat = Vec3::new(0.0, 0.0, -1.0);
+        s.focus_dist = 1e-30;
+        let Err(CameraError::Unresolved { needed, .. }) = Camera::new(&s, 400, 300) else {
+            panic!("a focus plane at 1e-30 accepted");
+        };
+        s.focus_dist = needed;
+        let camera = Camera::new(&s, 400, 300).expect("the distance asked for works");
+        let ray = camera.ray(0, 0, 0.3, -0.2, &mut crate::rng::Rng::new(1));
+        assert!(ray.direction.is_finite() && ray.direction.length() > 0.99);
+        // Far from the origin the bound grows with the coordinates.
+        s.lookfrom = Vec3::new(1e6, 0.0, 0.0);
+        s.focus_dist = 1.0;
+        assert!(matches!(
+            Camera::new(&s, 4000, 3000),
+            Err(CameraError::Unresolved { .. })
+        ));
+        s.focus_dist = 1e3;
+        assert!(Camera::new(&s, 4000, 3000).is_ok());
     }
 
     #[test]

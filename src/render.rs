@@ -11,6 +11,10 @@ use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Duration;
 
+/// The share of dropped samples above which a render warns: a few in a
+/// million are the rounding of extreme paths, more are a fault of the scene.
+pub const DROPPED_WARNING: f64 = 1e-4;
+
 /// Counts gathered while rendering.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderStats {
@@ -28,6 +32,31 @@ impl RenderStats {
         self.samples += other.samples;
         self.rays += other.rays;
         self.dropped += other.dropped;
+    }
+
+    /// A warning when more than [`DROPPED_WARNING`] of the samples were
+    /// dropped (NaN or infinite), with their count and the likely causes.
+    pub fn dropped_warning(&self) -> Option<String> {
+        if self.dropped == 0 || (self.dropped as f64) <= DROPPED_WARNING * self.samples as f64 {
+            return None;
+        }
+        let share = 100.0 * self.dropped as f64 / self.samples.max(1) as f64;
+        let what = if self.all_dropped() {
+            "every sample".to_string()
+        } else {
+            format!("{} of {} samples ({share:.2}%)", self.dropped, self.samples)
+        };
+        Some(format!(
+            "{what} came out NaN or infinite and left out of the image: likely a degenerate \
+             camera (focus_dist or vfov tiny against the coordinates), geometry at the limits \
+             of f32, or extreme radiance"
+        ))
+    }
+
+    /// Whether samples were taken and every one of them was dropped (the
+    /// image holds nothing).
+    pub fn all_dropped(&self) -> bool {
+        self.samples > 0 && self.dropped == self.samples
     }
 
     /// Rays per second over `elapsed`.
@@ -288,6 +317,27 @@ mod tests {
                 "row {y}: baseline and {isa:?} differ"
             );
         }
+    }
+
+    #[test]
+    fn dropping_more_than_a_few_samples_in_ten_thousand_warns() {
+        let stats = |samples, dropped| RenderStats {
+            samples,
+            rays: samples,
+            dropped,
+        };
+        assert_eq!(stats(100_000, 0).dropped_warning(), None);
+        assert_eq!(stats(100_000, 10).dropped_warning(), None);
+        let some = stats(100_000, 11).dropped_warning().expect("warns");
+        assert!(some.contains("11 of 100000 samples (0.01%)"), "{some}");
+        assert!(!stats(100_000, 11).all_dropped());
+        let all = stats(500, 500);
+        assert!(all.all_dropped());
+        assert!(all
+            .dropped_warning()
+            .expect("warns")
+            .starts_with("every sample"));
+        assert!(!stats(0, 0).all_dropped());
     }
 
     #[test]

@@ -73,7 +73,9 @@ impl SceneError {
                 CameraError::FieldOfView(_) => "camera.vfov".into(),
                 CameraError::NoViewDirection(_) => "camera.lookat".into(),
                 CameraError::UpParallelToView(_) => "camera.vup".into(),
-                CameraError::FocusDistance(_) => "camera.focus_dist".into(),
+                CameraError::FocusDistance(_) | CameraError::Unresolved { .. } => {
+                    "camera.focus_dist".into()
+                }
                 CameraError::DefocusAngle(_) => "camera.defocus_angle".into(),
                 CameraError::EmptyImage(..) => "render".into(),
                 CameraError::Overflow => "camera".into(),

@@ -7,6 +7,7 @@ use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::{Integrator, LightSelection, Overrides, Sampling};
+use std::ffi::{OsStr, OsString};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -30,7 +31,7 @@ enum Command {
         /// Name of a built-in scene (see `lumen scenes`) or a scene file
         /// (.toml or .json, see docs/scene-format.md). Command-line settings
         /// override the scene's own.
-        scene: String,
+        scene: OsString,
         /// Output image; the extension chooses the format.
         #[arg(short, long)]
         output: PathBuf,
@@ -104,7 +105,7 @@ enum ScenesCommand {
     /// Write a built-in scene (or convert a scene file) as a scene file.
     Export {
         /// Name of a built-in scene, or a scene file to convert.
-        name: String,
+        name: OsString,
         /// Output file (default: standard output); .toml or .json chooses the format.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -302,7 +303,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             settings,
             progressive,
         } => with_threads(settings.threads, || {
-            render_command(&scene, &output, &settings, &progressive)
+            render_command(scene_name(&scene)?, &output, &settings, &progressive)
         }),
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
@@ -319,7 +320,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     format,
                 }),
         } => {
-            export_command(&name, output.as_deref(), format)?;
+            export_command(scene_name(&name)?, output.as_deref(), format)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Gallery { dir, settings } => {
@@ -382,6 +383,17 @@ where
             .context("cannot start worker threads")?
             .install(f),
     }
+}
+
+/// A scene argument as text: built-in names and the scene files' own
+/// references to meshes and images are UTF-8, so a scene path must be too.
+fn scene_name(arg: &OsStr) -> Result<&str> {
+    arg.to_str().ok_or_else(|| {
+        anyhow::anyhow!(
+            "scene path {} is not valid UTF-8: rename the file (or its folder) to a UTF-8 name",
+            arg.to_string_lossy()
+        )
+    })
 }
 
 /// One line of counts: rates of this run (`run`) over `elapsed`, totals of

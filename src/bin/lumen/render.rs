@@ -208,5 +208,12 @@ pub(crate) fn render_command(
         }
     };
     eprintln!("{}", summary(&run.stats, &session.stats(), elapsed));
+    let all = session.stats();
+    if let Some(warning) = all.dropped_warning() {
+        eprintln!("lumen: warning: {warning}");
+    }
+    if all.all_dropped() {
+        return Ok(ExitCode::FAILURE);
+    }
     Ok(code)
 }
