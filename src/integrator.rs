@@ -358,7 +358,7 @@ fn direct_light(
 /// the background (which lights it), meets a light (an emissive surface,
 /// which ends it), is absorbed, or reaches `max_depth` segments (it never
 /// found light in time). With the `path` integrator each diffuse bounce
-/// also looks for light directly (see [`step`]).
+/// also looks for light directly (next-event estimation, in the private `step`).
 #[inline(always)]
 pub fn trace_path(
     scene: &Scene,

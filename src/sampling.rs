@@ -78,7 +78,7 @@ pub(crate) fn sin_cos_turns(u: f32) -> (f32, f32) {
 ///
 /// The distribution is the same; what changes is which `u` gives which
 /// direction. For a Lambertian bounce `axis + v`, the cosine of the bounce
-/// then depends on `u[0]` alone (cos²θ = 1 − u[0]) and its azimuth on `u[1]`
+/// then depends on `u[0]` alone (cos²θ = 1 − `u[0]`) and its azimuth on `u[1]`
 /// alone, so the compact cells of a low-discrepancy sampler stay compact on
 /// the hemisphere, wherever the surface faces: 6% less variance per sample on
 /// the sphere field and on the bunny with the Sobol sampler.
