@@ -7,7 +7,7 @@
 //! checkpoint only if its own description is the same, so that the image is
 //! bit-identical to one rendered without a stop.
 //!
-//! # File format (version 2)
+//! # File format (version 3)
 //!
 //! All integers little-endian.
 //!
@@ -22,13 +22,13 @@
 //! The payload: the renderer identity and the description (each as a u32 length
 //! and UTF-8 bytes), samples per pixel done (u32), width and height (u32),
 //! samples, rays and dropped samples (u64 each), then every pixel's three
-//! `f64` sums and every pixel's `u32` count (pixels row-major, top row
+//! sums (`i128`, 64.64 fixed point: [`Sum`]) and every pixel's `u32` count (pixels row-major, top row
 //! first), and last a byte saying whether the render samples adaptively (1)
 //! or not (0), followed, if it does, by the same sums and counts for the
 //! samples of odd index and a byte a pixel: 1 while the pixel is still being
 //! sampled, 0 once it stopped.
 
-use crate::film::Film;
+use crate::film::{Film, Sum};
 use crate::output::{self, OutputError};
 use crate::render::RenderStats;
 use crate::scene::{MeshSource, SceneDesc};
@@ -39,7 +39,7 @@ use thiserror::Error;
 /// First bytes of every checkpoint file.
 pub const MAGIC: &[u8; 8] = b"LUMENCKP";
 /// The format version this lumen writes and reads.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// Identifies the code that computes samples: the crate version and a
 /// revision of the sample computation. Any change that alters the value of a
 /// sample (random stream, sampling, intersection arithmetic, materials) must
@@ -318,20 +318,20 @@ impl Checkpoint {
         };
         let n = width as usize * height as usize;
         let rest = r.0.len() as u64;
-        let adaptive = if rest == n as u64 * 28 + 1 {
+        let adaptive = if rest == n as u64 * PIXEL_LEN as u64 + 1 {
             false
-        } else if rest == n as u64 * 57 + 1 {
+        } else if rest == n as u64 * (2 * PIXEL_LEN as u64 + 1) + 1 {
             true
         } else {
             return Err("pixel data does not match the image size");
         };
-        let (whole, rest) = r.0.split_at(n * 28);
+        let (whole, rest) = r.0.split_at(n * PIXEL_LEN);
         let (sums, counts) = sums_and_counts(whole, n);
         let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
         let (film, active) = match (adaptive, rest) {
             (false, [0]) => (film, None),
             (true, [1, rest @ ..]) => {
-                let (odd, flags) = rest.split_at(n * 28);
+                let (odd, flags) = rest.split_at(n * PIXEL_LEN);
                 let (odd_sums, odd_counts) = sums_and_counts(odd, n);
                 let film = film
                     .with_odd(odd_sums, odd_counts)
@@ -480,16 +480,19 @@ fn describe_differences(theirs: &str, ours: &str) -> String {
     out.join(", ")
 }
 
-/// Feeds every pixel's three `f64` sums and then every pixel's `u32` count
-/// to `sink`, a few thousand pixels at a time.
+/// Bytes a pixel takes: three `i128` sums and a `u32` count.
+const PIXEL_LEN: usize = 3 * 16 + 4;
+
+/// Feeds every pixel's three sums and then every pixel's `u32` count to
+/// `sink`, a few thousand pixels at a time.
 fn write_sums_and_counts(
-    (sums, counts): (&[[f64; 3]], &[u32]),
+    (sums, counts): (&[Sum], &[u32]),
     sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let mut buf = Vec::with_capacity(4096 * 24);
+    let mut buf = Vec::with_capacity(4096 * 48);
     for chunk in sums.chunks(4096) {
         buf.clear();
-        for v in chunk.iter().flatten() {
+        for v in chunk.iter().flat_map(|s| s.0) {
             buf.extend_from_slice(&v.to_le_bytes());
         }
         sink(&buf)?;
@@ -504,15 +507,15 @@ fn write_sums_and_counts(
     Ok(())
 }
 
-/// The `n` pixels' three `f64` sums and then their `u32` counts, decoded
-/// from `bytes` (28 bytes a pixel).
-fn sums_and_counts(bytes: &[u8], n: usize) -> (Vec<[f64; 3]>, Vec<u32>) {
-    let (sum_bytes, count_bytes) = bytes.split_at(n * 24);
+/// The `n` pixels' three sums and then their `u32` counts, decoded from
+/// `bytes` ([`PIXEL_LEN`] bytes a pixel).
+fn sums_and_counts(bytes: &[u8], n: usize) -> (Vec<Sum>, Vec<u32>) {
+    let (sum_bytes, count_bytes) = bytes.split_at(n * 48);
     let sums = sum_bytes
-        .chunks_exact(24)
+        .chunks_exact(48)
         .map(|p| {
-            let f = |i: usize| f64::from_le_bytes(p[i..i + 8].try_into().expect("8 bytes"));
-            [f(0), f(8), f(16)]
+            let f = |i: usize| i128::from_le_bytes(p[i..i + 16].try_into().expect("16 bytes"));
+            Sum([f(0), f(16), f(32)])
         })
         .collect();
     let counts = count_bytes
@@ -560,7 +563,9 @@ mod tests {
         let h = 4;
         desc.render.height = Some(h);
         let n = 8 * h as usize;
-        let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, f64::MAX]).collect();
+        let sums = (0..n as i128)
+            .map(|i| Sum([i * 7, -15, i128::MAX - i]))
+            .collect();
         let counts = (0..n as u32).collect();
         let ckpt = Checkpoint {
             renderer_id: RENDERER_ID.into(),
@@ -592,7 +597,7 @@ mod tests {
                 .film
                 .clone()
                 .with_odd(
-                    vec![[0.25, 1.0, -2.0]; n],
+                    vec![Sum([1, 2, -3]); n],
                     (0..n as u32).map(|c| c / 2).collect(),
                 )
                 .unwrap(),

@@ -3,58 +3,101 @@
 
 use crate::math::Color;
 
+/// The sum of some samples of a pixel, a number per channel, in 64.64 fixed
+/// point: integers counting 2⁻⁶⁴.
+///
+/// Integer addition is associative, so a pixel's sum is the same to the bit
+/// whatever order its samples are added in: by pass, by thread, or by
+/// machine, each summing a share of the samples and the shares then added
+/// (see `docs/distributed.md`). Each sample is exact down to 2⁻⁶⁴ ≈ 5.4e-20
+/// (every `f32` from about 4.5e-13 up is kept whole; smaller values are cut
+/// to a multiple of 2⁻⁶⁴), and a pixel's sum holds up to 2⁶³ ≈ 9.2e18: a
+/// sample of 2⁶³ or more is dropped, like a NaN, and sums wrap (still
+/// associatively) only past that bound.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Sum(pub [i128; 3]);
+
+/// 2⁶⁴: one in 64.64 fixed point.
+const ONE: f64 = 18_446_744_073_709_551_616.0;
+
+impl Sum {
+    /// Zero.
+    pub const ZERO: Sum = Sum([0; 3]);
+
+    /// The fixed-point value of a colour: `None` if a channel is NaN, infinite
+    /// or of magnitude 2⁶³ or more (such a sample is dropped).
+    #[inline]
+    pub fn of(c: [f64; 3]) -> Option<Self> {
+        let fixed = |v: f64| (v.abs() < ONE / 2.0).then_some((v * ONE) as i128);
+        Some(Sum([fixed(c[0])?, fixed(c[1])?, fixed(c[2])?]))
+    }
+
+    /// This sum plus `other`, channel by channel.
+    #[inline]
+    pub fn plus(self, other: Sum) -> Sum {
+        Sum([0, 1, 2].map(|c| self.0[c].wrapping_add(other.0[c])))
+    }
+
+    /// This sum minus `other`, channel by channel.
+    #[inline]
+    pub fn minus(self, other: Sum) -> Sum {
+        Sum([0, 1, 2].map(|c| self.0[c].wrapping_sub(other.0[c])))
+    }
+
+    /// The sum as floating-point numbers (rounded to `f64`).
+    #[inline]
+    pub fn to_f64(self) -> [f64; 3] {
+        self.0.map(|v| v as f64 / ONE)
+    }
+}
+
 /// Linear accumulation of samples for every pixel.
 ///
-/// Sums are kept in `f64` so that adding hundreds of samples loses nothing,
-/// and always in sample order, so an image is the same however the samples
-/// were split into passes.
+/// Sums are kept in fixed point ([`Sum`]), so an image is the same to the
+/// bit however its samples were split: into passes, between threads, or
+/// between machines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
     height: u32,
     /// Sum of the finite samples of each pixel, row-major, top row first.
-    sums: Vec<[f64; 3]>,
+    sums: Vec<Sum>,
     /// Number of finite samples in each pixel.
     counts: Vec<u32>,
     /// The same for the samples of odd index only, in a film that keeps
     /// them ([`Film::with_halves`]; empty otherwise): with the whole, two
     /// independent half estimates of each pixel, whose difference measures
     /// its noise (see [`crate::adaptive`]).
-    odd_sums: Vec<[f64; 3]>,
+    odd_sums: Vec<Sum>,
     odd_counts: Vec<u32>,
 }
 
 /// One row of a film, to add samples to (see [`Film::rows_mut`]).
 pub struct RowMut<'a> {
     /// Sums of the finite samples of each pixel.
-    pub sums: &'a mut [[f64; 3]],
+    pub sums: &'a mut [Sum],
     /// Numbers of finite samples.
     pub counts: &'a mut [u32],
     /// Sums of the finite samples of odd index (empty in a film that does
     /// not keep them).
-    pub odd_sums: &'a mut [[f64; 3]],
+    pub odd_sums: &'a mut [Sum],
     /// Numbers of finite samples of odd index (empty likewise).
     pub odd_counts: &'a mut [u32],
 }
 
 impl RowMut<'_> {
-    /// Adds sample `index` of pixel `x`, of colour `c`, unless it is NaN or
-    /// infinite: such a sample is left out and `false` is returned so the
-    /// caller can count it.
+    /// Adds sample `index` of pixel `x`, of colour `c`, unless it is NaN,
+    /// infinite or beyond what a [`Sum`] holds: such a sample is left out and
+    /// `false` is returned so the caller can count it.
     #[inline]
     pub fn add(&mut self, x: usize, index: u32, c: Color) -> bool {
-        if !c.is_finite() {
+        let Some(c) = Sum::of([f64::from(c.x), f64::from(c.y), f64::from(c.z)]) else {
             return false;
-        }
-        let c = [f64::from(c.x), f64::from(c.y), f64::from(c.z)];
-        for (s, v) in self.sums[x].iter_mut().zip(c) {
-            *s += v;
-        }
+        };
+        self.sums[x] = self.sums[x].plus(c);
         self.counts[x] += 1;
         if index % 2 == 1 && !self.odd_counts.is_empty() {
-            for (s, v) in self.odd_sums[x].iter_mut().zip(c) {
-                *s += v;
-            }
+            self.odd_sums[x] = self.odd_sums[x].plus(c);
             self.odd_counts[x] += 1;
         }
         true
@@ -68,7 +111,7 @@ impl Film {
         Self {
             width,
             height,
-            sums: vec![[0.0; 3]; n],
+            sums: vec![Sum::ZERO; n],
             counts: vec![0; n],
             odd_sums: Vec::new(),
             odd_counts: Vec::new(),
@@ -80,7 +123,7 @@ impl Film {
     pub fn with_halves(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
         Self {
-            odd_sums: vec![[0.0; 3]; n],
+            odd_sums: vec![Sum::ZERO; n],
             odd_counts: vec![0; n],
             ..Self::new(width, height)
         }
@@ -143,24 +186,19 @@ impl Film {
     }
 
     /// The raw per-pixel sums and counts (for checkpoints).
-    pub fn raw(&self) -> (&[[f64; 3]], &[u32]) {
+    pub fn raw(&self) -> (&[Sum], &[u32]) {
         (&self.sums, &self.counts)
     }
 
     /// The raw per-pixel sums and counts of the samples of odd index (empty
     /// in a film without halves).
-    pub fn raw_odd(&self) -> (&[[f64; 3]], &[u32]) {
+    pub fn raw_odd(&self) -> (&[Sum], &[u32]) {
         (&self.odd_sums, &self.odd_counts)
     }
 
     /// Rebuilds a film from raw sums and counts, with no record of which
     /// samples had odd indices; `None` if the sizes disagree.
-    pub fn from_raw(
-        width: u32,
-        height: u32,
-        sums: Vec<[f64; 3]>,
-        counts: Vec<u32>,
-    ) -> Option<Self> {
+    pub fn from_raw(width: u32, height: u32, sums: Vec<Sum>, counts: Vec<u32>) -> Option<Self> {
         let n = width as usize * height as usize;
         (sums.len() == n && counts.len() == n).then_some(Self {
             width,
@@ -175,7 +213,7 @@ impl Film {
     /// This film with the sums and counts of its samples of odd index;
     /// `None` if their sizes disagree with the film's or an odd count
     /// exceeds its pixel's count.
-    pub fn with_odd(self, odd_sums: Vec<[f64; 3]>, odd_counts: Vec<u32>) -> Option<Self> {
+    pub fn with_odd(self, odd_sums: Vec<Sum>, odd_counts: Vec<u32>) -> Option<Self> {
         let n = self.sums.len();
         let fits = odd_sums.len() == n
             && odd_counts.len() == n
@@ -195,8 +233,8 @@ impl Film {
         if odd == 0 || odd == n {
             return None;
         }
-        let even_sum = [0, 1, 2].map(|c| self.sums[i][c] - self.odd_sums[i][c]);
-        Some((mean(&even_sum, n - odd), mean(&self.odd_sums[i], odd)))
+        let even_sum = self.sums[i].minus(self.odd_sums[i]);
+        Some((mean(even_sum, n - odd), mean(self.odd_sums[i], odd)))
     }
 
     /// Number of pixels.
@@ -211,13 +249,13 @@ impl Film {
 
     /// The mean linear colour of pixel `i` (row-major); black if it has no samples.
     pub fn mean(&self, i: usize) -> Color {
-        mean(&self.sums[i], self.counts[i])
+        mean(self.sums[i], self.counts[i])
     }
 
     /// The mean linear colour of pixel `(x, y)`; black if it has no samples.
     pub fn pixel(&self, x: u32, y: u32) -> Color {
         let i = y as usize * self.width as usize + x as usize;
-        mean(&self.sums[i], self.counts[i])
+        mean(self.sums[i], self.counts[i])
     }
 
     /// All pixels' mean linear colours, row-major, top row first.
@@ -239,22 +277,22 @@ impl Film {
 
     /// The mean linear colour of every pixel, row-major, top row first.
     pub fn pixels(&self) -> impl Iterator<Item = Color> + '_ {
-        self.sums.iter().zip(&self.counts).map(|(s, &n)| mean(s, n))
+        self.sums
+            .iter()
+            .zip(&self.counts)
+            .map(|(&s, &n)| mean(s, n))
     }
 }
 
 /// The mean of `n` samples summing to `sum`; black if there are none.
 #[inline]
-fn mean(sum: &[f64; 3], n: u32) -> Color {
+fn mean(sum: Sum, n: u32) -> Color {
     if n == 0 {
         return Color::ZERO;
     }
     let n = f64::from(n);
-    Color::new(
-        (sum[0] / n) as f32,
-        (sum[1] / n) as f32,
-        (sum[2] / n) as f32,
-    )
+    let [r, g, b] = sum.to_f64().map(|v| (v / n) as f32);
+    Color::new(r, g, b)
 }
 
 /// Applies the display gamma (v^(1/γ)) and tone-maps by clamping to [0, 1].

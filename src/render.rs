@@ -274,6 +274,7 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderSt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film::Sum;
     use crate::scene::{builtin, Sampling};
 
     #[test]
@@ -305,7 +306,7 @@ mod tests {
             let bits = |f: &Film| {
                 let (sums, counts) = f.raw();
                 let (odd, odd_counts) = f.raw_odd();
-                let bits = sums.iter().chain(odd).flatten().map(|x| x.to_bits());
+                let bits = sums.iter().chain(odd).flat_map(|s| s.0);
                 (
                     bits.collect::<Vec<_>>(),
                     counts.to_vec(),
@@ -350,14 +351,17 @@ mod tests {
                 Color::new(f32::NAN, 0.0, 0.0),
                 Color::new(0.0, f32::INFINITY, 0.0),
                 Color::new(0.0, 0.0, f32::NEG_INFINITY),
+                // Beyond what a fixed-point sum holds (2⁶³).
+                Color::new(0.0, 1e19, 0.0),
             ] {
                 assert!(!row.add(0, 1, bad));
             }
             assert!(row.add(0, 3, Color::new(0.25, 0.5, 2.0)));
             assert!(row.add(0, 4, Color::new(1.0, 1.0, 1.0)));
         }
-        assert_eq!(film.raw(), (&[[1.5, 2.0, 5.0]][..], &[3][..]));
+        let sum = |c| Sum::of(c).unwrap();
+        assert_eq!(film.raw(), (&[sum([1.5, 2.0, 5.0])][..], &[3][..]));
         // Only sample 3 has an odd index among those added.
-        assert_eq!(film.raw_odd(), (&[[0.25, 0.5, 2.0]][..], &[1][..]));
+        assert_eq!(film.raw_odd(), (&[sum([0.25, 0.5, 2.0])][..], &[1][..]));
     }
 }

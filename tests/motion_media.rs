@@ -54,7 +54,7 @@ transform = [{{ motion = [4, 0, 0] }}]
 fn coverage(scene: &Scene) -> f64 {
     let (film, _) = lumen::render::render(scene, &|_| {});
     let (sums, counts) = film.raw();
-    sums[0][0] / f64::from(counts[0])
+    sums[0].to_f64()[0] / f64::from(counts[0])
 }
 
 #[test]
@@ -308,8 +308,8 @@ fn the_new_built_ins_render_the_same_with_any_number_of_threads() {
         assert!(one == three, "{name}: 1 and 3 threads differ");
         let (sums, _) = one.raw();
         assert!(
-            sums.iter().flatten().all(|v| v.is_finite()) && sums.iter().flatten().any(|&v| v > 0.0),
-            "{name}: not a finite, lit image"
+            sums.iter().flat_map(|s| s.0).any(|v| v > 0),
+            "{name}: not a lit image"
         );
     }
 }

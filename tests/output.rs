@@ -3,7 +3,7 @@
 
 mod common;
 
-use lumen::film::{to_display, Film};
+use lumen::film::{to_display, Film, Sum};
 use lumen::output::{encode_pfm, encode_ppm, write_image, ImageFormat};
 use lumen::scene::desc::BackgroundDesc;
 use lumen::scene::Scene;
@@ -19,7 +19,10 @@ fn scratch_dir(name: &str) -> PathBuf {
 /// A film whose pixels are exactly the given linear colours (one sample each,
 /// except pixels given as `None`, which have no sample).
 fn film_of(width: u32, height: u32, pixels: &[Option<[f64; 3]>]) -> Film {
-    let sums = pixels.iter().map(|p| p.unwrap_or([0.0; 3])).collect();
+    let sums = pixels
+        .iter()
+        .map(|p| Sum::of(p.unwrap_or([0.0; 3])).unwrap())
+        .collect();
     let counts = pixels.iter().map(|p| u32::from(p.is_some())).collect();
     Film::from_raw(width, height, sums, counts).unwrap()
 }
@@ -79,10 +82,11 @@ fn eight_bit_values_are_floor_of_256_times_the_clamped_value() {
 
 #[test]
 fn a_pixel_without_samples_is_black_and_means_divide_by_the_count() {
-    let film = Film::from_raw(2, 1, vec![[0.0; 3], [3.0, 1.5, 0.75]], vec![0, 3]).unwrap();
+    let sums = vec![Sum::ZERO, Sum::of([3.0, 1.5, 0.75]).unwrap()];
+    let film = Film::from_raw(2, 1, sums, vec![0, 3]).unwrap();
     assert_eq!(film.pixel(0, 0), lumen::math::Color::ZERO);
     assert_eq!(film.pixel(1, 0), lumen::math::Color::new(1.0, 0.5, 0.25));
-    assert!(Film::from_raw(2, 2, vec![[0.0; 3]; 3], vec![0; 4]).is_none());
+    assert!(Film::from_raw(2, 2, vec![Sum::ZERO; 3], vec![0; 4]).is_none());
 }
 
 #[test]

@@ -194,6 +194,7 @@ pub fn measure_adaptive(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film::Sum;
 
     #[test]
     fn sky_spheres_has_no_glass_no_fuzz_and_a_white_sky() {
@@ -229,8 +230,9 @@ mod tests {
 
     #[test]
     fn variance_between_two_films_is_half_their_mean_squared_difference() {
-        let a = Film::from_raw(2, 1, vec![[1.0; 3], [0.0; 3]], vec![1, 1]).unwrap();
-        let b = Film::from_raw(2, 1, vec![[3.0; 3], [0.0; 3]], vec![1, 1]).unwrap();
+        let sums = |v| vec![Sum::of([v; 3]).unwrap(), Sum::ZERO];
+        let a = Film::from_raw(2, 1, sums(1.0), vec![1, 1]).unwrap();
+        let b = Film::from_raw(2, 1, sums(3.0), vec![1, 1]).unwrap();
         // Differences 2, 2, 2, 0, 0, 0: mean square 2, half of it 1.
         assert_eq!(variance_between(&a, &b), 1.0);
     }
