@@ -285,6 +285,9 @@ fn overridden(o: &Overrides) -> Vec<&'static str> {
     if o.max_depth.is_some() {
         fields.push("render.max_depth");
     }
+    if o.seed.is_some() {
+        fields.push("render.seed");
+    }
     fields
 }
 
