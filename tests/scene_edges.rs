@@ -27,18 +27,6 @@ fn scratch_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// Asserts a run that failed with one `lumen: error:` line containing every
-/// one of `words`, and no panic.
-fn assert_refused(out: &Output, words: &[&str]) {
-    let err = stderr(out);
-    assert!(!out.status.success(), "succeeded: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    let first = err.lines().next().unwrap_or("");
-    for w in words {
-        assert!(first.contains(w), "{w:?} not in {first:?}\n{err}");
-    }
-}
-
 fn parse(text: &str, format: Format) -> Result<SceneFile, String> {
     let name = match format {
         Format::Toml => "s.toml",
@@ -146,3 +134,66 @@ fn the_command_line_seed_has_the_scene_files_range() {
     let ok = lumen(&[&args[..], &[max.as_str()]].concat());
     assert!(ok.status.success(), "{}", stderr(&ok));
 }
+
+#[test]
+fn blank_files_and_byte_order_marks_mean_the_same_in_both_formats() {
+    let bom = "\u{feff}";
+    for body in ["", " ", "\n", "\r\n\t \n"] {
+        for format in [Format::Toml, Format::Json] {
+            for text in [body.to_string(), format!("{bom}{body}")] {
+                let file = parse(&text, format).unwrap_or_else(|e| panic!("{text:?}: {e}"));
+                assert_eq!(file.desc, SceneDesc::default(), "{text:?}");
+            }
+        }
+    }
+    let json = format!("{bom}{{{SPHERE_JSON}}}");
+    let toml = export(&parse(&json, Format::Json).unwrap().desc, Format::Toml).unwrap();
+    assert_eq!(
+        parse(&format!("{bom}{toml}"), Format::Toml).unwrap().desc,
+        parse(&json, Format::Json).unwrap().desc
+    );
+    // Columns on the first line count from after the mark.
+    let err = parse(&format!("{bom}{{\"render\": 5}}"), Format::Json).unwrap_err();
+    assert!(err.starts_with("s.json:1:12: render:"), "{err}");
+    let err = parse(&format!("{bom}render = 5"), Format::Toml).unwrap_err();
+    assert!(err.starts_with("s.toml:1:10: render:"), "{err}");
+}
+
+#[test]
+fn a_scene_without_objects_is_rendered_with_a_warning() {
+    assert_eq!(SceneDesc::default().warnings().len(), 1);
+    let dir = scratch_dir("empty");
+    // The built-in `gradient` is meant to show the background only.
+    let png = dir.join("gradient.png");
+    let args = ["render", "gradient", "-o", png.to_str().unwrap(), "--width", "8"];
+    let out = lumen(&args);
+    assert!(out.status.success() && !stderr(&out).contains("warning"));
+    for (name, text) in [("e.json", ""), ("e.toml", "\u{feff}\n"), ("c.json", "{}")] {
+        let scene = dir.join(name);
+        std::fs::write(&scene, text).unwrap();
+        let png = dir.join(format!("{name}.png"));
+        let out = lumen(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--width",
+            "8",
+            "--spp",
+            "1",
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        let warning = format!(
+            "lumen: warning: {}: the scene has no objects",
+            scene.display()
+        );
+        assert_eq!(err.matches(&warning).count(), 1, "{err}");
+        assert!(png.is_file());
+    }
+    let scene = dir.join("one.json");
+    std::fs::write(&scene, format!("{{{SPHERE_JSON}}}")).unwrap();
+    let out = lumen(&["scenes", "export", scene.to_str().unwrap()]);
+    assert!(out.status.success() && !stderr(&out).contains("warning"));
+}
+

@@ -45,6 +45,21 @@ pub struct SceneDesc {
     pub objects: Vec<ObjectDesc>,
 }
 
+impl SceneDesc {
+    /// What is legal but probably not what was meant, one sentence each,
+    /// for the reader to show as warnings: a scene without objects (such
+    /// as an empty file) renders only its background.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if self.objects.is_empty() {
+            warnings.push(
+                "the scene has no objects: the image will show only its background".to_string(),
+            );
+        }
+        warnings
+    }
+}
+
 /// Image size, sampling and output settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

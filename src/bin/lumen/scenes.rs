@@ -49,7 +49,11 @@ pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
         || name.contains('/')
         || path.exists();
     if looks_like_file {
-        return Ok(SceneSource::File(SceneFile::read(path)?));
+        let file = SceneFile::read(path)?;
+        for warning in file.desc.warnings() {
+            eprintln!("lumen: warning: {}: {warning}", file.name);
+        }
+        return Ok(SceneSource::File(file));
     }
     let closest = hint::closest(name, BUILTINS.iter().map(|b| b.name))
         .map(|n| format!(" (did you mean '{n}'?)"))
