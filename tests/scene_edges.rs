@@ -27,6 +27,18 @@ fn scratch_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// Asserts a run that failed with one `lumen: error:` line containing every
+/// one of `words`, and no panic.
+fn assert_refused(out: &Output, words: &[&str]) {
+    let err = stderr(out);
+    assert!(!out.status.success(), "succeeded: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let first = err.lines().next().unwrap_or("");
+    for w in words {
+        assert!(first.contains(w), "{w:?} not in {first:?}\n{err}");
+    }
+}
+
 fn parse(text: &str, format: Format) -> Result<SceneFile, String> {
     let name = match format {
         Format::Toml => "s.toml",
@@ -195,5 +207,44 @@ fn a_scene_without_objects_is_rendered_with_a_warning() {
     std::fs::write(&scene, format!("{{{SPHERE_JSON}}}")).unwrap();
     let out = lumen(&["scenes", "export", scene.to_str().unwrap()]);
     assert!(out.status.success() && !stderr(&out).contains("warning"));
+}
+
+#[test]
+fn a_scene_file_is_never_exported_over_itself() {
+    let dir = scratch_dir("in-place");
+    let text = "# a comment export would drop\n[render]\nwidth = 8\n";
+    let scene = dir.join("s.toml");
+    std::fs::write(&scene, text).unwrap();
+    let s = scene.to_str().unwrap();
+    let dotted = dir.join("sub/../s.toml");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let mut outputs = vec![s.to_string(), dotted.to_str().unwrap().to_string()];
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&scene, dir.join("link.toml")).unwrap();
+        std::fs::hard_link(&scene, dir.join("hard.toml")).unwrap();
+        outputs.push(dir.join("link.toml").to_str().unwrap().to_string());
+        outputs.push(dir.join("hard.toml").to_str().unwrap().to_string());
+    }
+    for output in &outputs {
+        let out = lumen(&["scenes", "export", s, "-o", output]);
+        assert_refused(&out, &[output, "is the scene file being exported"]);
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+    }
+    // Through a link the other way round, and to JSON by another name.
+    #[cfg(unix)]
+    {
+        let link = dir.join("link.toml");
+        let out = lumen(&["scenes", "export", link.to_str().unwrap(), "-o", s]);
+        assert_refused(&out, &["is the scene file being exported"]);
+    }
+    let json = dir.join("s.json");
+    let out = lumen(&["scenes", "export", s, "-o", json.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let back = lumen(&["scenes", "export", json.to_str().unwrap(), "-o", s]);
+    assert!(back.status.success(), "{}", stderr(&back));
+    assert!(!std::fs::read_to_string(&scene)
+        .unwrap()
+        .contains("a comment"));
 }
 
