@@ -4,7 +4,7 @@
 
 use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc,
-    ScaleDesc, TransformDesc,
+    ScaleDesc, TransformDesc, MAX_SEED,
 };
 use super::textures::{read_image, ColorRef, TextureTable};
 use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
@@ -907,6 +907,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
             format!("must not be negative, got {}", r.epsilon),
         ));
     }
+    check_seed("render.seed", r.seed)?;
     let noise_target = match r.noise_target {
         None => None,
         Some(t) if t > 0.0 && t <= 1.0 && (t as f32) > 0.0 => Some(t as f32),
@@ -931,6 +932,18 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         epsilon: r.epsilon as f32,
         shading: r.shading,
     })
+}
+
+/// Refuses a seed above [`MAX_SEED`] (given by a program or the library's
+/// user: scene files are checked when read), which TOML could not write.
+pub(super) fn check_seed(field: &str, seed: u64) -> Result<(), SceneError> {
+    if seed > MAX_SEED {
+        return Err(invalid(
+            field,
+            format!("must be at most {MAX_SEED} (2^63-1, the largest integer TOML can hold), got {seed}"),
+        ));
+    }
+    Ok(())
 }
 
 /// The material `m` of field `field`, and the texture that gives its

@@ -11,7 +11,7 @@
 use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
     IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
-    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple,
+    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, MAX_SEED,
 };
 use super::hint;
 use super::source::{Entry, Node, Value};
@@ -201,6 +201,21 @@ fn integer(node: &Node, path: &str, min: u64, max: u64) -> Result<u64> {
             &node.span,
             format!("expected a whole number, got {}", other.describe()),
         )),
+    }
+}
+
+/// A seed: 0 to [`MAX_SEED`] in both formats, so that a JSON scene can
+/// always be exported to TOML (whose integers are signed 64-bit).
+fn seed(node: &Node, path: &str) -> Result<u64> {
+    match node.value {
+        Value::Integer(i) if i > i128::from(MAX_SEED) => Err(error(
+            path,
+            &node.span,
+            format!(
+                "must be at most {MAX_SEED} (2^63-1, the largest integer TOML can hold), got {i}"
+            ),
+        )),
+        _ => integer(node, path, 0, MAX_SEED),
     }
 }
 
@@ -449,9 +464,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             .optional("samples_per_pixel", positive)?
             .unwrap_or(d.samples_per_pixel),
         max_depth: t.optional("max_depth", positive)?.unwrap_or(d.max_depth),
-        seed: t
-            .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
-            .unwrap_or(d.seed),
+        seed: t.optional("seed", seed)?.unwrap_or(d.seed),
         sampler: sampler(&t)?.unwrap_or(d.sampler),
         integrator: t
             .optional("integrator", |n, p| keyword(n, p, INTEGRATORS))?
@@ -778,9 +791,7 @@ fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
             pattern: t
                 .optional("pattern", |n, p| keyword(n, p, NOISE_PATTERNS))?
                 .unwrap_or_default(),
-            seed: t
-                .optional("seed", |n, p| integer(n, p, 0, u64::MAX))?
-                .unwrap_or(0),
+            seed: t.optional("seed", seed)?.unwrap_or(0),
         },
     })
 }

@@ -13,6 +13,11 @@ use std::collections::BTreeMap;
 /// An RGB triple or a 3-D point/vector.
 pub type Triple = [f64; 3];
 
+/// Largest seed (of a render or of a noise texture): 2⁶³−1, the largest
+/// integer TOML can write, so that every scene, however it was made (JSON,
+/// the command line, a program), can be exported to either format.
+pub const MAX_SEED: u64 = i64::MAX as u64;
+
 /// A whole scene: settings, camera, background, named materials and objects.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -40,6 +45,21 @@ pub struct SceneDesc {
     pub objects: Vec<ObjectDesc>,
 }
 
+impl SceneDesc {
+    /// What is legal but probably not what was meant, one sentence each,
+    /// for the reader to show as warnings: a scene without objects (such
+    /// as an empty file) renders only its background.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if self.objects.is_empty() {
+            warnings.push(
+                "the scene has no objects: the image will show only its background".to_string(),
+            );
+        }
+        warnings
+    }
+}
+
 /// Image size, sampling and output settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -55,7 +75,7 @@ pub struct RenderDesc {
     pub samples_per_pixel: u32,
     /// Maximum number of ray segments per path; 1 shows no bounce light.
     pub max_depth: u32,
-    /// Seed of every random choice of the render.
+    /// Seed of every random choice of the render, at most [`MAX_SEED`].
     pub seed: u64,
     /// Where the numbers of every random decision come from, the position
     /// in the pixel first (`sampling` in older scene files).
@@ -349,7 +369,7 @@ pub enum TextureDesc {
         /// How the noise becomes a grey level.
         #[serde(default)]
         pattern: NoisePatternDesc,
-        /// The seed the noise is made from.
+        /// The seed the noise is made from, at most [`MAX_SEED`].
         #[serde(default, skip_serializing_if = "is_zero_u64")]
         seed: u64,
     },

@@ -206,13 +206,28 @@ impl SceneFile {
     /// files are found relative to the working directory.
     pub fn parse(
         name: impl Into<String>,
-        text: String,
+        mut text: String,
         format: Format,
     ) -> Result<SceneFile, SceneFileError> {
         let name = name.into();
-        let parsed = match format {
-            Format::Toml => source::parse_toml(&text),
-            Format::Json => source::parse_json(&text),
+        // A byte-order mark only says the text is UTF-8 (some Windows
+        // editors write one): dropped in both formats, so that columns on
+        // the first line count from its first visible character.
+        if text.starts_with(BOM) {
+            text.drain(..BOM.len_utf8());
+        }
+        let parsed = if is_blank(&text) {
+            // Nothing but whitespace is the empty scene in both formats, as
+            // an empty TOML document is (JSON would call it a syntax error).
+            Ok(Node {
+                span: 0..0,
+                value: Value::Table(Vec::new()),
+            })
+        } else {
+            match format {
+                Format::Toml => source::parse_toml(&text),
+                Format::Json => source::parse_json(&text),
+            }
         };
         let root = parsed.map_err(|e| {
             // toml_edit splits its message over lines; keep the message on one.
@@ -273,6 +288,15 @@ impl SceneFile {
     }
 }
 
+/// The Unicode byte-order mark.
+const BOM: char = '\u{feff}';
+
+/// Whether `text` holds nothing but the whitespace both formats allow
+/// between values (space, tab, line breaks).
+fn is_blank(text: &str) -> bool {
+    text.bytes().all(|b| matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
+}
+
 /// The fields whose values `overrides` replaces.
 fn overridden(o: &Overrides) -> Vec<&'static str> {
     let mut fields = Vec::new();
@@ -284,6 +308,9 @@ fn overridden(o: &Overrides) -> Vec<&'static str> {
     }
     if o.max_depth.is_some() {
         fields.push("render.max_depth");
+    }
+    if o.seed.is_some() {
+        fields.push("render.seed");
     }
     fields
 }

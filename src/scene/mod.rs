@@ -5,6 +5,7 @@ pub mod builtin;
 mod compile;
 mod decode;
 pub mod desc;
+pub mod export;
 pub mod file;
 pub mod hint;
 pub mod source;

@@ -132,7 +132,10 @@ impl<'a> TextureTable<'a> {
                 pattern,
                 seed,
             } => Texture::Noise {
-                perlin: Arc::new(Perlin::new(*seed)),
+                perlin: {
+                    super::compile::check_seed(&format!("{here}.seed"), *seed)?;
+                    Arc::new(Perlin::new(*seed))
+                },
                 scale: positive(&format!("{here}.scale"), *scale)?,
                 pattern: match pattern {
                     NoisePatternDesc::Smooth => NoisePattern::Smooth,

@@ -194,8 +194,8 @@ struct SettingArgs {
     /// Maximum path depth in ray segments (1 = no bounces).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     depth: Option<u32>,
-    /// Random seed.
-    #[arg(long)]
+    /// Random seed, 0 to 2^63-1 (as in scene files).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(..=lumen::scene::desc::MAX_SEED))]
     seed: Option<u64>,
     /// Where the random numbers come from [default: the scene's; `sobol`
     /// unless it says otherwise].

@@ -4,6 +4,7 @@ use crate::{write_stdout, FormatArg};
 use anyhow::{anyhow, bail, Context, Result};
 use lumen::output;
 use lumen::scene::builtin::{self, BUILTINS};
+use lumen::scene::export;
 use lumen::scene::file::{self, Format, SceneFile};
 use lumen::scene::{hint, Overrides, Scene, SceneDesc};
 use std::path::Path;
@@ -49,7 +50,11 @@ pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
         || name.contains('/')
         || path.exists();
     if looks_like_file {
-        return Ok(SceneSource::File(SceneFile::read(path)?));
+        let file = SceneFile::read(path)?;
+        for warning in file.desc.warnings() {
+            eprintln!("lumen: warning: {}: {warning}", file.name);
+        }
+        return Ok(SceneSource::File(file));
     }
     let closest = hint::closest(name, BUILTINS.iter().map(|b| b.name))
         .map(|n| format!(" (did you mean '{n}'?)"))
@@ -61,6 +66,10 @@ pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
 }
 
 pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<()> {
+    // Checked before the file is read: a large scene takes a while.
+    if let (None, Some(path)) = (builtin::find(name), out) {
+        export::check_not_source(Path::new(name), path)?;
+    }
     let source = load_scene(name)?;
     let format = match out {
         Some(path) => Format::from_extension(path)
