@@ -31,10 +31,17 @@
 use crate::film::Film;
 use crate::output::{self, OutputError};
 use crate::render::RenderStats;
-use crate::scene::{MeshSource, SceneDesc};
-use std::collections::BTreeSet;
+use crate::scene::SceneDesc;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+
+mod consistency;
+mod header;
+mod identity;
+
+pub use header::{inspect, remove, Existing};
+pub use identity::{description_text, identity_text};
 
 /// First bytes of every checkpoint file.
 pub const MAGIC: &[u8; 8] = b"LUMENCKP";
@@ -49,7 +56,8 @@ pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.9");
 /// Extension added to an output path to name its default checkpoint.
 pub const EXTENSION: &str = "lumen-ckpt";
 
-const HEADER_LEN: usize = 8 + 4 + 8 + 4;
+/// Length of the header: magic, version, payload length, checksum.
+pub const HEADER_LEN: usize = 8 + 4 + 8 + 4;
 
 /// The state of an unfinished render.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,9 +89,28 @@ pub enum CheckpointError {
         /// Why.
         message: String,
     },
-    /// The file does not start with the checkpoint magic bytes.
-    #[error("checkpoint {path}: not a lumen checkpoint (wrong magic bytes)")]
+    /// Something other than a regular file is at the path: lumen neither
+    /// reads (a device or a pipe may never end) nor replaces it.
+    #[error("checkpoint {path}: {message}; choose another --checkpoint")]
+    NotRegular {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// What is there.
+        message: String,
+    },
+    /// The file is not a checkpoint at all: it is someone's file, which
+    /// lumen neither reads nor replaces.
+    #[error("checkpoint {path}: not a lumen checkpoint but {what}; lumen will neither resume from it nor replace it: move or delete it if it is not needed, or choose another --checkpoint")]
     NotACheckpoint {
+        /// The checkpoint path.
+        path: PathBuf,
+        /// What the file seems to be, e.g. `a PNG image of 1234 bytes`.
+        what: String,
+    },
+    /// The magic bytes are wrong, but the rest is laid out as a checkpoint:
+    /// a checkpoint damaged on disk.
+    #[error("checkpoint {path}: damaged (its first bytes are wrong, but the rest is laid out as a lumen checkpoint); it cannot be resumed: render without --resume to start afresh, which replaces it")]
+    Damaged {
         /// The checkpoint path.
         path: PathBuf,
     },
@@ -96,7 +123,7 @@ pub enum CheckpointError {
         found: u32,
     },
     /// The file is shorter or longer than its header says.
-    #[error("checkpoint {path}: truncated or damaged: {found} bytes, the header says {expected}; refusing to use it")]
+    #[error("checkpoint {path}: truncated or damaged: {found} bytes, the header says {expected}; refusing to use it (render without --resume to start afresh, which replaces it)")]
     Truncated {
         /// The checkpoint path.
         path: PathBuf,
@@ -106,13 +133,14 @@ pub enum CheckpointError {
         found: u64,
     },
     /// The payload does not match its checksum.
-    #[error("checkpoint {path}: corrupted (checksum mismatch); refusing to use it")]
+    #[error("checkpoint {path}: corrupted (checksum mismatch); refusing to use it (render without --resume to start afresh, which replaces it)")]
     Corrupted {
         /// The checkpoint path.
         path: PathBuf,
     },
-    /// The checksum matches but the content makes no sense.
-    #[error("checkpoint {path}: malformed: {message}")]
+    /// The checksum matches but the content makes no sense, or does not
+    /// fit the render.
+    #[error("checkpoint {path}: malformed: {message}; refusing to use it (render without --resume to start afresh, which replaces it)")]
     Malformed {
         /// The checkpoint path.
         path: PathBuf,
@@ -129,37 +157,12 @@ pub enum CheckpointError {
     },
 }
 
-/// The canonical text of a scene description that identifies a render:
-/// compact JSON, materials sorted by name (they are a `BTreeMap`).
-pub fn description_text(desc: &SceneDesc) -> String {
-    identity_text(desc, &[])
-}
-
-/// [`description_text`] with the content hashes of the mesh files the
-/// scene reads (`mesh_sources`), so that a changed mesh file is a different
-/// render.
-pub fn identity_text(desc: &SceneDesc, sources: &[MeshSource]) -> String {
-    #[derive(serde::Serialize)]
-    struct Identity<'a> {
-        #[serde(flatten)]
-        desc: &'a SceneDesc,
-        #[serde(skip_serializing_if = "<[MeshSource]>::is_empty")]
-        mesh_sources: &'a [MeshSource],
-    }
-    serde_json::to_string(&Identity {
-        desc,
-        mesh_sources: sources,
-    })
-    .expect("a scene description always serialises")
-}
-
 /// The default checkpoint path of an output image: `out.png` →
-/// `out.png.lumen-ckpt`, in the same directory.
+/// `out.png.lumen-ckpt`, in the same directory (with the output's name
+/// shortened if the whole would not fit in a file name, see
+/// [`crate::files::fit_name`]).
 pub fn default_path(output: &Path) -> PathBuf {
-    let mut name = output.as_os_str().to_owned();
-    name.push(".");
-    name.push(EXTENSION);
-    PathBuf::from(name)
+    crate::files::sibling(output, "", &format!(".{EXTENSION}"))
 }
 
 /// A checkpoint to be written, borrowing the state it saves: a render in
@@ -266,41 +269,27 @@ impl Checkpoint {
     /// Reads a checkpoint from `bytes`; `path` only names it in errors.
     pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, CheckpointError> {
         let path_buf = || path.to_path_buf();
-        if !bytes.starts_with(MAGIC) {
-            return Err(CheckpointError::NotACheckpoint { path: path_buf() });
-        }
-        if bytes.len() < HEADER_LEN {
-            return Err(CheckpointError::Truncated {
-                path: path_buf(),
-                expected: HEADER_LEN as u64,
-                found: bytes.len() as u64,
-            });
-        }
-        let mut header = Reader(&bytes[MAGIC.len()..HEADER_LEN]);
-        let version = header.u32().expect("header length checked");
-        if version != VERSION {
-            return Err(CheckpointError::Version {
-                path: path_buf(),
-                found: version,
-            });
-        }
-        let len = header.u64().expect("header length checked");
-        let crc = header.u32().expect("header length checked");
+        let head = &bytes[..bytes.len().min(HEADER_LEN)];
+        header::check(head, bytes.len() as u64, path)?;
+        let crc = u32::from_le_bytes(
+            bytes[HEADER_LEN - 4..HEADER_LEN]
+                .try_into()
+                .expect("4 bytes"),
+        );
         let payload = &bytes[HEADER_LEN..];
-        if payload.len() as u64 != len {
-            return Err(CheckpointError::Truncated {
-                path: path_buf(),
-                expected: HEADER_LEN as u64 + len,
-                found: bytes.len() as u64,
-            });
-        }
         if crc32fast::hash(payload) != crc {
             return Err(CheckpointError::Corrupted { path: path_buf() });
         }
-        Self::decode_payload(payload).map_err(|message| CheckpointError::Malformed {
+        let ckpt = Self::decode_payload(payload).map_err(|message| CheckpointError::Malformed {
             path: path_buf(),
             message: message.to_string(),
-        })
+        })?;
+        ckpt.check_consistency()
+            .map_err(|message| CheckpointError::Malformed {
+                path: path_buf(),
+                message,
+            })?;
+        Ok(ckpt)
     }
 
     fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
@@ -316,15 +305,18 @@ impl Checkpoint {
             rays: stat()?,
             dropped: stat()?,
         };
-        let n = width as usize * height as usize;
-        let rest = r.0.len() as u64;
-        let adaptive = if rest == n as u64 * 28 + 1 {
+        // Checked: the size is read from the file, which may say anything.
+        let pixels = u64::from(width) * u64::from(height);
+        let bytes = |per_pixel: u64| pixels.checked_mul(per_pixel).and_then(|b| b.checked_add(1));
+        let rest = Some(r.0.len() as u64);
+        let adaptive = if rest == bytes(28) {
             false
-        } else if rest == n as u64 * 57 + 1 {
+        } else if rest == bytes(57) {
             true
         } else {
             return Err("pixel data does not match the image size");
         };
+        let n = pixels as usize;
         let (whole, rest) = r.0.split_at(n * 28);
         let (sums, counts) = sums_and_counts(whole, n);
         let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
@@ -363,12 +355,27 @@ impl Checkpoint {
         self.view().write(path)
     }
 
-    /// Reads and verifies the checkpoint at `path`.
+    /// Reads and verifies the checkpoint at `path`. Only a regular file is
+    /// read, and no more of it than its header announces (which must be
+    /// its size): a device or a pipe given as a checkpoint is refused
+    /// rather than read for ever.
     pub fn read(path: &Path) -> Result<Self, CheckpointError> {
-        let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io {
+        let io = |e: std::io::Error| CheckpointError::Io {
             path: path.to_path_buf(),
             message: e.to_string(),
-        })?;
+        };
+        let (mut file, len) = header::open_regular(path)?;
+        let mut bytes = Vec::with_capacity(HEADER_LEN);
+        (&mut file)
+            .take(HEADER_LEN as u64)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        let payload_len = header::check(&bytes, len, path)?;
+        bytes.reserve_exact(usize::try_from(payload_len).unwrap_or(0));
+        (&mut file)
+            .take(payload_len)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
         Self::decode(&bytes, path)
     }
 
@@ -390,94 +397,14 @@ impl Checkpoint {
                 ),
             });
         }
-        if self.description == ours {
+        if identity::same_render(&self.description, ours) {
             return Ok(());
         }
         Err(CheckpointError::Mismatch {
             path: path.to_path_buf(),
-            differences: describe_differences(&self.description, ours),
+            differences: identity::describe_differences(&self.description, ours),
         })
     }
-}
-
-/// What differs between two description texts, in words: render settings
-/// one by one, the rest by section. Both are parsed the same way, so that
-/// equal numbers compare equal.
-fn describe_differences(theirs: &str, ours: &str) -> String {
-    use serde_json::Value;
-    let parse = |t: &str| serde_json::from_str::<Value>(t).unwrap_or(Value::Null);
-    let (theirs, ours) = (parse(theirs), parse(ours));
-    let (Value::Object(theirs), Value::Object(ours)) = (theirs, ours) else {
-        return "a different scene description".into();
-    };
-    let absent = Value::String("unset".into());
-    let show = |v: &Value| match v {
-        Value::String(s) => s.clone(),
-        v => v.to_string(),
-    };
-    let mut out = Vec::new();
-    let empty = serde_json::Map::new();
-    let section = |m| {
-        serde_json::Map::get(m, "render")
-            .and_then(Value::as_object)
-            .unwrap_or(&empty)
-    };
-    let (a, b) = (section(&theirs), section(&ours));
-    let keys: BTreeSet<&String> = a.keys().chain(b.keys()).collect();
-    for key in keys {
-        let (x, y) = (a.get(key).unwrap_or(&absent), b.get(key).unwrap_or(&absent));
-        if x != y {
-            let name = match key.as_str() {
-                "samples_per_pixel" => "spp".to_string(),
-                "max_depth" => "depth".to_string(),
-                k => k.replace('_', " "),
-            };
-            out.push(format!(
-                "{name} {} in the checkpoint, {} here",
-                show(x),
-                show(y)
-            ));
-        }
-    }
-    let sections: BTreeSet<&String> = theirs.keys().chain(ours.keys()).collect();
-    let differing: Vec<&str> = sections
-        .into_iter()
-        .filter(|k| *k != "render" && theirs.get(*k) != ours.get(*k))
-        .map(String::as_str)
-        .collect();
-    if differing.contains(&"mesh_sources") {
-        // Name the files whose content changed.
-        let files = |m: &serde_json::Map<String, Value>| -> Vec<(String, Value)> {
-            m.get("mesh_sources")
-                .and_then(Value::as_array)
-                .map(|list| list.iter().map(|s| (show(&s["file"]), s.clone())).collect())
-                .unwrap_or_default()
-        };
-        let (a, b) = (files(&theirs), files(&ours));
-        for (name, source) in &b {
-            match a.iter().find(|(n, _)| n == name) {
-                Some((_, old)) if old != source => {
-                    out.push(format!("file {name} has changed since the checkpoint"))
-                }
-                None => out.push(format!("file {name} is not in the checkpoint")),
-                _ => {}
-            }
-        }
-    }
-    let differing: Vec<&str> = differing
-        .into_iter()
-        .filter(|k| *k != "mesh_sources")
-        .collect();
-    if !differing.is_empty() {
-        out.push(format!(
-            "a different scene ({} differ)",
-            differing.join(", ")
-        ));
-    }
-    if out.is_empty() {
-        out.push("a different scene description".into());
-    }
-    out.join(", ")
 }
 
 /// Feeds every pixel's three `f64` sums and then every pixel's `u32` count
@@ -554,22 +481,24 @@ mod tests {
     use super::*;
     use crate::scene::builtin;
 
+    /// A consistent checkpoint of 8×4 pixels at 16 spp, a quarter of the
+    /// pixels with a dropped sample.
     fn sample() -> (SceneDesc, Checkpoint) {
         let mut desc = builtin::find("metal-mirror").unwrap().desc();
         desc.render.width = 8;
         let h = 4;
         desc.render.height = Some(h);
         let n = 8 * h as usize;
-        let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, f64::MAX]).collect();
-        let counts = (0..n as u32).collect();
+        let sums = (0..n).map(|i| [i as f64 * 0.1, -1.5, 1e300]).collect();
+        let counts = (0..n).map(|i| if i % 4 == 0 { 15 } else { 16 }).collect();
         let ckpt = Checkpoint {
             renderer_id: RENDERER_ID.into(),
             description: description_text(&desc),
-            spp_done: 3,
+            spp_done: 16,
             stats: RenderStats {
-                samples: 96,
+                samples: 16 * n as u64,
                 rays: 1234,
-                dropped: 2,
+                dropped: n as u64 / 4,
             },
             film: Film::from_raw(8, h, sums, counts).unwrap(),
             active: None,
@@ -591,10 +520,7 @@ mod tests {
             film: ckpt
                 .film
                 .clone()
-                .with_odd(
-                    vec![[0.25, 1.0, -2.0]; n],
-                    (0..n as u32).map(|c| c / 2).collect(),
-                )
+                .with_odd(vec![[0.25, 1.0, -2.0]; n], vec![8; n])
                 .unwrap(),
             ..ckpt
         };
@@ -640,7 +566,8 @@ mod tests {
         );
         let other = builtin::find("cover").unwrap().desc();
         let e = ckpt.check_matches(&other, p).unwrap_err().to_string();
-        assert!(e.contains("a different scene (camera, caption, "), "{e}");
+        assert!(e.contains("a different scene (its camera, "), "{e}");
+        assert!(e.contains(" and objects differ)"), "{e}");
     }
 
     #[test]
