@@ -292,3 +292,38 @@ fn help_documents_interrupts_and_exit_status() {
         assert!(help.contains(words), "{words:?} not in: {help}");
     }
 }
+
+#[test]
+fn editing_the_caption_or_the_gamma_keeps_the_checkpoint() {
+    let dir = temp_dir("caption");
+    let scene = dir.join("c.toml");
+    let o = lumen()
+        .args(["scenes", "export", "cover", "-o"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "--width",
+        "160",
+        "--spp",
+        "64",
+    ];
+    let out = dir.join("c.pfm");
+    let r = spawn(&args, &out, &[]);
+    r.wait_line("pass 3:");
+    r.signal(libc::SIGINT);
+    let (status, err) = r.finish();
+    assert_eq!(status.code(), Some(130), "{err}");
+    let edited = text
+        .replace("caption = \"The cover", "caption = \"Edited: the cover")
+        .replace("gamma = 2.0", "gamma = 2.2");
+    assert_ne!(edited, text);
+    std::fs::write(&scene, edited).unwrap();
+    let (status, err) = run(&args, &out, &["--resume"]);
+    assert!(status.success(), "{err}");
+    assert!(err.contains("resuming at"), "{err}");
+}
