@@ -28,6 +28,9 @@
 //! - [`progressive`] and [`checkpoint`]: rendering in passes that can be
 //!   stopped, saved and resumed, within a time budget; [`adaptive`]: pixels
 //!   that stop once clean.
+//! - [`files`] and [`lock`]: the files beside an output (checkpoint,
+//!   temporaries, lock files): names that fit, regular files only, and one
+//!   render at a time.
 //! - [`scene`]: scene descriptions, the built-in scenes, and the compiled scene.
 //! - [`gallery`] and [`bench`](mod@bench): all the notes' figures at once; throughput.
 //!
@@ -53,6 +56,7 @@ pub mod bench;
 pub mod camera;
 pub mod checkpoint;
 pub mod distribution;
+pub mod files;
 pub mod film;
 pub mod gallery;
 pub mod geometry;
@@ -60,6 +64,7 @@ pub mod integrator;
 pub mod isa;
 pub mod lanes;
 pub mod light;
+pub mod lock;
 pub mod material;
 pub mod math;
 pub mod medium;

@@ -66,12 +66,12 @@ fn io_error(path: &Path, e: impl std::fmt::Display) -> OutputError {
     }
 }
 
-/// Checks, before any work is done, that `path` can later be written: its
-/// directory exists and accepts new files.
+/// Checks, before any work is done, that `path` can later be written: it
+/// is a regular file or does not exist yet (see
+/// [`crate::files::check_regular`]), and its directory exists and accepts
+/// new files.
 pub fn check_writable(path: &Path) -> Result<(), OutputError> {
-    if path.is_dir() {
-        return Err(io_error(path, "is a directory, not a file"));
-    }
+    crate::files::check_regular(path).map_err(|e| io_error(path, e))?;
     let dir = parent_dir(path);
     if !dir.is_dir() {
         return Err(io_error(
@@ -94,21 +94,22 @@ pub fn parent_dir(path: &Path) -> &Path {
 }
 
 /// The temporary name [`write_atomic`] writes `path`'s content to before
-/// renaming it into place: hidden, in the same directory, unique per process.
+/// renaming it into place: `.NAME.PID.tmp`, hidden, in the same directory,
+/// unique per process (shortened to fit in a file name, see
+/// [`crate::files::temp_path_of`]).
 pub fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()))
+    crate::files::temp_path_of(path, std::process::id())
 }
 
 /// Writes a file atomically: `write` fills a temporary file in the same
-/// directory, which is flushed to disk and then renamed over `path`.
+/// directory, which is flushed to disk and then renamed over `path`. Only a
+/// regular file is replaced: anything else at `path` (a device, a named
+/// pipe, a directory) is refused before anything is written.
 pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), OutputError> {
+    crate::files::check_regular(path).map_err(|e| io_error(path, e))?;
     let tmp = temp_path(path);
     let result = write(&tmp)
         .and_then(|()| {

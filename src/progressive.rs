@@ -70,6 +70,16 @@ pub fn schedule(spp: u32) -> Vec<Range<u32>> {
     passes
 }
 
+/// Whether a pass of a render of `spp` samples per pixel ends at `done`
+/// (see [`pass_size`]): lumen saves checkpoints between passes only.
+pub fn ends_a_pass(done: u32, spp: u32) -> bool {
+    let mut at = 0;
+    while at < done && at < spp {
+        at += pass_size(at, spp);
+    }
+    at == done
+}
+
 /// Parses a duration such as `90s`, `1.5m`, `2h` or `45` (seconds).
 pub fn parse_duration(text: &str) -> Result<Duration, String> {
     let t = text.trim();
@@ -228,6 +238,13 @@ impl Session {
         if checkpoint.spp_done > s.samples_per_pixel {
             return Err(malformed(format!(
                 "it holds {} spp of a {} spp render",
+                checkpoint.spp_done, s.samples_per_pixel
+            ))
+            .into());
+        }
+        if !ends_a_pass(checkpoint.spp_done, s.samples_per_pixel) {
+            return Err(malformed(format!(
+                "it holds {} spp, where no pass of a {} spp render ends",
                 checkpoint.spp_done, s.samples_per_pixel
             ))
             .into());
@@ -428,6 +445,8 @@ mod tests {
             assert!(passes.iter().all(|p| !p.is_empty() && p.len() <= cap));
         }
         assert_eq!(schedule(64).len(), 11);
+        assert!(ends_a_pass(4, 64) && ends_a_pass(64, 64));
+        assert!(!ends_a_pass(3, 64) && !ends_a_pass(65, 64));
     }
 
     #[test]

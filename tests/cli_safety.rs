@@ -117,3 +117,36 @@ fn a_closed_pipe_ends_output_quietly_and_a_full_device_is_an_error() {
         refused_with(&out, &["cannot write to standard output"]);
     }
 }
+
+#[test]
+fn a_closed_standard_error_lets_the_render_finish() {
+    // `lumen render … 2>&1 | head -5`: the reader goes away while lumen
+    // still reports passes.
+    let dir = temp_dir("closed-stderr");
+    let out = dir.join("p.pfm");
+    let mut child = lumen()
+        .args([
+            "render",
+            "cover",
+            "--width",
+            "64",
+            "--spp",
+            "16",
+            "--threads",
+            "1",
+        ])
+        .arg("-o")
+        .arg(&out)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status:?}");
+    let image = std::fs::read(&out).unwrap();
+    let header = b"PF\n64 36\n-1.0\n";
+    assert!(image.starts_with(header));
+    assert_eq!(image.len(), header.len() + 64 * 36 * 12);
+    assert!(!lumen::checkpoint::default_path(&out).exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

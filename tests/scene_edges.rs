@@ -177,7 +177,14 @@ fn a_scene_without_objects_is_rendered_with_a_warning() {
     let dir = scratch_dir("empty");
     // The built-in `gradient` is meant to show the background only.
     let png = dir.join("gradient.png");
-    let args = ["render", "gradient", "-o", png.to_str().unwrap(), "--width", "8"];
+    let args = [
+        "render",
+        "gradient",
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "8",
+    ];
     let out = lumen(&args);
     assert!(out.status.success() && !stderr(&out).contains("warning"));
     for (name, text) in [("e.json", ""), ("e.toml", "\u{feff}\n"), ("c.json", "{}")] {
@@ -247,4 +254,3 @@ fn a_scene_file_is_never_exported_over_itself() {
         .unwrap()
         .contains("a comment"));
 }
-

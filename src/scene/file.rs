@@ -294,7 +294,8 @@ const BOM: char = '\u{feff}';
 /// Whether `text` holds nothing but the whitespace both formats allow
 /// between values (space, tab, line breaks).
 fn is_blank(text: &str) -> bool {
-    text.bytes().all(|b| matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
+    text.bytes()
+        .all(|b| matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
 }
 
 /// The fields whose values `overrides` replaces.

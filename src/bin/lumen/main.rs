@@ -16,6 +16,28 @@ use std::time::Duration;
 /// lumen runs on has cores; each thread costs a stack).
 const MAX_THREADS: i64 = 1024;
 
+/// The end of `lumen render --help`: what an interrupt does and the exit
+/// status (see `render.rs` and `signals.rs`).
+const RENDER_HELP: &str = "\
+The image and a checkpoint (OUTPUT.lumen-ckpt unless --checkpoint says
+otherwise) are saved after every pass (or every --checkpoint-interval); the
+checkpoint is removed when the render completes. While it runs, the render
+holds a lock file beside each (.NAME.lumen-lock): a second render to the same
+image or checkpoint is refused. Only regular files are written.
+
+Ctrl-C (or SIGTERM) stops the render: the pass in flight is abandoned and the
+image and checkpoint of the passes finished so far are saved; continue with
+--resume. Interrupted before the first pass finished, nothing is written. A
+second Ctrl-C quits at once, leaving the files of the last save (a save in
+progress is given up to two seconds to finish).
+
+Exit status:
+  0    the image is complete, or --time-limit stopped the render (saved)
+  1    error: nothing rendered, or the render failed (e.g. every sample was
+       dropped, or a file could not be written)
+  2    the command line is wrong
+  130  interrupted (Ctrl-C or SIGTERM)";
+
 /// lumen: a physically based path tracer following Ray Tracing in One Weekend.
 #[derive(Parser)]
 #[command(name = "lumen", version, about, propagate_version = true)]
@@ -27,6 +49,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a built-in scene or a scene file to an image file (.ppm, .png, .pfm or .exr).
+    #[command(after_help = RENDER_HELP)]
     Render {
         /// Name of a built-in scene (see `lumen scenes`) or a scene file
         /// (.toml or .json, see docs/scene-format.md). Command-line settings
@@ -272,6 +295,21 @@ macro_rules! outln {
     };
 }
 
+/// Writes to standard error, ignoring failures: progress and messages are
+/// for a person watching, and a closed pipe (`lumen render … 2>&1 | head`)
+/// must neither stop the render nor leave its image half-saved.
+fn write_stderr(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stderr().lock().write_all(text.as_bytes());
+}
+
+/// `eprintln!` through [`write_stderr`]: never panics.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::write_stderr(&format!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 mod commands;
 mod render;
 mod scenes;
@@ -289,7 +327,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("lumen: error: {e:#}");
+            errln!("lumen: error: {e:#}");
             ExitCode::FAILURE
         }
     }

@@ -4,9 +4,10 @@ use crate::scenes::load_scene;
 use crate::signals::{install_stop_handler, quit_if_asked, saving, EXIT_INTERRUPTED};
 use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs};
 use anyhow::{bail, Context, Result};
-use lumen::checkpoint::{self, Checkpoint};
-use lumen::output;
+use lumen::checkpoint::{self, Checkpoint, Existing};
+use lumen::lock::RenderLock;
 use lumen::progressive::{Session, StopReason};
+use lumen::{files, output};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -25,8 +26,8 @@ fn resolved(path: &Path) -> PathBuf {
 }
 
 /// The checkpoint is overwritten after every pass and deleted at the end:
-/// it must be neither the output image nor the scene file, and a file
-/// already there must be a checkpoint, not something of the user's.
+/// it must be neither the output image nor the scene file. (What is
+/// already at its path is looked at once the render holds its lock.)
 fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
     let place = resolved(ckpt);
     if place == resolved(out) {
@@ -41,19 +42,24 @@ fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
             ckpt.display()
         );
     }
-    if ckpt.is_file() {
-        let mut magic = [0u8; checkpoint::MAGIC.len()];
-        let is_checkpoint = std::fs::File::open(ckpt)
-            .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
-            .is_ok_and(|()| &magic == checkpoint::MAGIC);
-        if !is_checkpoint {
-            bail!(
-                "{}: exists and is not a lumen checkpoint; refusing to overwrite it (choose another --checkpoint)",
-                ckpt.display()
-            );
-        }
-    }
     Ok(())
+}
+
+/// Removes the temporaries of `paths` that killed renders left, saying so.
+fn remove_stale_temps(paths: [&Path; 2]) {
+    let removed: Vec<String> = paths
+        .into_iter()
+        .flat_map(files::remove_stale_temps)
+        .map(|p| p.display().to_string())
+        .collect();
+    if !removed.is_empty() {
+        errln!(
+            "lumen: note: removed {} temporary file{} left by a render that no longer runs: {}",
+            removed.len(),
+            if removed.len() == 1 { "" } else { "s" },
+            removed.join(", ")
+        );
+    }
 }
 
 pub(crate) fn render_command(
@@ -72,9 +78,13 @@ pub(crate) fn render_command(
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
     output::check_writable(&ckpt_path).context("checkpoint")?;
+    // Held to the end: no other render writes these files meanwhile.
+    let locks = [RenderLock::acquire(out)?, RenderLock::acquire(&ckpt_path)?];
+    remove_stale_temps([out, &ckpt_path]);
+    let existing = checkpoint::inspect(&ckpt_path)?;
     let session = Session::with_scene(&desc, scene);
     let mut session = if prog.resume {
-        if !ckpt_path.exists() {
+        if existing == Existing::Nothing {
             bail!(
                 "--resume: there is no checkpoint at {}",
                 ckpt_path.display()
@@ -83,11 +93,16 @@ pub(crate) fn render_command(
         let ckpt = Checkpoint::read(&ckpt_path)?;
         session.restore(ckpt, &ckpt_path)?
     } else {
-        if ckpt_path.exists() {
-            eprintln!(
+        match existing {
+            Existing::Nothing => {}
+            Existing::Checkpoint => errln!(
                 "lumen: note: starting afresh; the checkpoint {} will be replaced (--resume continues it)",
                 ckpt_path.display()
-            );
+            ),
+            Existing::Damaged => errln!(
+                "lumen: note: starting afresh; the damaged checkpoint {} will be replaced",
+                ckpt_path.display()
+            ),
         }
         session
     };
@@ -96,11 +111,12 @@ pub(crate) fn render_command(
     install_stop_handler(
         &stop,
         [output::temp_path(out), output::temp_path(&ckpt_path)],
+        locks.iter().map(|l| l.path().to_path_buf()).collect(),
     )?;
 
     let s = session.scene().settings.clone();
     let resumed_from = session.spp_done();
-    eprintln!(
+    errln!(
         "{name}: {}x{} at {} spp, depth {}{}",
         s.width,
         s.height,
@@ -145,7 +161,7 @@ pub(crate) fn render_command(
                     session.stats().samples as f64 / pixels as f64
                 )
             });
-            eprintln!(
+            errln!(
                 "pass {}: samples {}..{} in {:.3} s, {} of {} spp{adaptive}",
                 pass.number,
                 pass.samples.start,
@@ -171,11 +187,8 @@ pub(crate) fn render_command(
     let code = match run.reason {
         StopReason::Complete => {
             save(&session)?;
-            match std::fs::remove_file(&ckpt_path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    eprintln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
-                }
-                _ => {}
+            if let Err(e) = checkpoint::remove(&ckpt_path) {
+                errln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
             }
             let spp = match session.active_pixels() {
                 None => format!("{total} spp"),
@@ -185,12 +198,12 @@ pub(crate) fn render_command(
                     s.noise_target.unwrap_or_default()
                 ),
             };
-            eprintln!("{name}: {spp} written to {}", out.display());
+            errln!("{name}: {spp} written to {}", out.display());
             ExitCode::SUCCESS
         }
         reason if held == 0 => {
             debug_assert_eq!(reason, StopReason::Interrupted);
-            eprintln!("lumen: interrupted before the first pass finished; nothing written");
+            errln!("lumen: interrupted before the first pass finished; nothing written");
             ExitCode::from(EXIT_INTERRUPTED)
         }
         reason => {
@@ -199,7 +212,7 @@ pub(crate) fn render_command(
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 _ => ("time limit reached", ExitCode::SUCCESS),
             };
-            eprintln!(
+            errln!(
                 "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
                 out.display(),
                 ckpt_path.display()
@@ -207,11 +220,12 @@ pub(crate) fn render_command(
             code
         }
     };
-    eprintln!("{}", summary(&run.stats, &session.stats(), elapsed));
+    errln!("{}", summary(&run.stats, &session.stats(), elapsed));
     let all = session.stats();
     if let Some(warning) = all.dropped_warning() {
-        eprintln!("lumen: warning: {warning}");
+        errln!("lumen: warning: {warning}");
     }
+    drop(locks);
     if all.all_dropped() {
         return Ok(ExitCode::FAILURE);
     }

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, TryLockError};
 use std::time::{Duration, Instant};
 
 /// Exit status of a render stopped by Ctrl-C or SIGTERM (128 + SIGINT).
@@ -12,6 +12,9 @@ pub(crate) const EXIT_INTERRUPTED: u8 = 130;
 static SAVING: Mutex<()> = Mutex::new(());
 /// Set by a second interrupt.
 static QUIT: AtomicBool = AtomicBool::new(false);
+/// The render's lock files, removed when it quits at once: the process
+/// exits without unwinding, so their guards never run.
+static LOCK_FILES: OnceLock<Vec<PathBuf>> = OnceLock::new();
 
 pub(crate) fn saving() -> MutexGuard<'static, ()> {
     SAVING
@@ -28,7 +31,10 @@ pub(crate) fn quit_if_asked() {
 }
 
 fn quit_now() -> ! {
-    eprintln!("lumen: stopped at once; the files on disk are those of the last save");
+    for lock in LOCK_FILES.get().into_iter().flatten() {
+        let _ = std::fs::remove_file(lock);
+    }
+    errln!("lumen: stopped at once; the files on disk are those of the last save");
     std::process::exit(i32::from(EXIT_INTERRUPTED))
 }
 
@@ -38,12 +44,17 @@ fn quit_now() -> ! {
 /// place only once written. A save in progress is let finish, so as not to
 /// leave its temporary files behind (the saver exits after it); should it
 /// take more than two seconds, its temporary files are removed and the
-/// process exits anyway.
-pub(crate) fn install_stop_handler(stop: &Arc<AtomicBool>, temps: [PathBuf; 2]) -> Result<()> {
+/// process exits anyway. Quitting at once removes the `locks` files.
+pub(crate) fn install_stop_handler(
+    stop: &Arc<AtomicBool>,
+    temps: [PathBuf; 2],
+    locks: Vec<PathBuf>,
+) -> Result<()> {
+    let _ = LOCK_FILES.set(locks);
     let stop = Arc::clone(stop);
     ctrlc::set_handler(move || {
         if !stop.swap(true, Ordering::SeqCst) {
-            eprintln!(
+            errln!(
                 "lumen: stopping: saving the image and a checkpoint (interrupt again to quit at once)"
             );
             return;

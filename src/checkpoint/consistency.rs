@@ -1,0 +1,115 @@
+//! A checkpoint's content checked against itself: the checksum only says
+//! that the bytes are those that were written, not that the writer was
+//! lumen, nor that it was right. A checkpoint whose counts, sums and flags
+//! do not agree would silently change the image (a pixel with no samples
+//! shows black, a NaN sum spreads), so it is refused on reading.
+
+use super::Checkpoint;
+use crate::film::Sum;
+
+impl Checkpoint {
+    /// Checks what a checkpoint can be checked against on its own: it holds
+    /// samples; every pixel's count is at most the samples per pixel done;
+    /// every sum is finite, and zero where there is no sample; the sample
+    /// counts add up; the halves of an adaptive film fit in the whole.
+    /// Whether it fits the render (size, pass schedule) is checked when it
+    /// is resumed ([`crate::progressive::Session::restore`]).
+    pub(super) fn check_consistency(&self) -> Result<(), String> {
+        let (w, h) = (self.film.width(), self.film.height());
+        if w == 0 || h == 0 {
+            return Err(format!("its image is {w}x{h} pixels"));
+        }
+        let done = self.spp_done;
+        if done == 0 {
+            return Err("it holds no samples (0 spp done)".into());
+        }
+        let at = |i: usize| format!("pixel ({}, {})", i % w as usize, i / w as usize);
+        let (sums, counts) = self.film.raw();
+        check_pixels(sums, counts, done, &at, "")?;
+        let counted: u64 = counts.iter().map(|&c| u64::from(c)).sum();
+        let s = self.stats;
+        if s.dropped > s.samples || counted != s.samples - s.dropped {
+            return Err(format!(
+                "its pixels hold {counted} samples, but it counts {} taken and {} dropped",
+                s.samples, s.dropped
+            ));
+        }
+        let pixels = self.film.len() as u64;
+        let most = pixels * u64::from(done);
+        match &self.active {
+            None if s.samples != most => Err(format!(
+                "it counts {} samples, but {pixels} pixels at {done} spp are {most}",
+                s.samples
+            )),
+            None => Ok(()),
+            Some(active) => {
+                if s.samples > most {
+                    return Err(format!(
+                        "it counts {} samples, more than {pixels} pixels at {done} spp",
+                        s.samples
+                    ));
+                }
+                if done < crate::adaptive::MIN_SAMPLES && active.iter().any(|a| !a) {
+                    return Err(format!(
+                        "pixels stopped sampling before {} spp",
+                        crate::adaptive::MIN_SAMPLES
+                    ));
+                }
+                // A pixel still sampling took every sample so far: what its
+                // count lacks was dropped.
+                let lacking: u64 = counts
+                    .iter()
+                    .zip(active)
+                    .filter(|(_, &on)| on)
+                    .map(|(&c, _)| u64::from(done - c))
+                    .sum();
+                if lacking > s.dropped {
+                    return Err(format!(
+                        "its pixels still sampling lack {lacking} of their {done} samples, but only {} were dropped",
+                        s.dropped
+                    ));
+                }
+                // Samples 0..done hold done / 2 of odd index.
+                let (odd_sums, odd_counts) = self.film.raw_odd();
+                check_pixels(odd_sums, odd_counts, done / 2, &at, " of odd index")?;
+                match counts
+                    .iter()
+                    .zip(odd_counts)
+                    .position(|(c, o)| c - o > done - done / 2)
+                {
+                    Some(i) => Err(format!(
+                        "{} has more samples of even index than {done} spp hold",
+                        at(i)
+                    )),
+                    None => Ok(()),
+                }
+            }
+        }
+    }
+}
+
+/// Checks one set of per-pixel sums and counts: counts at most `most`, and
+/// sums zero where the count is.
+fn check_pixels(
+    sums: &[Sum],
+    counts: &[u32],
+    most: u32,
+    at: &dyn Fn(usize) -> String,
+    which: &str,
+) -> Result<(), String> {
+    for (i, (sum, &count)) in sums.iter().zip(counts).enumerate() {
+        if count > most {
+            return Err(format!(
+                "{} has {count} samples{which}, more than the {most} its spp allow",
+                at(i)
+            ));
+        }
+        if count == 0 && *sum != Sum::ZERO {
+            return Err(format!(
+                "{} has no samples{which} but a sum that is not zero",
+                at(i)
+            ));
+        }
+    }
+    Ok(())
+}
