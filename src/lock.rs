@@ -70,7 +70,7 @@ impl RenderLock {
             lock: lock.clone(),
             message,
         };
-        crate::files::check_regular(&lock).map_err(&io)?;
+        check_lock_file(&lock).map_err(&io)?;
         // A holder that finishes removes the file, possibly between our
         // opening it and locking it: the lock would then be on a file nobody
         // else sees, so it is taken again on the file now at the path.
@@ -127,6 +127,30 @@ impl Drop for RenderLock {
     }
 }
 
+/// Checks that what is at `lock`, if anything, is a lock file lumen made:
+/// a regular file, not a link (writing the process id through a link would
+/// overwrite the file it points to), holding a process id or nothing.
+fn check_lock_file(lock: &Path) -> Result<(), String> {
+    match fs::symlink_metadata(lock) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e.to_string()),
+        Ok(meta) if meta.file_type().is_symlink() => {
+            return Err("is a symbolic link, not a lock file of lumen's; remove it".into())
+        }
+        Ok(_) => crate::files::check_regular(lock)?,
+    }
+    let mut text = Vec::new();
+    File::open(lock)
+        .and_then(|f| f.take(64).read_to_end(&mut text))
+        .map_err(|e| e.to_string())?;
+    let ours = text.len() <= 20 && text.iter().all(u8::is_ascii_digit);
+    if ours {
+        Ok(())
+    } else {
+        Err("exists and is not a lock file of lumen's (it holds something other than a process id); move or remove it".into())
+    }
+}
+
 /// Whether the open `file` is the file now at `path`.
 fn same_file(file: &File, path: &Path) -> bool {
     #[cfg(unix)]
@@ -166,6 +190,22 @@ mod tests {
         drop(held);
         assert!(!dir.join(".out.png.lumen-lock").exists());
         drop(RenderLock::acquire(&target).unwrap());
+        // Someone's file, or a link to one, at the lock path is left alone.
+        let lock = dir.join(".out.png.lumen-lock");
+        fs::write(&lock, "my notes").unwrap();
+        let e = RenderLock::acquire(&target).unwrap_err().to_string();
+        assert!(e.contains("not a lock file"), "{e}");
+        assert_eq!(fs::read_to_string(&lock).unwrap(), "my notes");
+        fs::remove_file(&lock).unwrap();
+        #[cfg(unix)]
+        {
+            let notes = dir.join("notes");
+            fs::write(&notes, "12").unwrap();
+            std::os::unix::fs::symlink(&notes, &lock).unwrap();
+            let e = RenderLock::acquire(&target).unwrap_err().to_string();
+            assert!(e.contains("symbolic link"), "{e}");
+            assert_eq!(fs::read_to_string(&notes).unwrap(), "12");
+        }
         fs::remove_dir_all(&dir).unwrap();
     }
 }

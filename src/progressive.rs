@@ -225,6 +225,8 @@ impl Session {
             path: path.to_path_buf(),
             message,
         };
+        // Checked on decoding too; a checkpoint built in memory is not.
+        checkpoint.check_consistency().map_err(malformed)?;
         if (checkpoint.film.width(), checkpoint.film.height()) != (s.width, s.height) {
             return Err(malformed(format!(
                 "its image is {}x{}, the render's {}x{}",

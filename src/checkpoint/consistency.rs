@@ -14,7 +14,7 @@ impl Checkpoint {
     /// counts add up; the halves of an adaptive film fit in the whole.
     /// Whether it fits the render (size, pass schedule) is checked when it
     /// is resumed ([`crate::progressive::Session::restore`]).
-    pub(super) fn check_consistency(&self) -> Result<(), String> {
+    pub(crate) fn check_consistency(&self) -> Result<(), String> {
         let (w, h) = (self.film.width(), self.film.height());
         if w == 0 || h == 0 {
             return Err(format!("its image is {w}x{h} pixels"));
