@@ -354,7 +354,7 @@ fn unknown_material_message(name: &str, known: &[String]) -> String {
     } else {
         format!(
             "no material named \"{name}\"; defined materials: {}",
-            known.join(", ")
+            hint::listing(name, known.iter().map(String::as_str), str::to_string)
         )
     }
 }
