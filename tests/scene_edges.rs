@@ -254,3 +254,43 @@ fn a_scene_file_is_never_exported_over_itself() {
         .unwrap()
         .contains("a comment"));
 }
+
+/// Materials `m0`, `m1`, … and one sphere of material `wanted`.
+fn many_materials(n: usize, wanted: &str) -> String {
+    let mut text = String::from("[materials]\n");
+    for i in 0..n {
+        text += &format!("m{i} = {{ type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }}\n");
+    }
+    text + &format!(
+        "\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, -1]\nradius = 0.5\nmaterial = \"{wanted}\"\n"
+    )
+}
+
+#[test]
+fn messages_list_a_few_of_many_names() {
+    let text = many_materials(200_000, "m1234x");
+    let file = parse(&text, Format::Toml).unwrap();
+    let err = file.compile(&Overrides::default()).unwrap_err().to_string();
+    assert!(err.len() < 600, "{} bytes: {}", err.len(), &err[..600]);
+    assert!(
+        err.starts_with("s.toml:200007:12: objects[0].material: no material named \"m1234x\"; defined materials: m1234, "),
+        "{err}"
+    );
+    assert!(err.contains(" and 199992 more"), "{err}");
+    assert!(err.contains("did you mean \"m1234\"?"), "{err}");
+
+    let mut text = String::new();
+    for i in 0..20 {
+        text += &format!("[textures.t{i}]\ntype = \"noise\"\n");
+    }
+    text += "[materials.m]\ntype = \"diffuse\"\nalbedo = \"t17x\"\n";
+    let err = parse(&text, Format::Toml)
+        .unwrap()
+        .compile(&Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("no texture named \"t17x\" (defined: t17, ") && err.contains(" and 12 more)"),
+        "{err}"
+    );
+}

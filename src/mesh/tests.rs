@@ -818,7 +818,9 @@ fn corrupt_or_inconsistent_gltf_is_refused() {
         gltf_json(&data_uri(&nan), nodes, ""),
         "vertex 1 has a non-finite position",
     );
-    // A transform that overflows f32.
+    // A transform beyond f32: JSON numbers are read exactly (serde_json's
+    // `float_roundtrip`, which scene files need), so it is refused where
+    // it is written, with its line and column.
     gltf_refused(
         "inf.gltf",
         gltf_json(
@@ -826,7 +828,7 @@ fn corrupt_or_inconsistent_gltf_is_refused() {
             r#"[{"mesh": 0, "scale": [1e39, 1, 1]}]"#,
             "",
         ),
-        "non-finite transform",
+        "number out of range at line",
     );
     // Only degenerate triangles.
     let mut flat = buf.clone();

@@ -51,12 +51,10 @@ fn child(path: &str, key: &str) -> String {
     }
 }
 
-fn quoted(names: &[&str]) -> String {
-    names
-        .iter()
-        .map(|n| format!("`{n}`"))
-        .collect::<Vec<_>>()
-        .join(", ")
+/// `names` in backquotes for a message, the closest to `near` first when
+/// there are many (see [`hint::listing`]).
+fn quoted(near: &str, names: &[&str]) -> String {
+    hint::listing(near, names.iter().copied(), |n| format!("`{n}`"))
 }
 
 /// A table of the file with its known fields checked.
@@ -106,12 +104,12 @@ impl<'a> Table<'a> {
                     format!(
                         "`{}` belongs to {owner}; {what} has {}",
                         e.key,
-                        quoted(known)
+                        quoted(&e.key, known)
                     )
                 } else if let Some(close) = hint::closest(&e.key, known.iter().copied()) {
                     format!("did you mean `{close}`?")
                 } else {
-                    format!("{what} has {}", quoted(known))
+                    format!("{what} has {}", quoted(&e.key, known))
                 },
             );
             return Err(err);
@@ -301,11 +299,7 @@ fn keyword<T: Copy>(node: &Node, path: &str, options: &[(&str, T)]) -> Result<T>
         &node.span,
         format!(
             "unknown value {name:?}, expected one of {}",
-            names
-                .iter()
-                .map(|n| format!("{n:?}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            hint::listing(name, names.iter().copied(), |n| format!("{n:?}"))
         ),
     );
     err.hint = hint::closest(name, names.iter().copied()).map(|c| format!("did you mean {c:?}?"));
@@ -981,7 +975,7 @@ fn transform_step(node: &Node, path: &str) -> Result<TransformDesc> {
             &node.span,
             format!(
                 "a transform step has exactly one of {}, got {}",
-                quoted(TRANSFORM_STEPS),
+                quoted("", TRANSFORM_STEPS),
                 t.entries.len()
             ),
         ));

@@ -35,14 +35,50 @@ pub struct SceneDesc {
     #[serde(default)]
     pub background: BackgroundDesc,
     /// Textures by name; materials refer to them by name.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "BTreeMap::is_empty",
+        deserialize_with = "unique_names"
+    )]
     pub textures: BTreeMap<String, TextureDesc>,
     /// Materials by name; objects refer to them by name.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "unique_names")]
     pub materials: BTreeMap<String, MaterialDesc>,
     /// The objects of the scene.
     #[serde(default)]
     pub objects: Vec<ObjectDesc>,
+}
+
+/// A table of named entries in which no name is given twice (a JSON object
+/// may repeat a key; serde would keep the last).
+fn unique_names<'de, D, T>(deserializer: D) -> Result<BTreeMap<String, T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    struct Names<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Names<T> {
+        type Value = BTreeMap<String, T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a table of named entries")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some((name, value)) = map.next_entry::<String, T>()? {
+                if out.contains_key(&name) {
+                    return Err(serde::de::Error::custom(format!(
+                        "`{name}` is defined twice"
+                    )));
+                }
+                out.insert(name, value);
+            }
+            Ok(out)
+        }
+    }
+    deserializer.deserialize_map(Names(std::marker::PhantomData))
 }
 
 impl SceneDesc {

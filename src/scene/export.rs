@@ -1,8 +1,90 @@
-//! Writing a description out as a scene file, and the checks that keep an
-//! export from destroying its own input.
+//! Writing a description out as a scene file, one object at a time, and
+//! the checks that keep an export from destroying its own input.
 
+use super::desc::{
+    BackgroundDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc, SceneDesc, TextureDesc,
+};
+use super::file::Format;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
 use std::fmt;
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+
+/// The first line of every exported TOML file.
+const TOML_HEADER: &str = "# A lumen scene. Every field is described in docs/scene-format.md.\n\n";
+
+/// Writes `desc` as a scene file of `format` to `out`. Reading the text
+/// back gives `desc` again, and writing that gives the same text. The
+/// objects are written one by one: a scene of millions of them needs no
+/// more memory than its description (the `toml` crate would build a
+/// document of the whole file first, many times its size).
+pub fn write_scene(desc: &SceneDesc, format: Format, out: &mut impl Write) -> io::Result<()> {
+    let failed = |e: &dyn fmt::Display| io::Error::other(e.to_string());
+    match format {
+        Format::Json => {
+            serde_json::to_writer_pretty(&mut *out, desc).map_err(|e| {
+                // An error of the writer is the writer's, not the format's.
+                e.io_error_kind()
+                    .map_or_else(|| failed(&e), |kind| io::Error::new(kind, e.to_string()))
+            })?;
+            out.write_all(b"\n")
+        }
+        // Without objects, `toml` writes `objects = []` among the first
+        // keys: the whole description is small, written at once.
+        Format::Toml if desc.objects.is_empty() => {
+            let body = toml::to_string(desc).map_err(|e| failed(&e))?;
+            out.write_all(TOML_HEADER.as_bytes())?;
+            out.write_all(body.as_bytes())
+        }
+        Format::Toml => {
+            let head = Head {
+                caption: &desc.caption,
+                render: &desc.render,
+                camera: &desc.camera,
+                background: &desc.background,
+                textures: &desc.textures,
+                materials: &desc.materials,
+            };
+            out.write_all(TOML_HEADER.as_bytes())?;
+            out.write_all(toml::to_string(&head).map_err(|e| failed(&e))?.as_bytes())?;
+            // Written in order, made on every core a few thousand at a time.
+            for chunk in desc.objects.chunks(4096) {
+                let tables: Vec<String> = chunk
+                    .par_iter()
+                    .map(|object| toml::to_string(&One { objects: [object] }))
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| failed(&e))?;
+                for table in tables {
+                    out.write_all(b"\n")?;
+                    out.write_all(table.as_bytes())?;
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+/// A [`SceneDesc`] without its objects, borrowed, written as the
+/// description writes those fields.
+#[derive(Serialize)]
+struct Head<'a> {
+    #[serde(skip_serializing_if = "String::is_empty")]
+    caption: &'a String,
+    render: &'a RenderDesc,
+    camera: &'a CameraDesc,
+    background: &'a BackgroundDesc,
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    textures: &'a BTreeMap<String, TextureDesc>,
+    materials: &'a BTreeMap<String, MaterialDesc>,
+}
+
+/// One object, as a `[[objects]]` table.
+#[derive(Serialize)]
+struct One<'a> {
+    objects: [&'a ObjectDesc; 1],
+}
 
 /// An export would write over the scene file it reads: refused, since the
 /// file would lose everything a description does not keep (its comments,
@@ -67,6 +149,25 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn objects_written_one_by_one_read_as_the_whole_document() {
+        let mut descs: Vec<SceneDesc> = crate::scene::builtin::BUILTINS
+            .iter()
+            .map(|b| b.desc())
+            .collect();
+        descs.push(SceneDesc::default());
+        for desc in descs {
+            let mut text = Vec::new();
+            write_scene(&desc, Format::Toml, &mut text).unwrap();
+            let whole = format!("{TOML_HEADER}{}", toml::to_string(&desc).unwrap());
+            assert_eq!(String::from_utf8(text).unwrap(), whole, "{}", desc.caption);
+            let mut text = Vec::new();
+            write_scene(&desc, Format::Json, &mut text).unwrap();
+            let whole = serde_json::to_string_pretty(&desc).unwrap() + "\n";
+            assert_eq!(String::from_utf8(text).unwrap(), whole);
+        }
+    }
 
     #[test]
     fn a_file_is_the_same_by_any_name_and_not_another() {

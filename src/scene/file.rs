@@ -20,11 +20,13 @@
 //! ```
 
 use super::decode;
+use super::fast;
 use super::source::{self, Node, Value};
 use super::{Overrides, Scene, SceneDesc, SceneError};
 use std::fmt;
 use std::ops::Range;
 use std::path::Path;
+use std::sync::OnceLock;
 use thiserror::Error;
 
 /// The two scene file formats, chosen by file extension.
@@ -136,21 +138,18 @@ pub struct ExportError {
     pub message: String,
 }
 
-/// The first line of every exported TOML file.
-const TOML_HEADER: &str = "# A lumen scene. Every field is described in docs/scene-format.md.\n\n";
-
 /// Writes `desc` as a scene file of the given format. Reading the text back
-/// gives `desc` again, and writing that gives the same text.
+/// gives `desc` again, and writing that gives the same text (see
+/// [`super::export::write_scene`], which writes it to a file or a pipe as
+/// it goes).
 pub fn export(desc: &SceneDesc, format: Format) -> Result<String, ExportError> {
-    let failed = |message: String| ExportError { format, message };
-    match format {
-        Format::Toml => toml::to_string(desc)
-            .map(|body| format!("{TOML_HEADER}{body}"))
-            .map_err(|e| failed(e.to_string())),
-        Format::Json => serde_json::to_string_pretty(desc)
-            .map(|body| body + "\n")
-            .map_err(|e| failed(e.to_string())),
-    }
+    let mut text = Vec::new();
+    super::export::write_scene(desc, format, &mut text).map_err(|e| ExportError {
+        format,
+        message: e.to_string(),
+    })?;
+    // Both writers write UTF-8 only.
+    Ok(String::from_utf8(text).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into()))
 }
 
 /// A parsed scene file, kept with its text so that errors found later (when
@@ -166,7 +165,7 @@ pub struct SceneFile {
     /// The directory mesh files are relative to: the file's own.
     pub dir: std::path::PathBuf,
     source: String,
-    root: Node,
+    root: OnceLock<Node>,
 }
 
 impl SceneFile {
@@ -204,32 +203,45 @@ impl SceneFile {
 
     /// Parses `text` in `format`; `name` is used in messages, and mesh
     /// files are found relative to the working directory.
+    ///
+    /// A file without mistakes is read straight into its description; only
+    /// a file with one is read again, slowly, to say exactly where and what
+    /// it is (the result is the same as [`SceneFile::parse_with_positions`]).
     pub fn parse(
         name: impl Into<String>,
         mut text: String,
         format: Format,
     ) -> Result<SceneFile, SceneFileError> {
-        let name = name.into();
-        // A byte-order mark only says the text is UTF-8 (some Windows
-        // editors write one): dropped in both formats, so that columns on
-        // the first line count from its first visible character.
-        if text.starts_with(BOM) {
-            text.drain(..BOM.len_utf8());
-        }
-        let parsed = if is_blank(&text) {
-            // Nothing but whitespace is the empty scene in both formats, as
-            // an empty TOML document is (JSON would call it a syntax error).
-            Ok(Node {
-                span: 0..0,
-                value: Value::Table(Vec::new()),
-            })
+        drop_bom(&mut text);
+        let desc = if is_blank(&text) {
+            Some(SceneDesc::default())
         } else {
-            match format {
-                Format::Toml => source::parse_toml(&text),
-                Format::Json => source::parse_json(&text),
-            }
+            fast::read(&text, format)
         };
-        let root = parsed.map_err(|e| {
+        match desc {
+            Some(desc) => Ok(SceneFile {
+                name: name.into(),
+                format,
+                desc,
+                dir: std::path::PathBuf::new(),
+                source: text,
+                root: OnceLock::new(),
+            }),
+            None => Self::parse_with_positions(name, text, format),
+        }
+    }
+
+    /// [`SceneFile::parse`] by the reader that records where every value is
+    /// written, the one that words the error messages: several times
+    /// slower, and several kilobytes an object, on large files.
+    pub fn parse_with_positions(
+        name: impl Into<String>,
+        mut text: String,
+        format: Format,
+    ) -> Result<SceneFile, SceneFileError> {
+        let name = name.into();
+        drop_bom(&mut text);
+        let root = tree(&text, format).map_err(|e| {
             // toml_edit splits its message over lines; keep the message on one.
             let message = e.message.lines().collect::<Vec<_>>().join("; ");
             let mut err = Diagnostic::plain(&name, format!("syntax error: {message}"));
@@ -251,7 +263,18 @@ impl SceneFile {
             desc,
             dir: std::path::PathBuf::new(),
             source: text,
-            root,
+            root: OnceLock::from(root),
+        })
+    }
+
+    /// The file's values with their positions, read when first needed (to
+    /// place an error found when compiling).
+    fn root(&self) -> &Node {
+        self.root.get_or_init(|| {
+            tree(&self.source, self.format).unwrap_or(Node {
+                span: 0..0,
+                value: Value::Table(Vec::new()),
+            })
         })
     }
 
@@ -271,6 +294,21 @@ impl SceneFile {
         Ok((desc, scene))
     }
 
+    /// [`SceneFile::resolve`], consuming the file: the description is moved
+    /// rather than copied (a file may hold millions of objects), and the
+    /// file's text is freed once the scene is compiled.
+    pub fn into_resolved(
+        mut self,
+        overrides: &Overrides,
+    ) -> Result<(SceneDesc, Scene), SceneFileError> {
+        let mut desc = std::mem::take(&mut self.desc);
+        overrides.apply(&mut desc);
+        match Scene::from_desc_in(&desc, &self.dir) {
+            Ok(scene) => Ok((desc, scene)),
+            Err(e) => Err(self.locate(&e, overrides)),
+        }
+    }
+
     /// `error`, found when compiling this file's scene, with the file's name,
     /// the line and column of the field at fault, and a hint where one helps.
     pub fn locate(&self, error: &SceneError, overrides: &Overrides) -> SceneFileError {
@@ -280,7 +318,7 @@ impl SceneFile {
         if overridden(overrides).contains(&field.as_str()) {
             err.message
                 .push_str(" (with the settings given on the command line)");
-        } else if let Some(span) = find(&self.root, &field) {
+        } else if let Some(span) = find(self.root(), &field) {
             err = err.at(&self.source, span);
         }
         err.field = Some(field);
@@ -290,6 +328,31 @@ impl SceneFile {
 
 /// The Unicode byte-order mark.
 const BOM: char = '\u{feff}';
+
+/// A byte-order mark only says the text is UTF-8 (some Windows editors
+/// write one): dropped in both formats, so that columns on the first line
+/// count from its first visible character.
+fn drop_bom(text: &mut String) {
+    if text.starts_with(BOM) {
+        text.drain(..BOM.len_utf8());
+    }
+}
+
+/// The tree of `text`'s values and their positions. Nothing but whitespace
+/// is the empty scene in both formats, as an empty TOML document is (JSON
+/// would call it a syntax error).
+fn tree(text: &str, format: Format) -> Result<Node, source::SyntaxError> {
+    if is_blank(text) {
+        return Ok(Node {
+            span: 0..0,
+            value: Value::Table(Vec::new()),
+        });
+    }
+    match format {
+        Format::Toml => source::parse_toml(text),
+        Format::Json => source::parse_json(text),
+    }
+}
 
 /// Whether `text` holds nothing but the whitespace both formats allow
 /// between values (space, tab, line breaks).

@@ -54,9 +54,62 @@ where
     })
 }
 
+/// Most names a message lists: a message stays a line or two however many
+/// names a scene defines.
+pub const MAX_LISTED: usize = 8;
+
+/// `candidates`, each written by `show`, for a message such as "defined
+/// materials: …": all of them, in their order, when there are at most
+/// [`MAX_LISTED`]; otherwise the [`MAX_LISTED`] closest to `name` by edit
+/// distance (the closest first, ties in their order) and how many more
+/// there are. Every message that lists names goes through here.
+pub fn listing<'a, I>(name: &str, candidates: I, show: impl Fn(&str) -> String) -> String
+where
+    I: IntoIterator<Item = &'a str>,
+{
+    let mut names: Vec<&str> = candidates.into_iter().collect();
+    let more = names.len().saturating_sub(MAX_LISTED);
+    if more > 0 {
+        let lower = name.to_lowercase();
+        // Edit distance costs the product of the lengths: a name far longer
+        // than the one asked for is cut first (it cannot be close anyway).
+        let limit = lower.chars().count() * 2 + 8;
+        let mut scored: Vec<(usize, usize, &str)> = names
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let short: String = c.to_lowercase().chars().take(limit).collect();
+                (edit_distance(&lower, &short), i, *c)
+            })
+            .collect();
+        scored.select_nth_unstable(MAX_LISTED - 1);
+        scored.truncate(MAX_LISTED);
+        scored.sort_unstable();
+        names = scored.into_iter().map(|(_, _, c)| c).collect();
+    }
+    let mut text = names.iter().map(|n| show(n)).collect::<Vec<_>>().join(", ");
+    if more > 0 {
+        text.push_str(&format!(" and {more} more"));
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn listings_are_short_and_start_with_the_closest_names() {
+        let few = ["b", "a", "c"];
+        assert_eq!(listing("x", few, |n| format!("`{n}`")), "`b`, `a`, `c`");
+        assert_eq!(listing("x", Vec::<&str>::new(), str::to_string), "");
+        let many: Vec<String> = (0..200_000).map(|i| format!("material{i}")).collect();
+        let text = listing("material7", many.iter().map(String::as_str), str::to_string);
+        assert!(text.starts_with("material7, "), "{text}");
+        assert!(text.ends_with(" and 199992 more"), "{text}");
+        assert_eq!(text.matches(", ").count(), MAX_LISTED - 1, "{text}");
+        assert!(text.len() < 200, "{text}");
+    }
 
     #[test]
     fn distance_counts_edits() {

@@ -6,8 +6,10 @@ mod compile;
 mod decode;
 pub mod desc;
 pub mod export;
+mod fast;
 pub mod file;
 pub mod hint;
+mod plain_toml;
 pub mod source;
 mod textures;
 mod world;
@@ -354,7 +356,7 @@ fn unknown_material_message(name: &str, known: &[String]) -> String {
     } else {
         format!(
             "no material named \"{name}\"; defined materials: {}",
-            known.join(", ")
+            hint::listing(name, known.iter().map(String::as_str), str::to_string)
         )
     }
 }

@@ -242,7 +242,7 @@ struct Scanner<'a> {
 
 /// Deepest nesting of JSON arrays and objects accepted: far more than any
 /// scene needs, far less than would overflow the stack.
-const MAX_DEPTH: usize = 64;
+pub(super) const MAX_DEPTH: usize = 64;
 
 impl Scanner<'_> {
     fn peek(&self) -> Option<u8> {

@@ -4,7 +4,7 @@
 //! recorded as sources of the scene.
 
 use super::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
-use super::{invalid, MeshSource, SceneError};
+use super::{hint, invalid, MeshSource, SceneError};
 use crate::math::Color;
 use crate::texture::{Image, NoisePattern, Perlin, Texture};
 use std::collections::{BTreeMap, HashMap};
@@ -94,12 +94,11 @@ impl<'a> TextureTable<'a> {
         }
         let descs = self.descs;
         let Some((key, desc)) = descs.get_key_value(name) else {
-            let mut known: Vec<&str> = descs.keys().map(String::as_str).collect();
-            known.truncate(8);
-            let listed = if known.is_empty() {
+            let listed = if descs.is_empty() {
                 "the scene defines no textures".to_string()
             } else {
-                format!("defined: {}", known.join(", "))
+                let known = descs.keys().map(String::as_str);
+                format!("defined: {}", hint::listing(name, known, str::to_string))
             };
             return Err(invalid(
                 field,
@@ -189,13 +188,11 @@ pub(crate) fn read_image(
     let bytes = match file.strip_prefix(EMBEDDED_PREFIX) {
         Some(name) => embedded(name)
             .ok_or_else(|| {
-                let known: Vec<String> = EMBEDDED
-                    .iter()
-                    .map(|(n, _)| format!("{EMBEDDED_PREFIX}{n}"))
-                    .collect();
+                let known = EMBEDDED.iter().map(|(n, _)| *n);
+                let show = |n: &str| format!("{EMBEDDED_PREFIX}{n}");
                 fail(format!(
                     "{file}: lumen has no such image (it has {})",
-                    known.join(", ")
+                    hint::listing(name, known, show)
                 ))
             })?
             .to_vec(),

@@ -6,6 +6,7 @@ use lumen::bench;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::desc::SceneDesc;
+use lumen::scene::hint;
 use lumen::scene::Sampling;
 use std::path::Path;
 use std::time::Instant;
@@ -81,10 +82,10 @@ pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<(
             .iter()
             .map(|w| w.name)
             .collect();
+        let only = only.unwrap_or("");
         return Err(anyhow!(
-            "no workload named '{}'; the workloads are {}",
-            only.unwrap_or(""),
-            names.join(", ")
+            "no workload named '{only}'; the workloads are {}",
+            hint::listing(only, names, str::to_string)
         ));
     }
     outln!(
@@ -159,10 +160,10 @@ fn efficiency_workloads(only: Option<&str>) -> Result<Vec<(&'static str, SceneDe
         .cloned()
         .collect();
     if chosen.is_empty() {
+        let only = only.unwrap_or("");
         return Err(anyhow!(
-            "no efficiency workload named '{}'; they are {}",
-            only.unwrap_or(""),
-            names.join(", ")
+            "no efficiency workload named '{only}'; they are {}",
+            hint::listing(only, names, str::to_string)
         ));
     }
     Ok(chosen)

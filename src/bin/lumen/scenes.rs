@@ -1,12 +1,14 @@
 //! Where scenes come from (built-in names or files) and `lumen scenes export`.
 
-use crate::{write_stdout, FormatArg};
+use crate::FormatArg;
 use anyhow::{anyhow, bail, Context, Result};
 use lumen::output;
 use lumen::scene::builtin::{self, BUILTINS};
 use lumen::scene::export;
-use lumen::scene::file::{self, Format, SceneFile};
+use lumen::scene::file::{Format, SceneFile};
 use lumen::scene::{hint, Overrides, Scene, SceneDesc};
+use std::fs::File;
+use std::io::Write as _;
 use std::path::Path;
 
 /// Where a scene comes from: a built-in name or a file.
@@ -25,16 +27,16 @@ impl SceneSource {
 
     /// The description with the command-line overrides, and the scene
     /// compiled from it; a mistake in a file is reported with its line and
-    /// column before any work starts.
-    pub(crate) fn resolve(&self, name: &str, overrides: &Overrides) -> Result<(SceneDesc, Scene)> {
+    /// column before any work starts. The description is moved, not
+    /// copied: a file may hold millions of objects.
+    pub(crate) fn resolve(self, name: &str, overrides: &Overrides) -> Result<(SceneDesc, Scene)> {
         match self {
-            SceneSource::Builtin(d) => {
-                let mut desc = d.clone();
+            SceneSource::Builtin(mut desc) => {
                 overrides.apply(&mut desc);
                 let scene = Scene::from_desc(&desc).with_context(|| format!("scene '{name}'"))?;
                 Ok((desc, scene))
             }
-            SceneSource::File(f) => Ok(f.resolve(overrides)?),
+            SceneSource::File(f) => Ok(f.into_resolved(overrides)?),
         }
     }
 }
@@ -79,14 +81,26 @@ pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) 
             FormatArg::Json => Format::Json,
         },
     };
-    let text = file::export(source.desc(), format)?;
+    let desc = source.desc();
     match out {
         Some(path) => {
             output::check_writable(path)?;
-            output::write_bytes_atomic(path, text.as_bytes())?;
+            output::write_atomic(path, |tmp| {
+                let mut w = std::io::BufWriter::new(File::create(tmp).map_err(|e| e.to_string())?);
+                export::write_scene(desc, format, &mut w)
+                    .and_then(|()| w.flush())
+                    .map_err(|e| e.to_string())
+            })?;
             eprintln!("{name}: written to {}", path.display());
         }
-        None => write_stdout(&text)?,
+        None => {
+            let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+            match export::write_scene(desc, format, &mut w).and_then(|()| w.flush()) {
+                // `lumen scenes export x | head` ends quietly.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+                result => result.context("cannot write to standard output")?,
+            }
+        }
     }
     Ok(())
 }
