@@ -20,7 +20,9 @@
 //! | *n* | payload |
 //!
 //! The payload: the renderer identity and the description (each as a u32 length
-//! and UTF-8 bytes), samples per pixel done (u32), width and height (u32),
+//! and UTF-8 bytes), the end of the samples done, the share of sample indices
+//! the render takes (start and end: `0` and the spp for a whole render, less
+//! for a part of one), the display gamma (f32), width and height (u32 each),
 //! samples, rays and dropped samples (u64 each), then every pixel's three
 //! sums (`i128`, 64.64 fixed point: [`crate::film::Sum`]) and every pixel's `u32` count (pixels row-major, top row
 //! first), and last a byte saying whether the render samples adaptively (1)
@@ -33,6 +35,7 @@ use crate::output::{self, OutputError};
 use crate::render::RenderStats;
 use crate::scene::SceneDesc;
 use std::io::Read;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -42,6 +45,7 @@ mod header;
 mod identity;
 
 pub use header::{inspect, remove, Existing};
+pub(crate) use identity::{describe_differences, same_render};
 pub use identity::{description_text, identity_text};
 
 /// First bytes of every checkpoint file.
@@ -69,8 +73,15 @@ pub struct Checkpoint {
     /// Canonical JSON of the scene description, overrides applied
     /// (see [`description_text`]).
     pub description: String,
-    /// Samples per pixel held by the film: samples `0..spp_done` of every pixel.
+    /// The sample indices this render takes in every pixel: `0..spp` for a
+    /// whole render, a share of them for a part of one ([`crate::part`]).
+    pub share: Range<u32>,
+    /// End of the samples the film holds: samples `share.start..spp_done`
+    /// of every pixel.
     pub spp_done: u32,
+    /// The display gamma the render writes its image with: not part of
+    /// what must match to resume, but what `lumen merge` writes parts with.
+    pub gamma: f32,
     /// Counts gathered while rendering those samples.
     pub stats: RenderStats,
     /// The accumulated samples.
@@ -168,14 +179,18 @@ pub fn default_path(output: &Path) -> PathBuf {
 
 /// A checkpoint to be written, borrowing the state it saves: a render in
 /// progress saves its film without copying it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct CheckpointView<'a> {
     /// [`RENDERER_ID`] of the lumen that writes it.
     pub renderer_id: &'a str,
     /// Canonical JSON of the scene description (see [`description_text`]).
     pub description: &'a str,
-    /// Samples per pixel held by the film.
+    /// The sample indices this render takes (see [`Checkpoint::share`]).
+    pub share: Range<u32>,
+    /// End of the samples the film holds.
     pub spp_done: u32,
+    /// The display gamma (see [`Checkpoint::gamma`]).
+    pub gamma: f32,
     /// Counts gathered while rendering those samples.
     pub stats: RenderStats,
     /// The accumulated samples.
@@ -204,7 +219,9 @@ impl Checkpoint {
         CheckpointView {
             renderer_id: &self.renderer_id,
             description: &self.description,
+            share: self.share.clone(),
             spp_done: self.spp_done,
+            gamma: self.gamma,
             stats: self.stats,
             film: &self.film,
             active: self.active.as_deref(),
@@ -294,7 +311,12 @@ impl Checkpoint {
         }
         Err(CheckpointError::Mismatch {
             path: path.to_path_buf(),
-            differences: identity::describe_differences(&self.description, ours),
+            differences: identity::describe_differences(
+                &self.description,
+                ours,
+                "the checkpoint",
+                "here",
+            ),
         })
     }
 }
@@ -320,7 +342,9 @@ mod tests {
         let ckpt = Checkpoint {
             renderer_id: RENDERER_ID.into(),
             description: description_text(&desc),
+            share: 0..16,
             spp_done: 16,
+            gamma: 2.0,
             stats: RenderStats {
                 samples: 16 * n as u64,
                 rays: 1234,

@@ -169,6 +169,26 @@ impl Film {
         )
     }
 
+    /// Adds the samples of `other`, a film of the same size: its pixels'
+    /// sums and counts are added to this film's (exactly, see [`Sum`]).
+    /// `false`, and nothing added, if the sizes differ or either film keeps
+    /// the halves of adaptive sampling.
+    pub fn add_film(&mut self, other: &Film) -> bool {
+        if (self.width, self.height) != (other.width, other.height)
+            || self.has_halves()
+            || other.has_halves()
+        {
+            return false;
+        }
+        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
+            *a = a.plus(*b);
+        }
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a = a.wrapping_add(*b);
+        }
+        true
+    }
+
     /// Whether the film keeps the sums of the samples of odd index.
     pub fn has_halves(&self) -> bool {
         !self.odd_counts.is_empty()

@@ -70,6 +70,7 @@ pub mod math;
 pub mod medium;
 pub mod mesh;
 pub mod output;
+pub mod part;
 pub mod progressive;
 pub mod ray;
 pub mod render;

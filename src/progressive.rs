@@ -37,6 +37,7 @@
 
 use crate::checkpoint::{identity_text, Checkpoint, CheckpointError, CheckpointView};
 use crate::film::Film;
+use crate::part::Part;
 use crate::render::{render_pixels, RenderStats};
 use crate::scene::{Scene, SceneDesc, SceneError};
 use std::ops::Range;
@@ -112,6 +113,10 @@ pub struct Session {
     /// abandoned; kept between passes so that no pass allocates one.
     backup: Film,
     stats: RenderStats,
+    /// The sample indices this session renders in every pixel: all of them,
+    /// or a part's share ([`Session::with_part`]).
+    share: Range<u32>,
+    /// End of the samples rendered: the film holds `share.start..spp_done`.
     spp_done: u32,
     /// With adaptive sampling, the pixels still being sampled.
     active: Option<Vec<bool>>,
@@ -126,6 +131,13 @@ pub enum SessionError {
     /// The checkpoint cannot be used.
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
+    /// Adaptive sampling decides each pass from all the samples before it,
+    /// which a part of the samples does not have.
+    #[error("part {part}: a render split into parts by samples cannot sample adaptively (render.noise_target is set); leave out the noise target")]
+    AdaptivePart {
+        /// The part asked for.
+        part: Part,
+    },
 }
 
 /// One finished pass.
@@ -178,15 +190,36 @@ impl Session {
             None => Film::new(w, h),
         };
         let active = scene.settings.noise_target.map(|_| vec![true; film.len()]);
+        let share = 0..scene.settings.samples_per_pixel;
         Self {
             description: identity_text(desc, &scene.sources),
             scene,
             film,
             backup: Film::new(0, 0),
             stats: RenderStats::default(),
+            share,
             spp_done: 0,
             active,
         }
+    }
+
+    /// A new render of `part` of the samples of `desc`, already compiled
+    /// into `scene`: the same film as the whole render, with the part's
+    /// share of every pixel's samples. Refused with adaptive sampling.
+    pub fn with_part(desc: &SceneDesc, scene: Scene, part: Part) -> Result<Self, SessionError> {
+        if scene.settings.noise_target.is_some() {
+            return Err(SessionError::AdaptivePart { part });
+        }
+        let share = part.samples(scene.settings.samples_per_pixel);
+        let mut session = Self::with_scene(desc, scene);
+        session.spp_done = share.start;
+        session.share = share;
+        Ok(session)
+    }
+
+    /// The sample indices this session renders in every pixel.
+    pub fn share(&self) -> Range<u32> {
+        self.share.clone()
     }
 
     /// Continues the render of `desc` saved in `checkpoint` (read from
@@ -237,6 +270,13 @@ impl Session {
             ))
             .into());
         }
+        if checkpoint.share != self.share {
+            return Err(malformed(format!(
+                "it holds samples {}..{} of every pixel, the render takes {}..{}",
+                checkpoint.share.start, checkpoint.share.end, self.share.start, self.share.end
+            ))
+            .into());
+        }
         if checkpoint.spp_done > s.samples_per_pixel {
             return Err(malformed(format!(
                 "it holds {} spp of a {} spp render",
@@ -244,7 +284,11 @@ impl Session {
             ))
             .into());
         }
-        if !ends_a_pass(checkpoint.spp_done, s.samples_per_pixel) {
+        let (done, len) = (
+            checkpoint.spp_done - self.share.start,
+            self.share.len() as u32,
+        );
+        if !(ends_a_pass(done, len) || done == 0 && len == 0) {
             return Err(malformed(format!(
                 "it holds {} spp, where no pass of a {} spp render ends",
                 checkpoint.spp_done, s.samples_per_pixel
@@ -292,7 +336,7 @@ impl Session {
     /// Whether every sample is rendered (with adaptive sampling: every
     /// sample of the pixels that have not stopped).
     pub fn is_complete(&self) -> bool {
-        self.spp_done >= self.spp_total() || self.active_pixels() == Some(0)
+        self.spp_done >= self.share.end || self.active_pixels() == Some(0)
     }
 
     /// With adaptive sampling, the number of pixels still being sampled.
@@ -313,11 +357,22 @@ impl Session {
         CheckpointView {
             renderer_id: crate::checkpoint::RENDERER_ID,
             description: &self.description,
+            share: self.share.clone(),
             spp_done: self.spp_done,
+            gamma: self.scene.settings.gamma,
             stats: self.stats,
             film: &self.film,
             active: self.active.as_deref(),
         }
+    }
+
+    /// Samples per pixel of the next pass: the schedule of [`pass_size`]
+    /// over this session's share.
+    fn next_pass_size(&self) -> u32 {
+        pass_size(
+            self.spp_done - self.share.start,
+            self.share.end - self.share.start,
+        )
     }
 
     /// Renders the next pass. `should_stop` is asked before every row; if it
@@ -328,7 +383,7 @@ impl Session {
         progress: &(dyn Fn(u64) + Sync),
         should_stop: &(dyn Fn() -> bool + Sync),
     ) -> Option<(Range<u32>, Duration, RenderStats)> {
-        let n = pass_size(self.spp_done, self.spp_total());
+        let n = self.next_pass_size();
         let samples = self.spp_done..self.spp_done + n;
         // A pass abandoned half-way has added samples to some rows only:
         // keep the film as it was to put it back.
@@ -390,7 +445,7 @@ impl Session {
                 summary.reason = StopReason::Interrupted;
                 return Ok(summary);
             }
-            let next = pass_size(self.spp_done, self.spp_total());
+            let next = self.next_pass_size();
             if let (Some(deadline), Some((n, took))) = (deadline, last) {
                 let predicted = took.mul_f64(f64::from(next) / f64::from(n));
                 if Instant::now() + predicted > deadline {

@@ -86,18 +86,20 @@ fn layout(bytes: &[u8]) -> Layout {
     let id = HEADER_LEN + 4..HEADER_LEN + 4 + u32_at(HEADER_LEN);
     let desc = id.end + 4..id.end + 4 + u32_at(id.end);
     let spp = desc.end;
-    let pixels = u32_at(spp + 4) * u32_at(spp + 8);
-    let sums = spp + 12 + 24;
+    // After spp_done: the share (start, end) and the gamma.
+    let width = spp + 16;
+    let pixels = u32_at(width) * u32_at(width + 4);
+    let sums = width + 8 + 24;
     let counts = sums + 48 * pixels;
     let adaptive = counts + 4 * pixels;
     Layout {
         id,
         desc,
         spp,
-        width: spp + 4,
-        samples: spp + 12,
-        rays: spp + 20,
-        dropped: spp + 28,
+        width,
+        samples: width + 8,
+        rays: width + 16,
+        dropped: width + 24,
         counts,
         adaptive,
         odd_counts: adaptive + 1 + 48 * pixels,

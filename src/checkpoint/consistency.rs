@@ -19,9 +19,27 @@ impl Checkpoint {
         if w == 0 || h == 0 {
             return Err(format!("its image is {w}x{h} pixels"));
         }
-        let done = self.spp_done;
-        if done == 0 {
+        if !(self.gamma > 0.0 && self.gamma.is_finite()) {
+            return Err(format!("its display gamma is {}", self.gamma));
+        }
+        let share = &self.share;
+        if share.start > share.end || !share.contains(&self.spp_done) && self.spp_done != share.end
+        {
+            return Err(format!(
+                "it holds samples up to {}, outside its share {}..{}",
+                self.spp_done, share.start, share.end
+            ));
+        }
+        // Samples per pixel held; none only in a part whose share is empty
+        // (more parts than samples per pixel).
+        let done = self.spp_done - share.start;
+        if done == 0 && !share.is_empty() {
             return Err("it holds no samples (0 spp done)".into());
+        }
+        if self.active.is_some() && share.start != 0 {
+            return Err(
+                "it samples adaptively, but holds a share of the samples not starting at 0".into(),
+            );
         }
         let at = |i: usize| format!("pixel ({}, {})", i % w as usize, i / w as usize);
         let (sums, counts) = self.film.raw();

@@ -15,7 +15,14 @@ impl CheckpointView<'_> {
             sink(&(text.len() as u32).to_le_bytes())?;
             sink(text.as_bytes())?;
         }
-        for v in [self.spp_done, self.film.width(), self.film.height()] {
+        for v in [
+            self.spp_done,
+            self.share.start,
+            self.share.end,
+            self.gamma.to_bits(),
+            self.film.width(),
+            self.film.height(),
+        ] {
             sink(&v.to_le_bytes())?;
         }
         for v in [self.stats.samples, self.stats.rays, self.stats.dropped] {
@@ -66,6 +73,9 @@ impl Checkpoint {
         let renderer_id = r.text().ok_or("bad renderer identity")?;
         let description = r.text().ok_or("bad description text")?;
         let spp_done = r.u32().ok_or("missing sample count")?;
+        let start = r.u32().ok_or("missing share of samples")?;
+        let end = r.u32().ok_or("missing share of samples")?;
+        let gamma = f32::from_bits(r.u32().ok_or("missing gamma")?);
         let width = r.u32().ok_or("missing width")?;
         let height = r.u32().ok_or("missing height")?;
         let mut stat = || r.u64().ok_or("missing statistics");
@@ -112,7 +122,9 @@ impl Checkpoint {
         Ok(Self {
             renderer_id,
             description,
+            share: start..end,
             spp_done,
+            gamma,
             stats,
             film,
             active,

@@ -77,8 +77,14 @@ fn list(items: &[&str]) -> String {
 
 /// What differs between two description texts, in words: render settings
 /// one by one, the rest by section. Both are parsed the same way, so that
-/// equal numbers compare equal.
-pub(crate) fn describe_differences(theirs: &str, ours: &str) -> String {
+/// equal numbers compare equal. `theirs_name` names where `theirs` comes
+/// from ("the checkpoint"), `ours_at` where `ours` is ("here").
+pub(crate) fn describe_differences(
+    theirs: &str,
+    ours: &str,
+    theirs_name: &str,
+    ours_at: &str,
+) -> String {
     let (theirs, ours) = (parse(theirs), parse(ours));
     let (Value::Object(theirs), Value::Object(ours)) = (theirs, ours) else {
         return "a different scene description".into();
@@ -106,7 +112,7 @@ pub(crate) fn describe_differences(theirs: &str, ours: &str) -> String {
                 k => k.replace('_', " "),
             };
             out.push(format!(
-                "{name} {} in the checkpoint, {} here",
+                "{name} {} in {theirs_name}, {} {ours_at}",
                 show(x),
                 show(y)
             ));
@@ -130,9 +136,9 @@ pub(crate) fn describe_differences(theirs: &str, ours: &str) -> String {
         for (name, source) in &b {
             match a.iter().find(|(n, _)| n == name) {
                 Some((_, old)) if old != source => {
-                    out.push(format!("file {name} has changed since the checkpoint"))
+                    out.push(format!("file {name} has changed since {theirs_name}"))
                 }
-                None => out.push(format!("file {name} is not in the checkpoint")),
+                None => out.push(format!("file {name} is not in {theirs_name}")),
                 _ => {}
             }
         }
@@ -188,7 +194,12 @@ mod tests {
         let cover = builtin::find("cover").unwrap().desc();
         let mut moved = cover.clone();
         moved.camera.vfov += 1.0;
-        let e = describe_differences(&description_text(&cover), &description_text(&moved));
+        let e = describe_differences(
+            &description_text(&cover),
+            &description_text(&moved),
+            "the checkpoint",
+            "here",
+        );
         assert_eq!(e, "a different scene (its camera differs)");
     }
 }

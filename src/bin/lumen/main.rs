@@ -63,6 +63,26 @@ enum Command {
         #[command(flatten)]
         progressive: ProgressiveArgs,
     },
+    /// Merge the part files of a render split with `render --part K/N` into
+    /// its image (.ppm, .png, .pfm or .exr): the same to the bit as the
+    /// render on one machine. See docs/distributed.md.
+    Merge {
+        /// The part files, in any order.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output image; the extension chooses the format.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Merge whatever the parts hold so far, finished or not and with
+        /// parts missing (a preview while they render); says which samples
+        /// the image holds.
+        #[arg(long)]
+        partial: bool,
+        /// Display gamma of PNG and PPM images [default: the render's, which
+        /// every part records].
+        #[arg(long, value_parser = parse_gamma)]
+        gamma: Option<f32>,
+    },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
         #[command(subcommand)]
@@ -246,8 +266,15 @@ struct SettingArgs {
 struct ProgressiveArgs {
     /// Checkpoint file, saved during the render so that it can be resumed
     /// [default: the output path + .lumen-ckpt].
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "part")]
     checkpoint: Option<PathBuf>,
+    /// Render only part K of N equal shares of every pixel's samples (K
+    /// from 0, as job array task ids count) into a part file (-o
+    /// NAME.lumen-part), its own checkpoint; `lumen merge` joins the parts
+    /// into the image of the whole render, to the bit. See
+    /// docs/distributed.md.
+    #[arg(long, value_name = "K/N")]
+    part: Option<lumen::part::Part>,
     /// Save the image and the checkpoint at most this often (e.g. 30s, 5m)
     /// instead of after every pass.
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
@@ -311,6 +338,7 @@ macro_rules! errln {
 }
 
 mod commands;
+mod merge;
 mod render;
 mod scenes;
 mod signals;
@@ -321,6 +349,14 @@ use commands::{
 };
 use render::render_command;
 use scenes::export_command;
+
+/// A display gamma: a finite number greater than 0.
+fn parse_gamma(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(g) if g > 0.0 && g.is_finite() => Ok(g),
+        _ => Err(format!("'{text}': a gamma is a number greater than 0")),
+    }
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -343,6 +379,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
         } => with_threads(settings.threads, || {
             render_command(scene_name(&scene)?, &output, &settings, &progressive)
         }),
+        Command::Merge {
+            parts,
+            output,
+            partial,
+            gamma,
+        } => merge::merge_command(&parts, &output, partial, gamma),
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {

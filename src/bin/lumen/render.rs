@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use lumen::checkpoint::{self, Checkpoint, Existing};
 use lumen::lock::RenderLock;
 use lumen::progressive::{Session, StopReason};
-use lumen::{files, output};
+use lumen::{files, output, part};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -16,7 +16,7 @@ use std::time::Instant;
 
 /// Where a path points once its directory is resolved (the file itself may
 /// not exist yet): `./out.png`, `out.png` and `$PWD/out.png` are one place.
-fn resolved(path: &Path) -> PathBuf {
+pub(crate) fn resolved(path: &Path) -> PathBuf {
     let dir = output::parent_dir(path);
     let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
     match path.file_name() {
@@ -69,20 +69,48 @@ pub(crate) fn render_command(
     prog: &ProgressiveArgs,
 ) -> Result<ExitCode> {
     let (desc, scene) = load_scene(name)?.resolve(name, &args.overrides())?;
-    output::ImageFormat::from_path(out)?;
-    let ckpt_path = prog
-        .checkpoint
-        .clone()
-        .unwrap_or_else(|| checkpoint::default_path(out));
-    check_checkpoint_path(&ckpt_path, out, name)?;
+    let is_part_file = out.extension().is_some_and(|e| e == part::EXTENSION);
+    match prog.part {
+        Some(_) if !is_part_file => bail!(
+            "{}: a part of a render is written to a part file: -o NAME.{}",
+            out.display(),
+            part::EXTENSION
+        ),
+        None if is_part_file => bail!(
+            "{}: a part file holds a part of a render: give --part K/N",
+            out.display()
+        ),
+        Some(_) => {}
+        None => {
+            output::ImageFormat::from_path(out)?;
+        }
+    }
+    // A part file is its own checkpoint.
+    let ckpt_path = match prog.part {
+        Some(_) => out.to_path_buf(),
+        None => {
+            let ckpt_path = prog
+                .checkpoint
+                .clone()
+                .unwrap_or_else(|| checkpoint::default_path(out));
+            check_checkpoint_path(&ckpt_path, out, name)?;
+            ckpt_path
+        }
+    };
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
     output::check_writable(&ckpt_path).context("checkpoint")?;
     // Held to the end: no other render writes these files meanwhile.
-    let locks = [RenderLock::acquire(out)?, RenderLock::acquire(&ckpt_path)?];
+    let mut locks = vec![RenderLock::acquire(out)?];
+    if ckpt_path != out {
+        locks.push(RenderLock::acquire(&ckpt_path)?);
+    }
     remove_stale_temps([out, &ckpt_path]);
     let existing = checkpoint::inspect(&ckpt_path)?;
-    let session = Session::with_scene(&desc, scene);
+    let session = match prog.part {
+        Some(part) => Session::with_part(&desc, scene, part)?,
+        None => Session::with_scene(&desc, scene),
+    };
     let mut session = if prog.resume {
         if existing == Existing::Nothing {
             bail!(
@@ -116,8 +144,12 @@ pub(crate) fn render_command(
 
     let s = session.scene().settings.clone();
     let resumed_from = session.spp_done();
+    let share = session.share();
+    let of_part = prog.part.map_or(String::new(), |p| {
+        format!(", part {p}: samples {}..{}", share.start, share.end)
+    });
     errln!(
-        "{name}: {}x{} at {} spp, depth {}{}",
+        "{name}: {}x{} at {} spp, depth {}{of_part}{}",
         s.width,
         s.height,
         s.samples_per_pixel,
@@ -135,6 +167,14 @@ pub(crate) fn render_command(
     // one step that a second interrupt lets finish (see `signals`).
     let save = |session: &Session| -> Result<()> {
         let _saving = saving();
+        if prog.part.is_some() {
+            session
+                .checkpoint()
+                .write(out)
+                .context("cannot save the part")?;
+            quit_if_asked();
+            return Ok(());
+        }
         output::write_image(out, session.film(), s.gamma)?;
         if !session.is_complete() {
             session
@@ -146,7 +186,7 @@ pub(crate) fn render_command(
         Ok(())
     };
     let pixels = u64::from(s.width) * u64::from(s.height);
-    let bar = progress_bar(pixels * u64::from(s.samples_per_pixel - resumed_from));
+    let bar = progress_bar(pixels * u64::from(share.end - resumed_from));
     let start = Instant::now();
     let mut last_save = start;
     let run = session.run(&stop, prog.time_limit, &|n| bar.inc(n), &mut |session,
@@ -185,6 +225,17 @@ pub(crate) fn render_command(
     bar.finish_and_clear();
     let (held, total) = (session.spp_done(), session.spp_total());
     let code = match run.reason {
+        StopReason::Complete if prog.part.is_some() => {
+            save(&session)?;
+            errln!(
+                "{name}: part {}: samples {}..{} of {total} spp written to {}",
+                prog.part.expect("a part"),
+                share.start,
+                share.end,
+                out.display()
+            );
+            ExitCode::SUCCESS
+        }
         StopReason::Complete => {
             save(&session)?;
             if let Err(e) = checkpoint::remove(&ckpt_path) {
@@ -201,7 +252,7 @@ pub(crate) fn render_command(
             errln!("{name}: {spp} written to {}", out.display());
             ExitCode::SUCCESS
         }
-        reason if held == 0 => {
+        reason if held == share.start => {
             debug_assert_eq!(reason, StopReason::Interrupted);
             errln!("lumen: interrupted before the first pass finished; nothing written");
             ExitCode::from(EXIT_INTERRUPTED)
@@ -210,13 +261,26 @@ pub(crate) fn render_command(
             save(&session)?;
             let (why, code) = match reason {
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
+                // An unfinished part is not a finished task: a job engine
+                // must see it fail, and the merge refuses it.
+                _ if prog.part.is_some() => ("time limit reached", ExitCode::FAILURE),
                 _ => ("time limit reached", ExitCode::SUCCESS),
             };
-            errln!(
-                "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
-                out.display(),
-                ckpt_path.display()
-            );
+            if prog.part.is_some() {
+                errln!(
+                    "lumen: {why}: part {} holds samples {}..{held} of its share {}..{}; continue with --resume",
+                    out.display(),
+                    share.start,
+                    share.start,
+                    share.end
+                );
+            } else {
+                errln!(
+                    "lumen: {why}: {} holds {held} of {total} spp; checkpoint {} (continue with --resume)",
+                    out.display(),
+                    ckpt_path.display()
+                );
+            }
             code
         }
     };

@@ -1,0 +1,64 @@
+//! `lumen merge`: the part files of a split render joined into its image.
+
+use crate::render::resolved;
+use anyhow::{bail, Result};
+use lumen::lock::RenderLock;
+use lumen::output;
+use lumen::part::{self, Merged};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// `a..b`, `a..b and c..d`, …
+fn ranges(held: &[std::ops::Range<u32>]) -> String {
+    let shown: Vec<String> = held
+        .iter()
+        .map(|r| format!("{}..{}", r.start, r.end))
+        .collect();
+    if shown.is_empty() {
+        "no samples".into()
+    } else {
+        format!("samples {}", shown.join(", "))
+    }
+}
+
+pub(crate) fn merge_command(
+    parts: &[PathBuf],
+    out: &Path,
+    partial: bool,
+    gamma: Option<f32>,
+) -> Result<ExitCode> {
+    output::ImageFormat::from_path(out)?;
+    let place = resolved(out);
+    if let Some(p) = parts.iter().find(|p| resolved(p) == place) {
+        bail!(
+            "{}: the merged image cannot be one of the parts; choose another -o",
+            p.display()
+        );
+    }
+    output::check_writable(out)?;
+    let _lock = RenderLock::acquire(out)?;
+    let merged: Merged = part::merge(parts, partial)?;
+    if merged.held.is_empty() {
+        bail!("the parts hold no samples yet: nothing to merge");
+    }
+    output::write_image(out, &merged.film, gamma.unwrap_or(merged.gamma))?;
+    let held: u32 = merged.held.iter().map(|r| r.end - r.start).sum();
+    if merged.is_complete() {
+        errln!(
+            "merged {} part{} ({} spp) into {}",
+            parts.len(),
+            if parts.len() == 1 { "" } else { "s" },
+            merged.spp,
+            out.display()
+        );
+    } else {
+        errln!(
+            "lumen: partial merge: {} holds {} of {} spp ({}) of every pixel",
+            out.display(),
+            held,
+            merged.spp,
+            ranges(&merged.held)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
