@@ -81,6 +81,27 @@ const TOKENS: &[&str] = &[
     "max",
     "[0, 0, 0]",
     "1e-40",
+    // Seeds at the edge of the range both formats share.
+    "9223372036854775807",
+    "9223372036854775808",
+    "18446744073709551615",
+    "seed = 9223372036854775808",
+    // A byte-order mark, blank text, TOML the quick reader leaves to the
+    // toml crate (escapes, underscores, multi-line strings and arrays,
+    // dotted keys, sub-tables).
+    "\u{feff}",
+    "\r\n",
+    "\t",
+    "\"\\t\"",
+    "1_000",
+    "'''",
+    "\"\"\"",
+    "[\n1,\n]",
+    "a.b = 1",
+    "[objects.boundary]",
+    "[[objects.transform]]",
+    "objects = []",
+    "[[ objects ]]",
 ];
 
 #[derive(Clone, Debug)]
@@ -308,6 +329,56 @@ proptest! {
     }
 }
 
+/// More spheres than the quick reader reads in one batch, written plainly
+/// (every table rewritten as JSON) or as JSON.
+fn many_spheres(format: Format) -> String {
+    let spheres = (0..300).map(|i| (f64::from(i) * 0.37 - 50.0, 0.1 + f64::from(i % 7) * 0.01));
+    match format {
+        Format::Toml => {
+            let mut text = String::from(
+                "[render]\nwidth = 8\nmax_depth = 3\n\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n",
+            );
+            for (x, r) in spheres {
+                text += &format!("\n[[objects]]\ntype = \"sphere\"\ncenter = [{x}, 0, -60]\nradius = {r}\nmaterial = \"m\"\n");
+            }
+            text
+        }
+        Format::Json => {
+            let objects: Vec<String> = spheres
+                .map(|(x, r)| format!("{{\"type\": \"sphere\", \"center\": [{x}, 0, -60], \"radius\": {r}, \"material\": \"m\"}}"))
+                .collect();
+            format!(
+                "{{\"render\": {{\"width\": 8, \"max_depth\": 3}},\n\"materials\": {{\"m\": {{\"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5]}}}},\n\"objects\": [\n{}\n]}}\n",
+                objects.join(",\n")
+            )
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(Config {
+        cases: 48,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(0xB16F11E),
+        ..Config::default()
+    })]
+
+    /// Edits anywhere in a file of several batches: the quick reader and
+    /// the precise one still agree (checked in `exercise`).
+    #[test]
+    fn mangled_files_of_many_objects_never_panic(
+        json in any::<bool>(),
+        edits in proptest::collection::vec(edit(), 1..6),
+    ) {
+        let format = if json { Format::Json } else { Format::Toml };
+        let mut text = many_spheres(format);
+        for e in &edits {
+            apply(&mut text, e);
+        }
+        exercise(text, format);
+    }
+}
+
 #[test]
 fn the_placed_seeds_are_valid() {
     for format in [Format::Toml, Format::Json] {
@@ -317,6 +388,11 @@ fn the_placed_seeds_are_valid() {
             .compile(&Overrides::default())
             .unwrap_or_else(|e| panic!("{e}"));
         assert!(scene.stats.placed_triangles >= 8);
+        let file = SceneFile::parse("seed", many_spheres(format), format).unwrap();
+        assert_eq!(
+            file.compile(&Overrides::default()).unwrap().spheres.len(),
+            300
+        );
     }
 }
 

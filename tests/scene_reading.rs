@@ -185,3 +185,22 @@ fn what_serde_would_take_and_the_precise_reader_refuses_is_refused() {
         assert!(err.contains(message), "{err}");
     }
 }
+
+#[test]
+fn negative_zero_reads_as_the_precise_reader_reads_it() {
+    let m = "[materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n";
+    let toml = format!("{m}[[objects]]\ntype = \"sphere\"\ncenter = [-0, -0.0, -1]\nradius = 1\nmaterial = \"m\"\n");
+    let json = r#"{"materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+        "objects": [{"type": "sphere", "center": [-0, -0.0, -1], "radius": 1, "material": "m"}]}"#;
+    for (text, format) in [(toml.as_str(), Format::Toml), (json, Format::Json)] {
+        let quick = read(text, format).unwrap().desc;
+        let precise = SceneFile::parse_with_positions(name(format), text.to_string(), format)
+            .unwrap()
+            .desc;
+        // Equal as numbers is not enough: the sign of a zero is written out.
+        assert_eq!(
+            export(&quick, Format::Json).unwrap(),
+            export(&precise, Format::Json).unwrap()
+        );
+    }
+}

@@ -12,6 +12,7 @@ pub mod hint;
 mod plain_toml;
 pub mod source;
 mod textures;
+mod toml_cut;
 mod world;
 
 pub use desc::SceneDesc;

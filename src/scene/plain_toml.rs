@@ -250,7 +250,9 @@ impl<'a> Cursor<'a> {
             integer = false;
         }
         let token = &self.s[start..i];
-        if integer && token.parse::<i64>().is_err() {
+        // TOML's `-0` is the integer 0; serde_json reads it as the float
+        // -0.0, which would be written back with its sign.
+        if integer && (token == "-0" || token.parse::<i64>().is_err()) {
             return None;
         }
         self.i = i;
@@ -289,6 +291,7 @@ mod tests {
             "[[objects]]\na = 1_000\n",
             "[[objects]]\na = +1\n",
             "[[objects]]\na = 01\n",
+            "[[objects]]\na = -0\n",
             "[[objects]]\na = 1.\n",
             "[[objects]]\na = .5\n",
             "[[objects]]\na = 1e\n",
