@@ -60,6 +60,6 @@ elif [ -n "$missing" ]; then
     exit 1
 fi
 
-echo "$me: merging $count parts from $dir into $out" >&2
+echo "$me: merging $# of $count parts from $dir into $out" >&2
 # shellcheck disable=SC2086 # LUMEN_MERGE_ARGS is split on purpose; globbing is off.
 exec "${LUMEN_BIN:-lumen}" merge "$@" -o "$out" ${LUMEN_MERGE_ARGS:-}
