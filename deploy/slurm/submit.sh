@@ -9,6 +9,11 @@
 # account, time limit, --cpus-per-task, ...) go in LUMEN_SBATCH_ARGS.
 # Prints the two job ids as shell assignments, `render=ID` and `merge=ID`.
 #
+# LUMEN_ARRAY=K[,K...] submits only those indexes (any `sbatch --array` list)
+# and a new merge after them: the way to rerun failed tasks with the same
+# command. Tasks whose part is complete return at once, so rerunning every
+# index is harmless too.
+#
 # The merge depends on the array with afterany, not afterok: with afterok a
 # task that fails leaves the merge pending forever (DependencyNeverSatisfied),
 # even once the task is requeued and succeeds. The merge checks the parts
@@ -27,6 +32,10 @@ out=$4
 shift 4
 case $count in
     '' | *[!0-9]* | 0*) echo "submit: error: N is '$count', not a number of parts (1, 2, ...)" >&2; exit 2 ;;
+esac
+array=${LUMEN_ARRAY:-0-$((count - 1))}
+case $array in
+    '' | *[!0-9,%:-]*) echo "submit: error: LUMEN_ARRAY is '$array', not an sbatch --array list of indexes (3 or 1,5 or 0-7)" >&2; exit 2 ;;
 esac
 for arg in "$@"; do
     case $arg in
@@ -55,7 +64,7 @@ export LUMEN_SCENE LUMEN_PARTS_DIR LUMEN_TASK_COUNT LUMEN_OUT LUMEN_ARGS \
 
 set -f
 # shellcheck disable=SC2086 # LUMEN_SBATCH_ARGS is split on purpose.
-render=$(sbatch --parsable --array="0-$((count - 1))" --export=ALL \
+render=$(sbatch --parsable --array="$array" --export=ALL \
     --output="$dir/logs/render-%A_%a.out" ${LUMEN_SBATCH_ARGS:-} \
     "$here/render.sbatch")
 render=${render%%;*} # --parsable prints "ID" or "ID;CLUSTER"
@@ -67,4 +76,4 @@ merge=$(sbatch --parsable --dependency="afterany:$render" --kill-on-invalid-dep=
 merge=${merge%%;*}
 
 echo "merge=$merge"
-echo "submit: render array $render (parts 0-$((count - 1)) of $count into $dir), merge $merge into $out after it" >&2
+echo "submit: render array $render (parts $array of $count into $dir), merge $merge into $out after it" >&2
