@@ -674,7 +674,9 @@ fn wait_for(what: &str, timeout: Duration, mut done: impl FnMut() -> bool) {
 /// (as lumen does after its first pass), takes 2 s, then writes its
 /// arguments, one a line, to the file after -o (atomically, as lumen writes
 /// parts) and removes the checkpoint; `merge` writes its arguments at once.
-/// Each step is appended to EVENTS, a line each, to show what ran when.
+/// A render whose part K has a file `fail-K` in `dir` fails at once instead,
+/// removing the file, as a task whose node is lost would. Each step is
+/// appended to EVENTS, a line each, to show what ran when.
 fn write_stub_lumen(dir: &Path, events: &Path) -> PathBuf {
     let stub = dir.join("lumen");
     write_executable(
@@ -683,6 +685,7 @@ fn write_stub_lumen(dir: &Path, events: &Path) -> PathBuf {
             r#"#!/bin/sh
 set -eu
 events='{events}'
+dir='{dir}'
 out= ckpt= part= prev=
 for arg in "$@"; do
     case $prev in
@@ -693,6 +696,11 @@ for arg in "$@"; do
     prev=$arg
 done
 if [ "$1" = render ]; then
+    if [ -e "$dir/fail-${{part%/*}}" ]; then
+        rm "$dir/fail-${{part%/*}}"
+        echo "fail $part" >> "$events"
+        exit 1
+    fi
     touch "$ckpt"
     echo "start $part" >> "$events"
     sleep 2
@@ -706,15 +714,53 @@ else
     echo "merge" >> "$events"
 fi
 "#,
-            events = events.display()
+            events = events.display(),
+            dir = dir.display(),
         ),
     );
     stub
 }
 
+/// `deploy/slurm/submit.sh cover PARTS N OUT OPTIONS...` on `cluster`, with
+/// `LUMEN_BIN=lumen` and `vars`; returns the ids of the array and the merge.
+fn submit(
+    cluster: &Cluster,
+    lumen: &Path,
+    (parts, n, out): (&Path, u32, &Path),
+    options: &[&str],
+    vars: &[(&str, &str)],
+) -> (String, String) {
+    let submitted = cluster
+        .script(deploy_dir().join("slurm/submit.sh"))
+        .arg("cover")
+        .arg(parts)
+        .arg(n.to_string())
+        .arg(out)
+        .args(options)
+        .env("LUMEN_BIN", lumen)
+        .envs(vars.iter().copied())
+        .current_dir(parts.parent().unwrap())
+        .output()
+        .unwrap();
+    assert!(
+        submitted.status.success(),
+        "submit.sh: {}",
+        text(&submitted.stderr)
+    );
+    // `render=ID` and `merge=ID`.
+    let ids: BTreeMap<String, String> = text(&submitted.stdout)
+        .lines()
+        .filter_map(|l| l.split_once('='))
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect();
+    (ids["render"].clone(), ids["merge"].clone())
+}
+
 #[test]
-fn slurm_array_renders_every_part_through_a_requeue_then_merges() {
-    if skip_without_slurm("slurm_array_renders_every_part_through_a_requeue_then_merges") {
+fn slurm_array_renders_every_part_through_a_requeue_and_a_failure_then_merges() {
+    if skip_without_slurm(
+        "slurm_array_renders_every_part_through_a_requeue_and_a_failure_then_merges",
+    ) {
         return;
     }
     let started = Instant::now();
@@ -734,50 +780,28 @@ fn slurm_array_renders_every_part_through_a_requeue_then_merges() {
         Some(_) => &["--width", "160", "--spp", "2048", "--seed", "3"],
         None => &["--width", "64", "--spp", "64", "--seed", "3"],
     };
-    let out_pfm = work.join("final.pfm");
+    let out = work.join("final.pfm");
     const N: u32 = 4;
+    // The part whose task fails (the stub's) or goes missing (lumen's).
+    const FAILS: u32 = 3;
+    fs::write(work.join(format!("fail-{FAILS}")), "").unwrap();
+    let part = |k: u32| parts.join(format!("part-{k}.lumen-part"));
+    let events_text = || fs::read_to_string(&events).unwrap();
 
-    let submitted = cluster
-        .script(deploy_dir().join("slurm/submit.sh"))
-        .args([
-            OsStr::new("cover"),
-            parts.as_os_str(),
-            OsStr::new(&N.to_string()),
-            out_pfm.as_os_str(),
-        ])
-        .args(options)
-        .env("LUMEN_BIN", &lumen)
-        .current_dir(&work)
-        .output()
-        .unwrap();
-    assert!(
-        submitted.status.success(),
-        "submit.sh: {}",
-        text(&submitted.stderr)
-    );
-    // `render=ID` and `merge=ID`.
-    let ids: BTreeMap<String, String> = text(&submitted.stdout)
-        .lines()
-        .filter_map(|l| l.split_once('='))
-        .map(|(k, v)| (k.to_owned(), v.to_owned()))
-        .collect();
-    let (render, merge) = (&ids["render"], &ids["merge"]);
+    let (render, merge) = submit(&cluster, &lumen, (&parts, N, &out), options, &[]);
 
     // Requeue a task while its render runs, as a node failure or preemption
     // would, and release it at once rather than after Slurm's requeue delay.
     // With the stub, "running" is also its having left a checkpoint.
     let mut victim = String::new();
     wait_for("a running task", Duration::from_secs(20), || {
-        let running = cluster.queued(render);
+        let running = cluster.queued(&render);
         let Some(task) = running.iter().find(|l| l.contains(" RUNNING ")) else {
             return false;
         };
         let id = task.split(' ').next().unwrap().to_owned();
         let k = id.rsplit('_').next().unwrap();
-        let started = LUMEN_BIN.is_some()
-            || fs::read_to_string(&events)
-                .unwrap()
-                .contains(&format!("start {k}/{N}\n"));
+        let started = LUMEN_BIN.is_some() || events_text().contains(&format!("start {k}/{N}\n"));
         if started {
             victim = id;
         }
@@ -794,48 +818,57 @@ fn slurm_array_renders_every_part_through_a_requeue_then_merges() {
         "scontrol",
         &["update", &format!("jobid={victim}"), "StartTime=now"],
     );
-
+    // The merge runs once every task has ended, the failed one too.
     cluster.wait_finished(&format!("{render},{merge}"), Duration::from_secs(45));
 
-    let logs = fs::read_dir(parts.join("logs")).unwrap().count();
-    assert!(
-        logs > N as usize,
-        "{logs} logs: one per task and the merge's"
+    let logs: Vec<String> = fs::read_dir(parts.join("logs"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        logs.len(),
+        N as usize + 1,
+        "{logs:?}: one per task and the merge's"
     );
-    let part = |k: u32| parts.join(format!("part-{k}.lumen-part"));
+    // The stub's arguments for part `k`: one lumen thread per CPU Slurm gave
+    // the task, then the options given to submit.sh.
+    let stub_args = |k: u32, resume: bool| {
+        let mut want = task_args(&parts, k, N, resume);
+        want.extend(["--threads", "1"].map(str::to_owned));
+        want.extend(options.iter().map(|&o| o.to_owned()));
+        want
+    };
+    let merge_log = fs::read_to_string(parts.join(format!("logs/merge-{merge}.out"))).unwrap();
+    let reference = work.join("reference.pfm");
     if LUMEN_BIN.is_none() {
         let victim_k: u32 = victim.rsplit('_').next().unwrap().parse().unwrap();
-        let events = fs::read_to_string(&events).unwrap();
-        for k in 0..N {
-            let args = fs::read_to_string(part(k)).unwrap_or_else(|e| {
-                panic!("part {k}: {e}; events:\n{events}");
-            });
-            let args: Vec<&str> = args.lines().collect();
-            // The requeued task found its checkpoint; one thread per CPU
-            // Slurm gave the task.
-            let mut want = task_args(&parts, k, N, k == victim_k);
-            want.extend(["--threads", "1"].map(str::to_owned));
-            want.extend(options.iter().map(|&o| o.to_owned()));
-            assert_eq!(args, want, "part {k}");
-            let starts = events.matches(&format!("start {k}/{N}\n")).count();
+        assert_ne!(victim_k, FAILS);
+        let events = events_text();
+        for k in (0..N).filter(|&k| k != FAILS) {
+            let args = fs::read_to_string(part(k))
+                .unwrap_or_else(|e| panic!("part {k}: {e}; events:\n{events}"));
+            // The requeued task found its checkpoint.
             assert_eq!(
-                starts,
-                1 + usize::from(k == victim_k),
-                "part {k}:\n{events}"
+                args.lines().collect::<Vec<_>>(),
+                stub_args(k, k == victim_k),
+                "part {k}"
             );
+            let starts = events.matches(&format!("start {k}/{N}\n")).count();
+            let want = 1 + usize::from(k == victim_k);
+            assert_eq!(starts, want, "part {k}:\n{events}");
         }
-        // The merge ran once, after every part was done.
-        let last_done = events.rfind("done ").unwrap();
-        assert_eq!(events.matches("merge\n").count(), 1, "{events}");
-        assert!(events.rfind("merge").unwrap() > last_done, "{events}");
-        let merged = fs::read_to_string(&out_pfm).unwrap();
-        let mut want = vec!["merge".to_owned()];
-        want.extend((0..N).map(|k| part(k).display().to_string()));
-        want.extend(["-o".to_owned(), out_pfm.display().to_string()]);
-        assert_eq!(merged.lines().collect::<Vec<_>>(), want);
+        assert!(events.contains(&format!("fail {FAILS}/{N}\n")), "{events}");
+        // The merge ran, found the failed task's part missing, named it and
+        // merged nothing.
+        assert!(!part(FAILS).exists());
+        assert!(
+            merge_log.contains(&format!("no part file for index {FAILS} of {N}")),
+            "{merge_log}"
+        );
+        assert!(!events.contains("merge"), "{events}");
+        assert!(!out.exists());
     } else {
         // The merged image is the one-machine render's, bit for bit.
-        let reference = work.join("reference.pfm");
         let status = Command::new(&lumen)
             .args(["render", "cover", "-o"])
             .arg(&reference)
@@ -843,11 +876,51 @@ fn slurm_array_renders_every_part_through_a_requeue_then_merges() {
             .status()
             .unwrap();
         assert!(status.success());
-        let merged = fs::read(&out_pfm).unwrap_or_else(|e| panic!("the merged image: {e}"));
+        let merged = fs::read(&out).unwrap_or_else(|e| panic!("{e}: {merge_log}"));
+        assert!(
+            merged == fs::read(&reference).unwrap(),
+            "the merged image differs from the one-machine render"
+        );
+        // A part lost for the rerun below.
+        fs::remove_file(part(FAILS)).unwrap();
+        fs::remove_file(&out).unwrap();
+    }
+
+    // The way docs/distributed.md gives to rerun a failed index: the same
+    // command with LUMEN_ARRAY. The one-task array must still render part
+    // FAILS of N, not of 1, and a new merge follows it.
+    let again = FAILS.to_string();
+    let (render, merge) = submit(
+        &cluster,
+        &lumen,
+        (&parts, N, &out),
+        options,
+        &[("LUMEN_ARRAY", &again)],
+    );
+    cluster.wait_finished(&format!("{render},{merge}"), Duration::from_secs(30));
+    let merge_log = fs::read_to_string(parts.join(format!("logs/merge-{merge}.out"))).unwrap();
+    if LUMEN_BIN.is_none() {
+        let events = events_text();
+        let args = fs::read_to_string(part(FAILS))
+            .unwrap_or_else(|e| panic!("part {FAILS}: {e}; events:\n{events}"));
+        assert_eq!(args.lines().collect::<Vec<_>>(), stub_args(FAILS, false));
+        // The merge ran once, after every part was done.
+        assert_eq!(events.matches("merge\n").count(), 1, "{events}");
+        assert!(
+            events.ends_with(&format!("done {FAILS}/{N}\nmerge\n")),
+            "{events}"
+        );
+        let merged = fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {merge_log}"));
+        let mut want = vec!["merge".to_owned()];
+        want.extend((0..N).map(|k| part(k).display().to_string()));
+        want.extend(["-o".to_owned(), out.display().to_string()]);
+        assert_eq!(merged.lines().collect::<Vec<_>>(), want);
+    } else {
+        let merged = fs::read(&out).unwrap_or_else(|e| panic!("{e}: {merge_log}"));
         assert!(
             merged == fs::read(&reference).unwrap(),
             "the merged image differs from the one-machine render"
         );
     }
-    eprintln!("Slurm render and merge took {:?}", started.elapsed());
+    eprintln!("Slurm renders and merges took {:?}", started.elapsed());
 }
