@@ -1,8 +1,9 @@
 //! The deployment scripts of `deploy/` (docs/distributed.md): the task script
 //! both cluster engines run, the merge script, and a whole render split
 //! across a real one-node Slurm cluster started by the test — a job array
-//! submitted by `deploy/slurm/submit.sh`, one task requeued while it runs, and
-//! the merge job running only once every part is written.
+//! submitted by `deploy/slurm/submit.sh`, one task requeued while it runs and
+//! one failing, the merge job running once every task has ended and refusing
+//! the incomplete set, and the failed index rerun as docs/distributed.md says.
 //!
 //! The Slurm test needs Slurm and munge (Debian: `slurm-wlm munge`) and root,
 //! which slurmd needs to start jobs. Without them it says it is skipped and
