@@ -565,13 +565,26 @@ PartitionName=debug Nodes={host} Default=YES MaxTime=INFINITE State=UP
 
     fn spawn(&mut self, name: &'static str, args: &[&str]) {
         let log = fs::File::create(self.dir.join(format!("{name}.out"))).unwrap();
-        let child = Command::new(find_program(name).unwrap())
-            .args(args)
+        let mut cmd = Command::new(find_program(name).unwrap());
+        cmd.args(args)
             .stdin(Stdio::null())
             .stdout(log.try_clone().unwrap())
-            .stderr(log)
-            .spawn()
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            .stderr(log);
+        // Should the test process die without dropping the cluster (killed
+        // by a timeout, say), the daemons die with it rather than linger.
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::unix::process::CommandExt;
+            // SAFETY: prctl is async-signal-safe, as code between fork and
+            // exec must be; it touches no memory of the parent.
+            unsafe {
+                cmd.pre_exec(|| {
+                    libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
+                    Ok(())
+                });
+            }
+        }
+        let child = cmd.spawn().unwrap_or_else(|e| panic!("{name}: {e}"));
         self.daemons.push((name, child));
     }
 
