@@ -55,8 +55,18 @@ pub const MAX_PASS_SPP: u32 = 64;
 /// stop or a time limit loses little. It depends on `done` and `spp` only,
 /// so a resumed render takes the same passes as one never stopped.
 pub fn pass_size(done: u32, spp: u32) -> u32 {
+    share_pass_size(done, spp, spp)
+}
+
+/// [`pass_size`] for a share of `len` samples per pixel of a render of
+/// `spp` (a part, see [`crate::part`]). A part shows no image while it
+/// renders, so its passes do not start small: they are all the whole
+/// render's largest, which keeps as many paths side by side as the whole
+/// render traces (passes of a sample or two are markedly slower per sample).
+pub fn share_pass_size(done: u32, len: u32, spp: u32) -> u32 {
     let cap = (spp / 8).clamp(1, MAX_PASS_SPP);
-    done.max(1).min(cap).min(spp.saturating_sub(done))
+    let first = if len == spp { done.max(1) } else { cap };
+    first.min(cap).min(len.saturating_sub(done))
 }
 
 /// All passes of a render of `spp` samples per pixel, as sample ranges.
@@ -74,9 +84,16 @@ pub fn schedule(spp: u32) -> Vec<Range<u32>> {
 /// Whether a pass of a render of `spp` samples per pixel ends at `done`
 /// (see [`pass_size`]): lumen saves checkpoints between passes only.
 pub fn ends_a_pass(done: u32, spp: u32) -> bool {
+    ends_a_share_pass(done, spp, spp)
+}
+
+/// Whether a pass of a share of `len` samples per pixel of a render of
+/// `spp` ends `done` samples into the share (see [`share_pass_size`]); an
+/// empty share ends at 0.
+pub fn ends_a_share_pass(done: u32, len: u32, spp: u32) -> bool {
     let mut at = 0;
-    while at < done && at < spp {
-        at += pass_size(at, spp);
+    while at < done && at < len {
+        at += share_pass_size(at, len, spp);
     }
     at == done
 }
@@ -288,7 +305,7 @@ impl Session {
             checkpoint.spp_done - self.share.start,
             self.share.len() as u32,
         );
-        if !(ends_a_pass(done, len) || done == 0 && len == 0) {
+        if !ends_a_share_pass(done, len, s.samples_per_pixel) {
             return Err(malformed(format!(
                 "it holds {} spp, where no pass of a {} spp render ends",
                 checkpoint.spp_done, s.samples_per_pixel
@@ -366,12 +383,13 @@ impl Session {
         }
     }
 
-    /// Samples per pixel of the next pass: the schedule of [`pass_size`]
-    /// over this session's share.
+    /// Samples per pixel of the next pass: the schedule of
+    /// [`share_pass_size`] over this session's share.
     fn next_pass_size(&self) -> u32 {
-        pass_size(
+        share_pass_size(
             self.spp_done - self.share.start,
             self.share.end - self.share.start,
+            self.spp_total(),
         )
     }
 
@@ -504,6 +522,36 @@ mod tests {
         assert_eq!(schedule(64).len(), 11);
         assert!(ends_a_pass(4, 64) && ends_a_pass(64, 64));
         assert!(!ends_a_pass(3, 64) && !ends_a_pass(65, 64));
+    }
+
+    #[test]
+    fn a_share_renders_in_the_whole_renders_largest_passes() {
+        // 500 spp in 8 parts: shares of 62 or 63 in passes of 62.
+        let sizes = |len: u32, spp: u32| {
+            let (mut done, mut out) = (0, Vec::new());
+            while done < len {
+                let n = share_pass_size(done, len, spp);
+                assert!(ends_a_share_pass(done, len, spp));
+                out.push(n);
+                done += n;
+            }
+            assert!(ends_a_share_pass(len, len, spp));
+            assert!(len == 0 || !ends_a_share_pass(len - 1, len, spp) || out.last() == Some(&1));
+            out
+        };
+        assert_eq!(sizes(62, 500), [62]);
+        assert_eq!(sizes(63, 500), [62, 1]);
+        assert_eq!(sizes(16, 128), [16]);
+        assert_eq!(sizes(40, 128), [16, 16, 8]);
+        assert_eq!(sizes(0, 5), Vec::<u32>::new());
+        // A whole render keeps its schedule.
+        assert_eq!(
+            sizes(64, 64),
+            schedule(64)
+                .iter()
+                .map(|p| p.len() as u32)
+                .collect::<Vec<_>>()
+        );
     }
 
     #[test]
