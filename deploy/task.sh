@@ -18,16 +18,16 @@
 #   LUMEN_BIN        the lumen command [lumen]
 #
 # It runs
-#   lumen render SCENE --part K/N -o DIR/part-K.lumen-part
-#                --checkpoint DIR/part-K.lumen-ckpt [--resume] LUMEN_ARGS
-# The checkpoint is named after the part and kept beside it on the shared
-# volume, so a task that is killed and requeued, on this node or another,
-# continues where it stopped. --resume is given whenever the part file or its
-# checkpoint exists: lumen then continues the checkpoint, or returns at once
-# when the part is already complete. A task that never started is rendered
-# afresh.
+#   lumen render SCENE --part K/N -o DIR/part-K.lumen-part [--resume] LUMEN_ARGS
+# The part file is its own checkpoint: lumen rewrites it after every pass,
+# on the shared volume, so a task that is killed and requeued, on this node
+# or another, continues where it stopped. --resume is given whenever the part
+# file exists: lumen then continues it, or returns at once when the part is
+# already complete. A task that never started is rendered afresh.
 #
-# Exit status: lumen's; 2 when the settings are missing or wrong.
+# Exit status: lumen's (0: the part is complete; 1: it is not, for instance
+# --time-limit ran out, the part file saved for --resume; 130: stopped by a
+# signal, the part file saved); 2 when the settings are missing or wrong.
 set -eu
 
 me=lumen-task
@@ -85,26 +85,29 @@ dir=${LUMEN_PARTS_DIR:-}
 [ -d "$dir" ] || refuse "LUMEN_PARTS_DIR $dir is not a directory (it must exist and be shared by every task)"
 
 # These options are the script's to give; a second copy in LUMEN_ARGS would
-# either be refused by lumen or point the task at another file.
+# either be refused by lumen or point the task at another file. --checkpoint
+# has no place at all: the part file is the checkpoint.
 set -f
 for arg in ${LUMEN_ARGS:-}; do
     case $arg in
-        -o | --output | --output=* | -o?* | --part | --part=* | --checkpoint | --checkpoint=* | --resume)
-            refuse "LUMEN_ARGS holds $arg, which $me sets itself (output, part, checkpoint, resume)"
+        -o | --output | --output=* | -o?* | --part | --part=* | --resume)
+            refuse "LUMEN_ARGS holds $arg, which $me sets itself (output, part, resume)"
+            ;;
+        --checkpoint | --checkpoint=*)
+            refuse "LUMEN_ARGS holds $arg: a part file is its own checkpoint, so lumen takes no --checkpoint with --part"
             ;;
     esac
 done
 
 part="$dir/part-$index.lumen-part"
-checkpoint="$dir/part-$index.lumen-ckpt"
 resume=
-if [ -e "$part" ] || [ -e "$checkpoint" ]; then
+if [ -e "$part" ]; then
     resume=--resume
 fi
 
 echo "$me: part $index/$count of $scene -> $part${resume:+ (resuming)} on $(hostname 2>/dev/null || echo '?')" >&2
 # exec: lumen receives the engine's SIGTERM itself (Slurm requeue or
-# preemption, a Kubernetes pod deletion) and saves its checkpoint.
+# preemption, a Kubernetes pod deletion), saves its part file and exits 130.
 # shellcheck disable=SC2086 # LUMEN_ARGS is split on purpose; globbing is off.
 exec "${LUMEN_BIN:-lumen}" render "$scene" --part "$index/$count" \
-    -o "$part" --checkpoint "$checkpoint" $resume ${LUMEN_ARGS:-}
+    -o "$part" $resume ${LUMEN_ARGS:-}
