@@ -22,7 +22,9 @@ pub struct RenderStats {
     pub samples: u64,
     /// Ray segments traced (camera rays and bounces).
     pub rays: u64,
-    /// Samples whose colour was NaN or infinite and were left out of the image.
+    /// Samples whose colour was NaN, infinite or too large for the film's
+    /// sums (2⁶³ or more, see [`crate::film::Sum`]) and were left out of the
+    /// image.
     pub dropped: u64,
 }
 
@@ -35,7 +37,8 @@ impl RenderStats {
     }
 
     /// A warning when more than [`DROPPED_WARNING`] of the samples were
-    /// dropped (NaN or infinite), with their count and the likely causes.
+    /// dropped (NaN, infinite or too large), with their count and the
+    /// likely causes.
     pub fn dropped_warning(&self) -> Option<String> {
         if self.dropped == 0 || (self.dropped as f64) <= DROPPED_WARNING * self.samples as f64 {
             return None;
@@ -47,7 +50,8 @@ impl RenderStats {
             format!("{} of {} samples ({share:.2}%)", self.dropped, self.samples)
         };
         Some(format!(
-            "{what} came out NaN or infinite and left out of the image: likely a degenerate \
+            "{what} came out NaN, infinite or beyond 9.2e18 (more than a pixel's sum holds) \
+             and left out of the image: likely a degenerate \
              camera (focus_dist or vfov tiny against the coordinates), geometry at the limits \
              of f32, or extreme radiance"
         ))

@@ -1,8 +1,8 @@
 //! Peak memory of a full-size cover render, measured on the real binary.
 #![cfg(target_os = "linux")]
 //!
-//! The film of a 1200×675 image takes 28 bytes a pixel (f64 sums and a u32
-//! count); a pass in flight keeps a copy to restore if it is abandoned, and
+//! The film of a 1200×675 image takes 52 bytes a pixel (three `i128`
+//! fixed-point sums and a u32 count, 42 MB); a pass in flight keeps a copy to restore if it is abandoned, and
 //! checkpoints and images are encoded without full-size intermediate copies.
 //! This file holds one test only: `RUSAGE_CHILDREN` reports the largest child
 //! this test process has waited for.
@@ -10,7 +10,7 @@
 mod lumen_process;
 
 #[test]
-fn full_size_cover_render_stays_under_64_mb() {
+fn full_size_cover_render_stays_under_100_mb() {
     let dir = lumen_process::temp_dir("memory");
     let out = dir.join("cover.png");
     let (status, stderr) = lumen_process::run(
@@ -33,8 +33,8 @@ fn full_size_cover_render_stays_under_64_mb() {
     let peak_mb = usage.ru_maxrss as f64 / 1024.0;
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(
-        peak_mb > 22.0,
+        peak_mb > 42.0,
         "peak {peak_mb:.1} MB is below the film's own size: not measured"
     );
-    assert!(peak_mb < 64.0, "peak memory {peak_mb:.1} MB");
+    assert!(peak_mb < 100.0, "peak memory {peak_mb:.1} MB");
 }

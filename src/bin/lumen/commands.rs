@@ -20,12 +20,12 @@ pub(crate) fn gallery_command(dir: &Path, args: &SettingArgs) -> Result<()> {
         total.add(stats);
     })?;
     bar.finish_and_clear();
-    eprintln!(
+    errln!(
         "gallery of {} scenes written to {}",
         BUILTINS.len(),
         dir.join("index.html").display()
     );
-    eprintln!("{}", summary(&total, &total, start.elapsed()));
+    errln!("{}", summary(&total, &total, start.elapsed()));
     Ok(())
 }
 

@@ -54,7 +54,7 @@ pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
     if looks_like_file {
         let file = SceneFile::read(path)?;
         for warning in file.desc.warnings() {
-            eprintln!("lumen: warning: {}: {warning}", file.name);
+            errln!("lumen: warning: {}: {warning}", file.name);
         }
         return Ok(SceneSource::File(file));
     }
@@ -91,7 +91,7 @@ pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) 
                     .and_then(|()| w.flush())
                     .map_err(|e| e.to_string())
             })?;
-            eprintln!("{name}: written to {}", path.display());
+            errln!("{name}: written to {}", path.display());
         }
         None => {
             let mut w = std::io::BufWriter::new(std::io::stdout().lock());
