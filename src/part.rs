@@ -112,7 +112,7 @@ pub enum MergeError {
         done: u32,
     },
     /// No part holds some samples.
-    #[error("no part holds samples {} of the {spp} spp render: {} (merge with --partial for a preview)", list(.missing), if .missing.len() == 1 { "a part is missing" } else { "parts are missing" })]
+    #[error("no part holds samples {} of the {spp} spp render: {} (merge with --partial for a preview)", ranges_text(.missing), if .missing.len() == 1 { "a part is missing" } else { "parts are missing" })]
     Missing {
         /// The samples per pixel of the render.
         spp: u32,
@@ -124,8 +124,8 @@ pub enum MergeError {
     NoSampleCount(PathBuf),
 }
 
-/// `a..b, c..d`.
-fn list(ranges: &[Range<u32>]) -> String {
+/// Sample ranges in words: `a..b, c..d`, at most eight of them.
+pub fn ranges_text(ranges: &[Range<u32>]) -> String {
     let shown: Vec<String> = ranges
         .iter()
         .take(8)
@@ -151,6 +151,9 @@ pub struct Merged {
     pub stats: RenderStats,
     /// The display gamma of the render (the first part's).
     pub gamma: f32,
+    /// [`crate::checkpoint::RENDERER_ID`] of the lumen that rendered the
+    /// parts.
+    pub renderer_id: String,
     /// The render's identity (canonical scene description).
     pub description: String,
 }
@@ -159,6 +162,11 @@ impl Merged {
     /// Whether the film holds every sample of the render.
     pub fn is_complete(&self) -> bool {
         self.held.len() == 1 && self.held[0] == (0..self.spp)
+    }
+
+    /// Samples per pixel the film holds.
+    pub fn held_spp(&self) -> u32 {
+        self.held.iter().map(|r| r.end - r.start).sum()
     }
 }
 
@@ -169,8 +177,8 @@ impl Merged {
 /// preview). Parts of different renders, and parts holding the same
 /// samples, are refused either way.
 pub fn merge(paths: &[PathBuf], partial: bool) -> Result<Merged, MergeError> {
-    let mut merged: Option<(Merged, PathBuf)> = None;
-    // (share held, path) of every part read so far.
+    let mut merged: Option<Merged> = None;
+    // (samples held, path) of every part read so far, the first first.
     let mut seen: Vec<(Range<u32>, PathBuf)> = Vec::new();
     for path in paths {
         let part = Checkpoint::read(path)?;
@@ -188,6 +196,30 @@ pub fn merge(paths: &[PathBuf], partial: bool) -> Result<Merged, MergeError> {
                 done: part.spp_done,
             });
         }
+        if let (Some(m), Some((_, first))) = (&merged, seen.first()) {
+            let differences = if part.renderer_id != m.renderer_id {
+                format!(
+                    "written by lumen {} and {}",
+                    m.renderer_id, part.renderer_id
+                )
+            } else if !same_render(&part.description, &m.description) {
+                describe_differences(
+                    &m.description,
+                    &part.description,
+                    &first.display().to_string(),
+                    &format!("in {}", path.display()),
+                )
+            } else {
+                String::new()
+            };
+            if !differences.is_empty() {
+                return Err(MergeError::DifferentRenders {
+                    first: first.clone(),
+                    other: path.clone(),
+                    differences,
+                });
+            }
+        }
         let held = part.share.start..part.spp_done;
         for (other, other_path) in &seen {
             // A part with an empty share (more parts than samples) holds
@@ -201,46 +233,30 @@ pub fn merge(paths: &[PathBuf], partial: bool) -> Result<Merged, MergeError> {
                 });
             }
         }
-        seen.push((held.clone(), path.clone()));
+        seen.push((held, path.clone()));
         match &mut merged {
-            None => {
-                let spp = samples_per_pixel(&part.description)
-                    .ok_or_else(|| MergeError::NoSampleCount(path.clone()))?;
-                merged = Some((
-                    Merged {
-                        film: part.film,
-                        spp,
-                        held: Vec::new(),
-                        stats: part.stats,
-                        gamma: part.gamma,
-                        description: part.description,
-                    },
-                    path.clone(),
-                ));
-            }
-            Some((m, first)) => {
-                if part.renderer_id != crate::checkpoint::RENDERER_ID
-                    || !same_render(&part.description, &m.description)
-                {
-                    return Err(MergeError::DifferentRenders {
-                        first: first.clone(),
-                        other: path.clone(),
-                        differences: describe_differences(
-                            &m.description,
-                            &part.description,
-                            &first.display().to_string(),
-                            &format!("in {}", path.display()),
-                        ),
-                    });
-                }
+            Some(m) => {
                 // Same description, so the same image size.
                 let added = m.film.add_film(&part.film);
                 debug_assert!(added, "parts of one render have one film size");
                 m.stats.add(part.stats);
             }
+            None => {
+                let spp = samples_per_pixel(&part.description)
+                    .ok_or_else(|| MergeError::NoSampleCount(path.clone()))?;
+                merged = Some(Merged {
+                    film: part.film,
+                    spp,
+                    held: Vec::new(),
+                    stats: part.stats,
+                    gamma: part.gamma,
+                    renderer_id: part.renderer_id,
+                    description: part.description,
+                });
+            }
         }
     }
-    let (mut m, _) = merged.ok_or(MergeError::NoParts)?;
+    let mut m = merged.ok_or(MergeError::NoParts)?;
     let mut ranges: Vec<Range<u32>> = seen.into_iter().map(|(r, _)| r).collect();
     ranges.sort_by_key(|r| r.start);
     let mut missing = Vec::new();

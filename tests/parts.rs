@@ -3,27 +3,17 @@
 //! number of parts and the order they are merged in; parts that do not make
 //! one render are refused, naming the files.
 
+mod common;
 mod lumen_process;
 
+use common::builtin_desc as desc;
 use lumen::part::{self, MergeError, Part};
 use lumen::progressive::{Session, StopReason};
 use lumen::render::render;
-use lumen::scene::{builtin, Overrides, Scene, SceneDesc};
+use lumen::scene::{Scene, SceneDesc};
 use lumen_process::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-
-fn desc(name: &str, width: u32, spp: u32, seed: u64) -> SceneDesc {
-    let mut desc = builtin::find(name).unwrap().desc();
-    Overrides {
-        width: Some(width),
-        samples_per_pixel: Some(spp),
-        seed: Some(seed),
-        ..Overrides::default()
-    }
-    .apply(&mut desc);
-    desc
-}
 
 /// Renders `part` of `desc` through the library, stopping after `passes`
 /// passes if given, and writes its part file into `dir`.
@@ -163,6 +153,14 @@ fn parts_that_do_not_make_one_render_are_refused_naming_the_files() {
         different.contains("are parts of different renders (seed 1 in"),
         "{different}"
     );
+
+    // Parts of another lumen are another render, whichever comes first.
+    let mut older = lumen::checkpoint::Checkpoint::read(&parts[0]).unwrap();
+    older.renderer_id = "0.0.1+samples.1".into();
+    let older_path = dir.join("older.lumen-part");
+    older.view().write(&older_path).unwrap();
+    let e = err(&[older_path, parts[1].clone(), parts[2].clone()]);
+    assert!(e.contains("written by lumen 0.0.1+samples.1 and"), "{e}");
 
     let truncated = dir.join("truncated.lumen-part");
     let bytes = std::fs::read(&parts[1]).unwrap();

@@ -8,19 +8,6 @@ use lumen::part::{self, Merged};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `a..b`, `a..b and c..d`, …
-fn ranges(held: &[std::ops::Range<u32>]) -> String {
-    let shown: Vec<String> = held
-        .iter()
-        .map(|r| format!("{}..{}", r.start, r.end))
-        .collect();
-    if shown.is_empty() {
-        "no samples".into()
-    } else {
-        format!("samples {}", shown.join(", "))
-    }
-}
-
 pub(crate) fn merge_command(
     parts: &[PathBuf],
     out: &Path,
@@ -42,7 +29,6 @@ pub(crate) fn merge_command(
         bail!("the parts hold no samples yet: nothing to merge");
     }
     output::write_image(out, &merged.film, gamma.unwrap_or(merged.gamma))?;
-    let held: u32 = merged.held.iter().map(|r| r.end - r.start).sum();
     if merged.is_complete() {
         errln!(
             "merged {} part{} ({} spp) into {}",
@@ -53,11 +39,11 @@ pub(crate) fn merge_command(
         );
     } else {
         errln!(
-            "lumen: partial merge: {} holds {} of {} spp ({}) of every pixel",
+            "lumen: partial merge: {} holds {} of {} spp (samples {}) of every pixel",
             out.display(),
-            held,
+            merged.held_spp(),
             merged.spp,
-            ranges(&merged.held)
+            part::ranges_text(&merged.held)
         );
     }
     Ok(ExitCode::SUCCESS)
