@@ -46,10 +46,10 @@ fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
 }
 
 /// Removes the temporaries of `paths` that killed renders left, saying so.
-fn remove_stale_temps(paths: [&Path; 2]) {
+fn remove_stale_temps(paths: &[&Path]) {
     let removed: Vec<String> = paths
-        .into_iter()
-        .flat_map(files::remove_stale_temps)
+        .iter()
+        .flat_map(|p| files::remove_stale_temps(p))
         .map(|p| p.display().to_string())
         .collect();
     if !removed.is_empty() {
@@ -85,10 +85,12 @@ pub(crate) fn render_command(
             output::ImageFormat::from_path(out)?;
         }
     }
-    // A part file is its own checkpoint.
-    let ckpt_path = match prog.part {
-        Some(_) => out.to_path_buf(),
-        None => {
+    // What the render saves: the image and its checkpoint, or a part file,
+    // which is its own checkpoint.
+    let image = prog.part.is_none().then_some(out);
+    let ckpt_path = match image {
+        None => out.to_path_buf(),
+        Some(_) => {
             let ckpt_path = prog
                 .checkpoint
                 .clone()
@@ -97,22 +99,27 @@ pub(crate) fn render_command(
             ckpt_path
         }
     };
+    let targets: Vec<&Path> = match image {
+        Some(image) => vec![image, &ckpt_path],
+        None => vec![&ckpt_path],
+    };
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
-    output::check_writable(&ckpt_path).context("checkpoint")?;
-    // Held to the end: no other render writes these files meanwhile.
-    let mut locks = vec![RenderLock::acquire(out)?];
-    if ckpt_path != out {
-        locks.push(RenderLock::acquire(&ckpt_path)?);
+    if image.is_some() {
+        output::check_writable(&ckpt_path).context("checkpoint")?;
     }
-    remove_stale_temps([out, &ckpt_path]);
-    let existing = checkpoint::inspect(&ckpt_path)?;
+    // Held to the end: no other render writes these files meanwhile.
+    let _locks = targets
+        .iter()
+        .map(|t| RenderLock::acquire(t))
+        .collect::<Result<Vec<_>, _>>()?;
+    remove_stale_temps(&targets);
     let session = match prog.part {
         Some(part) => Session::with_part(&desc, scene, part)?,
         None => Session::with_scene(&desc, scene),
     };
     let mut session = if prog.resume {
-        if existing == Existing::Nothing {
+        if !ckpt_path.exists() {
             bail!(
                 "--resume: there is no checkpoint at {}",
                 ckpt_path.display()
@@ -121,7 +128,7 @@ pub(crate) fn render_command(
         let ckpt = Checkpoint::read(&ckpt_path)?;
         session.restore(ckpt, &ckpt_path)?
     } else {
-        match existing {
+        match checkpoint::inspect(&ckpt_path)? {
             Existing::Nothing => {}
             Existing::Checkpoint => errln!(
                 "lumen: note: starting afresh; the checkpoint {} will be replaced (--resume continues it)",
@@ -136,11 +143,7 @@ pub(crate) fn render_command(
     };
 
     let stop = Arc::new(AtomicBool::new(false));
-    install_stop_handler(
-        &stop,
-        [output::temp_path(out), output::temp_path(&ckpt_path)],
-        locks.iter().map(|l| l.path().to_path_buf()).collect(),
-    )?;
+    install_stop_handler(&stop, &targets)?;
 
     let s = session.scene().settings.clone();
     let resumed_from = session.spp_done();
@@ -167,20 +170,17 @@ pub(crate) fn render_command(
     // one step that a second interrupt lets finish (see `signals`).
     let save = |session: &Session| -> Result<()> {
         let _saving = saving();
-        if prog.part.is_some() {
-            session
-                .checkpoint()
-                .write(out)
-                .context("cannot save the part")?;
-            quit_if_asked();
-            return Ok(());
+        if let Some(image) = image {
+            output::write_image(image, session.film(), s.gamma)?;
         }
-        output::write_image(out, session.film(), s.gamma)?;
-        if !session.is_complete() {
+        if image.is_none() || !session.is_complete() {
             session
                 .checkpoint()
                 .write(&ckpt_path)
-                .context("cannot save the checkpoint")?;
+                .context(match image {
+                    Some(_) => "cannot save the checkpoint",
+                    None => "cannot save the part",
+                })?;
         }
         quit_if_asked();
         Ok(())
@@ -224,19 +224,18 @@ pub(crate) fn render_command(
     let elapsed = start.elapsed();
     bar.finish_and_clear();
     let (held, total) = (session.spp_done(), session.spp_total());
-    let code = match run.reason {
-        StopReason::Complete if prog.part.is_some() => {
+    let code = match (run.reason, prog.part) {
+        (StopReason::Complete, Some(part)) => {
             save(&session)?;
             errln!(
-                "{name}: part {}: samples {}..{} of {total} spp written to {}",
-                prog.part.expect("a part"),
+                "{name}: part {part}: samples {}..{} of {total} spp written to {}",
                 share.start,
                 share.end,
                 out.display()
             );
             ExitCode::SUCCESS
         }
-        StopReason::Complete => {
+        (StopReason::Complete, None) => {
             save(&session)?;
             if let Err(e) = checkpoint::remove(&ckpt_path) {
                 errln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
@@ -252,21 +251,21 @@ pub(crate) fn render_command(
             errln!("{name}: {spp} written to {}", out.display());
             ExitCode::SUCCESS
         }
-        reason if held == share.start => {
+        (reason, _) if held == share.start => {
             debug_assert_eq!(reason, StopReason::Interrupted);
             errln!("lumen: interrupted before the first pass finished; nothing written");
             ExitCode::from(EXIT_INTERRUPTED)
         }
-        reason => {
+        (reason, part) => {
             save(&session)?;
             let (why, code) = match reason {
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 // An unfinished part is not a finished task: a job engine
                 // must see it fail, and the merge refuses it.
-                _ if prog.part.is_some() => ("time limit reached", ExitCode::FAILURE),
+                _ if part.is_some() => ("time limit reached", ExitCode::FAILURE),
                 _ => ("time limit reached", ExitCode::SUCCESS),
             };
-            if prog.part.is_some() {
+            if part.is_some() {
                 errln!(
                     "lumen: {why}: part {} holds samples {}..{held} of its share {}..{}; continue with --resume",
                     out.display(),
@@ -289,7 +288,6 @@ pub(crate) fn render_command(
     if let Some(warning) = all.dropped_warning() {
         errln!("lumen: warning: {warning}");
     }
-    drop(locks);
     if all.all_dropped() {
         return Ok(ExitCode::FAILURE);
     }

@@ -1,7 +1,8 @@
 //! Ctrl-C and SIGTERM: the first stops the render gracefully, the second at once.
 
 use anyhow::{Context, Result};
-use std::path::PathBuf;
+use lumen::{lock, output};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock, TryLockError};
 use std::time::{Duration, Instant};
@@ -44,13 +45,11 @@ fn quit_now() -> ! {
 /// place only once written. A save in progress is let finish, so as not to
 /// leave its temporary files behind (the saver exits after it); should it
 /// take more than two seconds, its temporary files are removed and the
-/// process exits anyway. Quitting at once removes the `locks` files.
-pub(crate) fn install_stop_handler(
-    stop: &Arc<AtomicBool>,
-    temps: [PathBuf; 2],
-    locks: Vec<PathBuf>,
-) -> Result<()> {
-    let _ = LOCK_FILES.set(locks);
+/// process exits anyway. Quitting at once removes the lock files of the
+/// render's `targets` (the files it writes).
+pub(crate) fn install_stop_handler(stop: &Arc<AtomicBool>, targets: &[&Path]) -> Result<()> {
+    let temps: Vec<PathBuf> = targets.iter().map(|t| output::temp_path(t)).collect();
+    let _ = LOCK_FILES.set(targets.iter().map(|t| lock::lock_path(t)).collect());
     let stop = Arc::clone(stop);
     ctrlc::set_handler(move || {
         if !stop.swap(true, Ordering::SeqCst) {
