@@ -12,27 +12,29 @@ the same on every run and the TOML and JSON forms describe the same scene.
 Every sphere is its own [[objects]] table, as a person or a simple program
 would write it.
 """
+import json
 import math
 import random
 import sys
 
 MATERIALS = {
-    "floor": '{ type = "diffuse", albedo = [0.5, 0.5, 0.5] }',
-    "matte": '{ type = "diffuse", albedo = [0.7, 0.3, 0.2] }',
-    "metal": '{ type = "metal", albedo = [0.8, 0.8, 0.9], fuzz = 0.1 }',
-    "glass": '{ type = "dielectric", ior = 1.5 }',
-}
-MATERIALS_JSON = {
-    "floor": '{"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}',
-    "matte": '{"type": "diffuse", "albedo": [0.7, 0.3, 0.2]}',
-    "metal": '{"type": "metal", "albedo": [0.8, 0.8, 0.9], "fuzz": 0.1}',
-    "glass": '{"type": "dielectric", "ior": 1.5}',
+    "floor": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]},
+    "matte": {"type": "diffuse", "albedo": [0.7, 0.3, 0.2]},
+    "metal": {"type": "metal", "albedo": [0.8, 0.8, 0.9], "fuzz": 0.1},
+    "glass": {"type": "dielectric", "ior": 1.5},
 }
 NAMES = ["matte", "metal", "glass"]
 
 
+def toml_inline(table):
+    """A flat table as a TOML inline table (its values written as in JSON)."""
+    return "{ %s }" % ", ".join("%s = %s" % (k, json.dumps(v)) for k, v in table.items())
+
+
 def spheres(n):
-    """(x, y, z, radius, material) of n spheres on a grid around the origin."""
+    """(x, y, z, radius, material) of the floor, then of n spheres on a grid
+    around the origin."""
+    yield 0, -10000, 0, 10000, "floor"
     rng = random.Random(1)
     side = max(1, math.ceil(math.sqrt(n)))
     spacing = 0.5
@@ -50,9 +52,7 @@ def write_toml(out, n):
     out.write("[camera]\nvfov = 40\nlookfrom = [0, 40, 120]\nlookat = [0, 0, 0]\n\n")
     out.write("[materials]\n")
     for name, body in MATERIALS.items():
-        out.write("%s = %s\n" % (name, body))
-    out.write('\n[[objects]]\ntype = "sphere"\ncenter = [0, -10000, 0]\n'
-              'radius = 10000\nmaterial = "floor"\n')
+        out.write("%s = %s\n" % (name, toml_inline(body)))
     for x, y, z, r, m in spheres(n):
         out.write('\n[[objects]]\ntype = "sphere"\ncenter = [%s, %s, %s]\n'
                   'radius = %s\nmaterial = "%s"\n' % (x, y, z, r, m))
@@ -63,13 +63,12 @@ def write_json(out, n):
     out.write('  "render": {"width": 400, "samples_per_pixel": 16, "max_depth": 8},\n')
     out.write('  "camera": {"vfov": 40, "lookfrom": [0, 40, 120], "lookat": [0, 0, 0]},\n')
     out.write('  "materials": {\n')
-    out.write(",\n".join('    "%s": %s' % kv for kv in MATERIALS_JSON.items()))
-    out.write('\n  },\n  "objects": [\n')
-    out.write('    {"type": "sphere", "center": [0, -10000, 0], "radius": 10000, '
-              '"material": "floor"}')
-    for x, y, z, r, m in spheres(n):
-        out.write(',\n    {"type": "sphere", "center": [%s, %s, %s], "radius": %s, '
-                  '"material": "%s"}' % (x, y, z, r, m))
+    out.write(",\n".join('    "%s": %s' % (name, json.dumps(body))
+                          for name, body in MATERIALS.items()))
+    out.write('\n  },\n  "objects": [')
+    for i, (x, y, z, r, m) in enumerate(spheres(n)):
+        out.write('%s\n    {"type": "sphere", "center": [%s, %s, %s], "radius": %s, '
+                  '"material": "%s"}' % ("," if i else "", x, y, z, r, m))
     out.write("\n  ]\n}\n")
 
 

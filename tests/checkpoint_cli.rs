@@ -5,39 +5,10 @@
 mod lumen_process;
 
 use lumen::checkpoint::{default_path, Checkpoint};
-use lumen::progressive::{Session, StopReason};
-use lumen::scene::{builtin, Overrides};
 use lumen_process::*;
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 const SMALL: &[&str] = &["render", "cover", "--width", "48", "--spp", "16"];
-
-/// Writes, through the library, the checkpoint that `lumen render cover
-/// --width 48 --spp 16 -o out` leaves after `passes` passes.
-fn make_checkpoint(out: &Path, passes: u32) -> Vec<u8> {
-    let mut desc = builtin::find("cover").unwrap().desc();
-    Overrides {
-        width: Some(48),
-        samples_per_pixel: Some(16),
-        ..Overrides::default()
-    }
-    .apply(&mut desc);
-    let mut session = Session::new(&desc).unwrap();
-    let stop = AtomicBool::new(false);
-    let run = session
-        .run(&stop, None, &|_| {}, &mut |_, pass| {
-            if pass.number == passes {
-                stop.store(true, std::sync::atomic::Ordering::SeqCst);
-            }
-            Ok::<(), ()>(())
-        })
-        .unwrap();
-    assert_eq!(run.reason, StopReason::Interrupted);
-    let path = default_path(out);
-    session.checkpoint().write(&path).unwrap();
-    std::fs::read(path).unwrap()
-}
 
 /// Runs `--resume` expecting a refusal that mentions every one of `words`;
 /// the checkpoint must be left as it was and no image written.

@@ -82,7 +82,7 @@ struct Layout {
 }
 
 fn layout(bytes: &[u8]) -> Layout {
-    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let u32_at = |at: usize| get_u32(bytes, at) as usize;
     let id = HEADER_LEN + 4..HEADER_LEN + 4 + u32_at(HEADER_LEN);
     let desc = id.end + 4..id.end + 4 + u32_at(id.end);
     let spp = desc.end;
@@ -132,6 +132,16 @@ fn get_u32(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap())
 }
 
+/// Replaces the u32 at `at` by another value (see [`other_than`]).
+fn perturb_u32(rng: &mut Rng, bytes: &mut [u8], at: usize) {
+    let old = get_u32(bytes, at);
+    put_u32(
+        bytes,
+        at,
+        other_than(rng, old.into(), u32::MAX.into()) as u32,
+    );
+}
+
 /// A value other than `old`: small neighbours, extremes, or random.
 fn other_than(rng: &mut Rng, old: u64, max: u64) -> u64 {
     loop {
@@ -167,26 +177,18 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
             format!("description byte {at}")
         }
         2 => {
-            let old = get_u32(bytes, l.spp);
-            put_u32(
-                bytes,
-                l.spp,
-                other_than(rng, old.into(), u32::MAX.into()) as u32,
-            );
+            perturb_u32(rng, bytes, l.spp);
             "spp done".into()
         }
         3 => {
             let at = l.width + 4 * rng.below(2);
-            let old = get_u32(bytes, at);
-            let v = if rng.below(2) == 0 {
-                get_u32(bytes, l.width + 4 * usize::from(at == l.width))
+            if rng.below(2) == 0 {
+                // The other side's value, or one more if they are equal.
+                let old = get_u32(bytes, at);
+                let v = get_u32(bytes, l.width + 4 * usize::from(at == l.width));
+                put_u32(bytes, at, if v == old { old + 1 } else { v });
             } else {
-                other_than(rng, old.into(), u32::MAX.into()) as u32
-            };
-            if v == old {
-                put_u32(bytes, at, old + 1);
-            } else {
-                put_u32(bytes, at, v);
+                perturb_u32(rng, bytes, at);
             }
             "image size".into()
         }
@@ -194,18 +196,12 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
             // The ray count only feeds the closing summary: a change is
             // accepted, and the image is the same.
             let at = [l.samples, l.dropped, l.rays][rng.below(3)];
-            let old = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+            let old = get_u64(bytes, at);
             put_u64(bytes, at, other_than(rng, old, u64::MAX));
             format!("statistic at {at}")
         }
         5 => {
-            let at = l.counts + 4 * pixel;
-            let old = get_u32(bytes, at);
-            put_u32(
-                bytes,
-                at,
-                other_than(rng, old.into(), u32::MAX.into()) as u32,
-            );
+            perturb_u32(rng, bytes, l.counts + 4 * pixel);
             format!("count of pixel {pixel}")
         }
         6 => {
@@ -231,13 +227,7 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
             // samples done (no sample of this scene is dropped).
             let at = l.flags + pixel;
             if bytes[at] == 1 {
-                let at = l.odd_counts + 4 * pixel;
-                let old = get_u32(bytes, at);
-                put_u32(
-                    bytes,
-                    at,
-                    other_than(rng, old.into(), u32::MAX.into()) as u32,
-                );
+                perturb_u32(rng, bytes, l.odd_counts + 4 * pixel);
                 format!("odd count of pixel {pixel}")
             } else if get_u32(bytes, l.counts + 4 * pixel) < get_u32(bytes, l.spp) {
                 bytes[at] = 1;
@@ -258,6 +248,15 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
     what
 }
 
+/// Decodes `bytes` as the checkpoint of a render of `desc` and resumes it;
+/// an error is the message.
+fn resume(bytes: &[u8], desc: &SceneDesc) -> Result<Session, String> {
+    let path = Path::new(PATH);
+    Checkpoint::decode(bytes, path)
+        .map_err(|e| e.to_string())
+        .and_then(|c| Session::resume(desc, c, path).map_err(|e| e.to_string()))
+}
+
 /// Decodes and resumes `bytes`: a refusal must be one clear line naming the
 /// file; an acceptance must finish as the render never stopped. Returns
 /// whether it was accepted.
@@ -268,11 +267,7 @@ fn check(
     active: &Option<Vec<bool>>,
     what: &str,
 ) -> bool {
-    let path = Path::new(PATH);
-    let session = Checkpoint::decode(bytes, path)
-        .map_err(|e| e.to_string())
-        .and_then(|c| Session::resume(desc, c, path).map_err(|e| e.to_string()));
-    match session {
+    match resume(bytes, desc) {
         Err(e) => {
             assert!(
                 e.contains(PATH) && !e.contains('\n'),
@@ -352,17 +347,7 @@ fn inconsistent_contents_are_named() {
     let desc = tiny(false);
     let (good, ..) = case(&desc, 4);
     let l = layout(&good);
-    let path = Path::new(PATH);
-    let refused = |bytes: &[u8]| -> String {
-        let e = Checkpoint::decode(bytes, path)
-            .map_err(|e| e.to_string())
-            .and_then(|c| {
-                Session::resume(&desc, c, path)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            });
-        e.unwrap_err()
-    };
+    let refused = |bytes: &[u8]| -> String { resume(bytes, &desc).map(|_| ()).unwrap_err() };
     let mut zero_spp = good.clone();
     put_u32(&mut zero_spp, l.spp, 0);
     reseal(&mut zero_spp);

@@ -3,7 +3,7 @@
 
 mod lumen_process;
 
-use lumen_process::{lumen, temp_dir};
+use lumen_process::{assert_valid_pfm, lumen, refused_stderr, temp_dir};
 use std::path::Path;
 use std::process::{Output, Stdio};
 
@@ -13,9 +13,7 @@ fn lumen_in(dir: &Path, args: &[&str]) -> Output {
 }
 
 fn refused_with(out: &Output, words: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "accepted: {err}");
-    assert!(!err.contains("panicked"), "{err}");
+    let err = refused_stderr(out);
     for w in words {
         assert!(err.contains(w), "{err:?} lacks {w:?}");
     }
@@ -144,9 +142,7 @@ fn a_closed_standard_error_lets_the_render_finish() {
     let status = child.wait().unwrap();
     assert!(status.success(), "{status:?}");
     let image = std::fs::read(&out).unwrap();
-    let header = b"PF\n64 36\n-1.0\n";
-    assert!(image.starts_with(header));
-    assert_eq!(image.len(), header.len() + 64 * 36 * 12);
+    assert_valid_pfm(&image, 64, 36);
     assert!(!lumen::checkpoint::default_path(&out).exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

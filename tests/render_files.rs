@@ -6,13 +6,10 @@
 mod lumen_process;
 
 use lumen::checkpoint::default_path;
-use lumen::progressive::Session;
-use lumen::scene::{builtin, Overrides};
 use lumen_process::*;
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
 use std::process::{Command, ExitStatus};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 const SMALL: &[&str] = &["render", "cover", "--width", "48", "--spp", "16"];
@@ -155,11 +152,7 @@ fn a_second_render_to_the_same_files_is_refused_naming_the_first() {
     b.signal(libc::SIGINT);
     let (status, err) = b.finish();
     assert_eq!(status.code(), Some(130), "{err}");
-    let left: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".lumen-lock"))
-        .collect();
+    let left = files_ending(&dir, ".lumen-lock");
     assert!(left.is_empty(), "lock files left: {left:?}");
     // Now free, the files can be rendered to again.
     let (status, err) = run(&["render", "gradient", "--spp", "4"], &out, &[]);
@@ -179,10 +172,7 @@ fn output_names_up_to_the_file_system_limit_work() {
         );
         assert!(status.success(), "{len} bytes: {err}");
         assert!(out.exists());
-        let mut left: Vec<String> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
+        let mut left = files_ending(&dir, "");
         left.retain(|n| *n != name && !n.ends_with(".pfm"));
         assert!(left.is_empty(), "{len} bytes: files left: {left:?}");
     }
@@ -199,28 +189,6 @@ fn output_names_up_to_the_file_system_limit_work() {
     assert!(status.success(), "{err}");
     assert!(err.contains("resuming at"), "{err}");
     assert!(!default_path(&out).exists());
-}
-
-/// The checkpoint that `SMALL` leaves after three passes, as bytes.
-fn small_checkpoint() -> Vec<u8> {
-    let mut desc = builtin::find("cover").unwrap().desc();
-    Overrides {
-        width: Some(48),
-        samples_per_pixel: Some(16),
-        ..Overrides::default()
-    }
-    .apply(&mut desc);
-    let mut session = Session::new(&desc).unwrap();
-    let stop = AtomicBool::new(false);
-    session
-        .run(&stop, None, &|_| {}, &mut |_, pass| {
-            if pass.number == 3 {
-                stop.store(true, Ordering::SeqCst);
-            }
-            Ok::<(), ()>(())
-        })
-        .unwrap();
-    session.checkpoint().encode()
 }
 
 #[test]
@@ -244,7 +212,7 @@ fn a_stray_file_is_told_from_a_damaged_checkpoint() {
         assert_eq!(std::fs::read_to_string(&ckpt).unwrap(), "my notes\n");
     }
     // A checkpoint whose magic bytes were damaged.
-    let mut damaged = small_checkpoint();
+    let mut damaged = make_checkpoint(&out, 3);
     damaged[..8].copy_from_slice(b"XXXXXXXX");
     std::fs::write(&ckpt, &damaged).unwrap();
     let (status, err) = run(SMALL, &out, &["--resume"]);

@@ -3,48 +3,17 @@
 //! names in messages. Each is read the same way in TOML and JSON, and a
 //! refusal is one message naming the place, never a panic.
 
+mod common;
+mod lumen_process;
+
 use lumen::scene::desc::{SceneDesc, MAX_SEED};
 use lumen::scene::file::{export, Format, SceneFile};
 use lumen::scene::{Overrides, Scene};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn lumen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lumen"))
-        .args(args)
-        .output()
-        .expect("the lumen binary runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("edges-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Asserts a run that failed with one `lumen: error:` line containing every
-/// one of `words`, and no panic.
-fn assert_refused(out: &Output, words: &[&str]) {
-    let err = stderr(out);
-    assert!(!out.status.success(), "succeeded: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    let first = err.lines().next().unwrap_or("");
-    for w in words {
-        assert!(first.contains(w), "{w:?} not in {first:?}\n{err}");
-    }
-}
+use lumen_process::{assert_refused, lumen_output, stderr, temp_dir};
 
 fn parse(text: &str, format: Format) -> Result<SceneFile, String> {
-    let name = match format {
-        Format::Toml => "s.toml",
-        Format::Json => "s.json",
-    };
-    SceneFile::parse(name, text.to_string(), format).map_err(|e| e.to_string())
+    SceneFile::parse(common::scene_file_name(format), text.to_string(), format)
+        .map_err(|e| e.to_string())
 }
 
 const SPHERE_JSON: &str = r#""materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
@@ -122,7 +91,7 @@ fn a_seed_too_large_for_toml_is_refused_when_compiled() {
 
 #[test]
 fn the_command_line_seed_has_the_scene_files_range() {
-    let dir = scratch_dir("seed");
+    let dir = temp_dir("seed");
     let out = dir.join("x.png");
     let out = out.to_str().unwrap();
     let big = (MAX_SEED + 1).to_string();
@@ -137,13 +106,13 @@ fn the_command_line_seed_has_the_scene_files_range() {
         "1",
         "--seed",
     ];
-    let refused = lumen(&[&args[..], &[big.as_str()]].concat());
+    let refused = lumen_output(&[&args[..], &[big.as_str()]].concat());
     assert!(!refused.status.success());
     let err = stderr(&refused);
     assert!(err.contains("--seed") && err.contains(&big), "{err}");
     assert!(err.contains("9223372036854775807"), "{err}");
     let max = MAX_SEED.to_string();
-    let ok = lumen(&[&args[..], &[max.as_str()]].concat());
+    let ok = lumen_output(&[&args[..], &[max.as_str()]].concat());
     assert!(ok.status.success(), "{}", stderr(&ok));
 }
 
@@ -174,7 +143,7 @@ fn blank_files_and_byte_order_marks_mean_the_same_in_both_formats() {
 #[test]
 fn a_scene_without_objects_is_rendered_with_a_warning() {
     assert_eq!(SceneDesc::default().warnings().len(), 1);
-    let dir = scratch_dir("empty");
+    let dir = temp_dir("empty");
     // The built-in `gradient` is meant to show the background only.
     let png = dir.join("gradient.png");
     let args = [
@@ -185,13 +154,13 @@ fn a_scene_without_objects_is_rendered_with_a_warning() {
         "--width",
         "8",
     ];
-    let out = lumen(&args);
+    let out = lumen_output(&args);
     assert!(out.status.success() && !stderr(&out).contains("warning"));
     for (name, text) in [("e.json", ""), ("e.toml", "\u{feff}\n"), ("c.json", "{}")] {
         let scene = dir.join(name);
         std::fs::write(&scene, text).unwrap();
         let png = dir.join(format!("{name}.png"));
-        let out = lumen(&[
+        let out = lumen_output(&[
             "render",
             scene.to_str().unwrap(),
             "-o",
@@ -212,13 +181,13 @@ fn a_scene_without_objects_is_rendered_with_a_warning() {
     }
     let scene = dir.join("one.json");
     std::fs::write(&scene, format!("{{{SPHERE_JSON}}}")).unwrap();
-    let out = lumen(&["scenes", "export", scene.to_str().unwrap()]);
+    let out = lumen_output(&["scenes", "export", scene.to_str().unwrap()]);
     assert!(out.status.success() && !stderr(&out).contains("warning"));
 }
 
 #[test]
 fn a_scene_file_is_never_exported_over_itself() {
-    let dir = scratch_dir("in-place");
+    let dir = temp_dir("in-place");
     let text = "# a comment export would drop\n[render]\nwidth = 8\n";
     let scene = dir.join("s.toml");
     std::fs::write(&scene, text).unwrap();
@@ -234,7 +203,7 @@ fn a_scene_file_is_never_exported_over_itself() {
         outputs.push(dir.join("hard.toml").to_str().unwrap().to_string());
     }
     for output in &outputs {
-        let out = lumen(&["scenes", "export", s, "-o", output]);
+        let out = lumen_output(&["scenes", "export", s, "-o", output]);
         assert_refused(&out, &[output, "is the scene file being exported"]);
         assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
     }
@@ -242,13 +211,13 @@ fn a_scene_file_is_never_exported_over_itself() {
     #[cfg(unix)]
     {
         let link = dir.join("link.toml");
-        let out = lumen(&["scenes", "export", link.to_str().unwrap(), "-o", s]);
+        let out = lumen_output(&["scenes", "export", link.to_str().unwrap(), "-o", s]);
         assert_refused(&out, &["is the scene file being exported"]);
     }
     let json = dir.join("s.json");
-    let out = lumen(&["scenes", "export", s, "-o", json.to_str().unwrap()]);
+    let out = lumen_output(&["scenes", "export", s, "-o", json.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let back = lumen(&["scenes", "export", json.to_str().unwrap(), "-o", s]);
+    let back = lumen_output(&["scenes", "export", json.to_str().unwrap(), "-o", s]);
     assert!(back.status.success(), "{}", stderr(&back));
     assert!(!std::fs::read_to_string(&scene)
         .unwrap()

@@ -163,14 +163,7 @@ fn exercise(text: String, format: Format) {
     };
     // The quick reader and the precise one agree: on the description, or
     // on the message.
-    let precise = SceneFile::parse_with_positions("fuzz", text.clone(), format);
-    let quick = SceneFile::parse("fuzz", text.clone(), format);
-    match (&quick, &precise) {
-        (Ok(a), Ok(b)) => assert_eq!(a.desc, b.desc, "{text:?}"),
-        (Err(a), Err(b)) => assert_eq!(a, b, "{text:?}"),
-        _ => panic!("the readers disagree on {text:?}: {quick:?} {precise:?}"),
-    }
-    match quick {
+    match common::read_both("fuzz", &text, format) {
         Err(e) => {
             let message = e.to_string();
             assert!(message.starts_with("fuzz"), "{message}");

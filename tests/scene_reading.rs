@@ -3,35 +3,15 @@
 //! two agree on every file, valid or not, written plainly or not, small or
 //! of many objects.
 
+mod common;
+
+use common::{read_both, scene_file_name};
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::file::{export, Format, SceneFile};
 
-fn name(format: Format) -> &'static str {
-    match format {
-        Format::Toml => "s.toml",
-        Format::Json => "s.json",
-    }
-}
-
 /// Both readers' results for `text`, which must agree; the quick one's.
 fn read(text: &str, format: Format) -> Result<SceneFile, String> {
-    let quick = SceneFile::parse(name(format), text.to_string(), format);
-    let precise = SceneFile::parse_with_positions(name(format), text.to_string(), format);
-    match (quick, precise) {
-        (Ok(a), Ok(b)) => {
-            assert_eq!(a.desc, b.desc, "{text}");
-            Ok(a)
-        }
-        (Err(a), Err(b)) => {
-            assert_eq!(a.to_string(), b.to_string());
-            Err(a.to_string())
-        }
-        (a, b) => panic!(
-            "the readers disagree: {:?} / {:?}\n{text}",
-            a.err(),
-            b.err()
-        ),
-    }
+    read_both(scene_file_name(format), text, format).map_err(|e| e.to_string())
 }
 
 #[test]
@@ -194,9 +174,10 @@ fn negative_zero_reads_as_the_precise_reader_reads_it() {
         "objects": [{"type": "sphere", "center": [-0, -0.0, -1], "radius": 1, "material": "m"}]}"#;
     for (text, format) in [(toml.as_str(), Format::Toml), (json, Format::Json)] {
         let quick = read(text, format).unwrap().desc;
-        let precise = SceneFile::parse_with_positions(name(format), text.to_string(), format)
-            .unwrap()
-            .desc;
+        let precise =
+            SceneFile::parse_with_positions(scene_file_name(format), text.to_string(), format)
+                .unwrap()
+                .desc;
         // Equal as numbers is not enough: the sign of a zero is written out.
         assert_eq!(
             export(&quick, Format::Json).unwrap(),

@@ -11,6 +11,8 @@
 //! which slurmd needs to start jobs. Without them it says it is skipped and
 //! passes, unless `LUMEN_REQUIRE_SLURM=1` (set by `.ci/run`), when it fails.
 
+mod lumen_process;
+
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::fs;
@@ -41,6 +43,19 @@ fn fresh_dir(name: &str) -> PathBuf {
     let _ = fs::remove_dir_all(&dir);
     fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// A fresh directory (see [`fresh_dir`]) and its empty `parts` directory.
+fn with_parts(name: &str) -> (PathBuf, PathBuf) {
+    let dir = fresh_dir(name);
+    let parts = dir.join("parts");
+    fs::create_dir(&parts).unwrap();
+    (dir, parts)
+}
+
+/// The file of part `index` of `count` in `parts`.
+fn part_file(parts: &Path, index: u32, count: u32) -> PathBuf {
+    lumen::part::file_name(parts, lumen::part::Part { index, count })
 }
 
 fn write_executable(path: &Path, text: &str) {
@@ -114,10 +129,7 @@ fn task_args(parts: &Path, k: u32, n: u32, resume: bool) -> Vec<String> {
         "--part".to_owned(),
         format!("{k}/{n}"),
         "-o".to_owned(),
-        parts
-            .join(format!("part-{k}.lumen-part"))
-            .display()
-            .to_string(),
+        part_file(parts, k, n).display().to_string(),
     ];
     if resume {
         args.push("--resume".to_owned());
@@ -127,9 +139,7 @@ fn task_args(parts: &Path, k: u32, n: u32, resume: bool) -> Vec<String> {
 
 #[test]
 fn task_script_runs_the_part_given_by_each_engines_variables() {
-    let dir = fresh_dir("task");
-    let parts = dir.join("parts");
-    fs::create_dir(&parts).unwrap();
+    let (dir, parts) = with_parts("task");
     let p = parts.to_str().unwrap();
     let base = [("LUMEN_SCENE", "cover"), ("LUMEN_PARTS_DIR", p)];
     let run = |vars: &[(&str, &str)]| {
@@ -228,9 +238,7 @@ fn task_script_runs_the_part_given_by_each_engines_variables() {
 
 #[test]
 fn task_script_refuses_missing_or_wrong_settings_without_running_lumen() {
-    let dir = fresh_dir("task-refusals");
-    let parts = dir.join("parts");
-    fs::create_dir(&parts).unwrap();
+    let (dir, parts) = with_parts("task-refusals");
     let p = parts.to_str().unwrap();
     let missing = dir.join("missing");
     let m = missing.to_str().unwrap();
@@ -299,13 +307,11 @@ fn task_script_refuses_missing_or_wrong_settings_without_running_lumen() {
 
 #[test]
 fn merge_script_names_missing_parts_and_merges_a_complete_set_in_index_order() {
-    let dir = fresh_dir("merge");
-    let parts = dir.join("parts");
-    fs::create_dir(&parts).unwrap();
+    let (dir, parts) = with_parts("merge");
     let p = parts.to_str().unwrap();
     let out_png = dir.join("final.png");
     let o = out_png.to_str().unwrap();
-    let part = |k: u32| parts.join(format!("part-{k}.lumen-part"));
+    let part = |k: u32| part_file(&parts, k, 4);
     for k in [0, 2, 10] {
         fs::write(part(k), "").unwrap();
     }
@@ -773,7 +779,9 @@ fn slurm_array_renders_every_part_through_a_requeue_and_a_failure_then_merges() 
     // The part whose render is killed half-way, as by a lost node or the
     // out-of-memory killer: the task fails and Slurm does not requeue it.
     const KILLED: u32 = 3;
-    let part = |k: u32| parts.join(format!("part-{k}.lumen-part"));
+    let part = |k: u32| part_file(&parts, k, N);
+    let read_merge_log =
+        |merge: &str| fs::read_to_string(parts.join(format!("logs/merge-{merge}.out"))).unwrap();
     let task_log = |render: &str, k: u32| {
         fs::read_to_string(parts.join(format!("logs/render-{render}_{k}.out"))).unwrap_or_default()
     };
@@ -841,7 +849,7 @@ fn slurm_array_renders_every_part_through_a_requeue_and_a_failure_then_merges() 
     );
     assert!(log.contains(" (resuming) "), "{log}");
     // The merge found the killed task's part unfinished and wrote nothing.
-    let merge_log = fs::read_to_string(parts.join(format!("logs/merge-{merge}.out"))).unwrap();
+    let merge_log = read_merge_log(&merge);
     assert!(merge_log.contains("part unfinished"), "{merge_log}");
     assert!(!out.exists());
 
@@ -861,22 +869,13 @@ fn slurm_array_renders_every_part_through_a_requeue_and_a_failure_then_merges() 
         log.contains(&format!("part {KILLED}/{N} of cover")) && log.contains(" (resuming) "),
         "{log}"
     );
-    let merge_log = fs::read_to_string(parts.join(format!("logs/merge-{merge}.out"))).unwrap();
+    let merge_log = read_merge_log(&merge);
     let merged = fs::read(&out).unwrap_or_else(|e| panic!("{e}: {merge_log}"));
 
     // The merged image is the one-machine render's, bit for bit.
-    let reference = work.join("reference.pfm");
-    let status = Command::new(LUMEN)
-        .args(["render", "cover", "-o"])
-        .arg(&reference)
-        .args(options)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let reference = lumen_process::reference(&work, &[&["render", "cover"], options].concat());
     assert!(
-        merged == fs::read(&reference).unwrap(),
+        merged == reference,
         "the merged image differs from the one-machine render: {merge_log}"
     );
     eprintln!("Slurm renders and merges took {:?}", started.elapsed());

@@ -491,3 +491,30 @@ pub fn scene_file_error(dir: &std::path::Path, text: &str) -> String {
         },
     }
 }
+
+/// The name a scene file of `format` is read under: `s.toml` or `s.json`.
+pub fn scene_file_name(format: lumen::scene::file::Format) -> &'static str {
+    match format {
+        lumen::scene::file::Format::Toml => "s.toml",
+        lumen::scene::file::Format::Json => "s.json",
+    }
+}
+
+/// Reads `text` (named `name`) with the quick reader and with the precise
+/// one, which must agree: on the description, or on the error. Returns the
+/// quick reader's result.
+pub fn read_both(
+    name: &str,
+    text: &str,
+    format: lumen::scene::file::Format,
+) -> Result<lumen::scene::file::SceneFile, lumen::scene::file::SceneFileError> {
+    use lumen::scene::file::SceneFile;
+    let quick = SceneFile::parse(name, text.to_string(), format);
+    let precise = SceneFile::parse_with_positions(name, text.to_string(), format);
+    match (&quick, &precise) {
+        (Ok(a), Ok(b)) => assert_eq!(a.desc, b.desc, "{text:?}"),
+        (Err(a), Err(b)) => assert_eq!(a, b, "{text:?}"),
+        _ => panic!("the readers disagree on {text:?}: {quick:?} {precise:?}"),
+    }
+    quick
+}

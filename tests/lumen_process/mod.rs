@@ -1,9 +1,13 @@
 //! Helpers for the tests that run the `lumen` binary and signal it.
 #![allow(dead_code)]
 
+use lumen::checkpoint::default_path;
+use lumen::progressive::{Session, StopReason};
+use lumen::scene::{builtin, Overrides};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -21,6 +25,34 @@ pub fn temp_dir(name: &str) -> PathBuf {
 
 pub fn lumen() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lumen"))
+}
+
+/// Runs lumen with `args` to the end.
+pub fn lumen_output(args: &[&str]) -> Output {
+    lumen().args(args).output().expect("the lumen binary runs")
+}
+
+/// A finished run's stderr as text.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts a run that failed without a panic; returns its stderr.
+pub fn refused_stderr(out: &Output) -> String {
+    let err = stderr(out);
+    assert!(!out.status.success(), "succeeded: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    err
+}
+
+/// Asserts a run that failed, without a panic, with a first stderr line
+/// containing every one of `words`.
+pub fn assert_refused(out: &Output, words: &[&str]) {
+    let err = refused_stderr(out);
+    let first = err.lines().next().unwrap_or("");
+    for w in words {
+        assert!(first.contains(w), "{w:?} not in {first:?}\n{err}");
+    }
 }
 
 /// Runs lumen to the end; returns its status and stderr.
@@ -134,12 +166,42 @@ pub fn assert_valid_pfm(bytes: &[u8], w: usize, h: usize) {
     );
 }
 
-/// Names of files in `dir` left by an atomic write that never finished.
-pub fn temp_files(dir: &Path) -> Vec<String> {
+/// Names of the files in `dir` that end with `suffix`.
+pub fn files_ending(dir: &Path, suffix: &str) -> Vec<String> {
     std::fs::read_dir(dir)
         .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".tmp"))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(suffix))
         .collect()
+}
+
+/// Names of files in `dir` left by an atomic write that never finished.
+pub fn temp_files(dir: &Path) -> Vec<String> {
+    files_ending(dir, ".tmp")
+}
+
+/// Writes, through the library, the checkpoint that `lumen render cover
+/// --width 48 --spp 16 -o out` leaves after `passes` passes.
+pub fn make_checkpoint(out: &Path, passes: u32) -> Vec<u8> {
+    let mut desc = builtin::find("cover").unwrap().desc();
+    Overrides {
+        width: Some(48),
+        samples_per_pixel: Some(16),
+        ..Overrides::default()
+    }
+    .apply(&mut desc);
+    let mut session = Session::new(&desc).unwrap();
+    let stop = AtomicBool::new(false);
+    let run = session
+        .run(&stop, None, &|_| {}, &mut |_, pass| {
+            if pass.number == passes {
+                stop.store(true, Ordering::SeqCst);
+            }
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+    assert_eq!(run.reason, StopReason::Interrupted);
+    let path = default_path(out);
+    session.checkpoint().write(&path).unwrap();
+    std::fs::read(path).unwrap()
 }
