@@ -203,13 +203,7 @@ impl CheckpointView<'_> {
     /// Writes the checkpoint to `path` atomically (temporary file + rename),
     /// so a kill at any moment leaves the previous checkpoint or this one.
     pub fn write(&self, path: &Path) -> Result<(), OutputError> {
-        output::write_atomic(path, |tmp| {
-            let file = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
-            let mut out = std::io::BufWriter::new(file);
-            self.encode_to(&mut out)
-                .and_then(|()| std::io::Write::flush(&mut out))
-                .map_err(|e| e.to_string())
-        })
+        output::write_atomic_with(path, |out| self.encode_to(out))
     }
 }
 

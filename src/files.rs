@@ -161,6 +161,35 @@ pub fn remove_stale_temps(path: &Path) -> Vec<PathBuf> {
     removed
 }
 
+/// Whether `a` and `b` are the same existing file: on Unix the same device
+/// and inode (which also sees hard links), elsewhere the same path once
+/// symbolic links and `.`/`..` are resolved. A path that does not exist is
+/// no existing file's.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        same_inode(&ma, &mb)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// Whether two files' metadata are of one file: the same device and inode.
+#[cfg(unix)]
+pub fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -155,9 +155,8 @@ fn check_lock_file(lock: &Path) -> Result<(), String> {
 fn same_file(file: &File, path: &Path) -> bool {
     #[cfg(unix)]
     {
-        use std::os::unix::fs::MetadataExt;
         match (file.metadata(), fs::metadata(path)) {
-            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            (Ok(a), Ok(b)) => crate::files::same_inode(&a, &b),
             _ => false,
         }
     }

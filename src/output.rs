@@ -128,6 +128,20 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// Writes a file atomically through a buffered writer that `write` fills
+/// (see [`write_atomic`]).
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<fs::File>) -> std::io::Result<()>,
+) -> Result<(), OutputError> {
+    write_atomic(path, |tmp| {
+        let mut out = std::io::BufWriter::new(fs::File::create(tmp).map_err(|e| e.to_string())?);
+        write(&mut out)
+            .and_then(|()| std::io::Write::flush(&mut out))
+            .map_err(|e| e.to_string())
+    })
+}
+
 /// Writes `bytes` to `path` atomically.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     write_atomic(path, |tmp| fs::write(tmp, bytes).map_err(|e| e.to_string()))

@@ -21,20 +21,16 @@ const TOML_HEADER: &str = "# A lumen scene. Every field is described in docs/sce
 /// more memory than its description (the `toml` crate would build a
 /// document of the whole file first, many times its size).
 pub fn write_scene(desc: &SceneDesc, format: Format, out: &mut impl Write) -> io::Result<()> {
-    let failed = |e: &dyn fmt::Display| io::Error::other(e.to_string());
     match format {
         Format::Json => {
-            serde_json::to_writer_pretty(&mut *out, desc).map_err(|e| {
-                // An error of the writer is the writer's, not the format's.
-                e.io_error_kind()
-                    .map_or_else(|| failed(&e), |kind| io::Error::new(kind, e.to_string()))
-            })?;
+            // An error of the writer stays the writer's (a closed pipe).
+            serde_json::to_writer_pretty(&mut *out, desc).map_err(io::Error::from)?;
             out.write_all(b"\n")
         }
         // Without objects, `toml` writes `objects = []` among the first
         // keys: the whole description is small, written at once.
         Format::Toml if desc.objects.is_empty() => {
-            let body = toml::to_string(desc).map_err(|e| failed(&e))?;
+            let body = toml::to_string(desc).map_err(io::Error::other)?;
             out.write_all(TOML_HEADER.as_bytes())?;
             out.write_all(body.as_bytes())
         }
@@ -48,14 +44,14 @@ pub fn write_scene(desc: &SceneDesc, format: Format, out: &mut impl Write) -> io
                 materials: &desc.materials,
             };
             out.write_all(TOML_HEADER.as_bytes())?;
-            out.write_all(toml::to_string(&head).map_err(|e| failed(&e))?.as_bytes())?;
+            out.write_all(toml::to_string(&head).map_err(io::Error::other)?.as_bytes())?;
             // Written in order, made on every core a few thousand at a time.
             for chunk in desc.objects.chunks(4096) {
                 let tables: Vec<String> = chunk
                     .par_iter()
                     .map(|object| toml::to_string(&One { objects: [object] }))
                     .collect::<Result<_, _>>()
-                    .map_err(|e| failed(&e))?;
+                    .map_err(io::Error::other)?;
                 for table in tables {
                     out.write_all(b"\n")?;
                     out.write_all(table.as_bytes())?;
@@ -112,9 +108,9 @@ impl std::error::Error for OverwritesSource {}
 
 /// Refuses to export the scene file `source` to `output` when both name the
 /// same file, however written: `s.toml` and `./dir/../s.toml`, a symbolic
-/// link to it, or a hard link (see [`same_file`]).
+/// link to it, or a hard link (see [`crate::files::same_file`]).
 pub fn check_not_source(source: &Path, output: &Path) -> Result<(), OverwritesSource> {
-    if same_file(source, output) {
+    if crate::files::same_file(source, output) {
         return Err(OverwritesSource {
             output: output.to_path_buf(),
             source: source.to_path_buf(),
@@ -123,32 +119,10 @@ pub fn check_not_source(source: &Path, output: &Path) -> Result<(), OverwritesSo
     Ok(())
 }
 
-/// Whether `a` and `b` are the same existing file: on Unix the same device
-/// and inode (which also sees hard links), elsewhere the same path once
-/// symbolic links and `.`/`..` are resolved. A path that does not exist is
-/// no existing file's.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
-        return false;
-    };
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        ma.dev() == mb.dev() && ma.ino() == mb.ino()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (ma, mb);
-        match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::files::same_file;
 
     #[test]
     fn objects_written_one_by_one_read_as_the_whole_document() {

@@ -8,6 +8,7 @@ use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
 use lumen::scene::{Integrator, LightSelection, Overrides, Sampling};
 use std::ffi::{OsStr, OsString};
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -307,9 +308,15 @@ impl SettingArgs {
 /// Writes to standard output. A closed pipe (`lumen scenes | head -1`) ends
 /// the output quietly; any other failure is an error, never a panic.
 fn write_stdout(text: &str) -> Result<()> {
-    use std::io::Write as _;
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+    write_stdout_with(|out| out.write_all(text.as_bytes()))
+}
+
+/// [`write_stdout`] of what `write` writes, through a buffer.
+fn write_stdout_with(
+    write: impl FnOnce(&mut std::io::BufWriter<std::io::StdoutLock>) -> std::io::Result<()>,
+) -> Result<()> {
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    match write(&mut out).and_then(|()| out.flush()) {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         result => result.context("cannot write to standard output"),
     }

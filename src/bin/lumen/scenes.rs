@@ -1,14 +1,12 @@
 //! Where scenes come from (built-in names or files) and `lumen scenes export`.
 
-use crate::FormatArg;
+use crate::{write_stdout_with, FormatArg};
 use anyhow::{anyhow, bail, Context, Result};
 use lumen::output;
 use lumen::scene::builtin::{self, BUILTINS};
 use lumen::scene::export;
 use lumen::scene::file::{Format, SceneFile};
 use lumen::scene::{hint, Overrides, Scene, SceneDesc};
-use std::fs::File;
-use std::io::Write as _;
 use std::path::Path;
 
 /// Where a scene comes from: a built-in name or a file.
@@ -85,22 +83,10 @@ pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) 
     match out {
         Some(path) => {
             output::check_writable(path)?;
-            output::write_atomic(path, |tmp| {
-                let mut w = std::io::BufWriter::new(File::create(tmp).map_err(|e| e.to_string())?);
-                export::write_scene(desc, format, &mut w)
-                    .and_then(|()| w.flush())
-                    .map_err(|e| e.to_string())
-            })?;
+            output::write_atomic_with(path, |w| export::write_scene(desc, format, w))?;
             errln!("{name}: written to {}", path.display());
         }
-        None => {
-            let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-            match export::write_scene(desc, format, &mut w).and_then(|()| w.flush()) {
-                // `lumen scenes export x | head` ends quietly.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-                result => result.context("cannot write to standard output")?,
-            }
-        }
+        None => write_stdout_with(|w| export::write_scene(desc, format, w))?,
     }
     Ok(())
 }
