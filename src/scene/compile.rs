@@ -934,16 +934,13 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
     })
 }
 
-/// Refuses a seed above [`MAX_SEED`] (given by a program or the library's
+/// The seed, or refuses one above [`MAX_SEED`] (given by a program or the library's
 /// user: scene files are checked when read), which TOML could not write.
-pub(super) fn check_seed(field: &str, seed: u64) -> Result<(), SceneError> {
+pub(super) fn check_seed(field: &str, seed: u64) -> Result<u64, SceneError> {
     if seed > MAX_SEED {
-        return Err(invalid(
-            field,
-            format!("must be at most {MAX_SEED} (2^63-1, the largest integer TOML can hold), got {seed}"),
-        ));
+        return Err(invalid(field, super::desc::seed_too_large(seed)));
     }
-    Ok(())
+    Ok(seed)
 }
 
 /// The material `m` of field `field`, and the texture that gives its

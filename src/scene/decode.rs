@@ -206,13 +206,9 @@ fn integer(node: &Node, path: &str, min: u64, max: u64) -> Result<u64> {
 /// always be exported to TOML (whose integers are signed 64-bit).
 fn seed(node: &Node, path: &str) -> Result<u64> {
     match node.value {
-        Value::Integer(i) if i > i128::from(MAX_SEED) => Err(error(
-            path,
-            &node.span,
-            format!(
-                "must be at most {MAX_SEED} (2^63-1, the largest integer TOML can hold), got {i}"
-            ),
-        )),
+        Value::Integer(i) if i > i128::from(MAX_SEED) => {
+            Err(error(path, &node.span, super::desc::seed_too_large(i)))
+        }
         _ => integer(node, path, 0, MAX_SEED),
     }
 }

@@ -18,6 +18,12 @@ pub type Triple = [f64; 3];
 /// the command line, a program), can be exported to either format.
 pub const MAX_SEED: u64 = i64::MAX as u64;
 
+/// What is wrong with a seed above [`MAX_SEED`], for the scene reader and
+/// the compiler alike.
+pub(crate) fn seed_too_large(got: impl std::fmt::Display) -> String {
+    format!("must be at most {MAX_SEED} (2^63-1, the largest integer TOML can hold), got {got}")
+}
+
 /// A whole scene: settings, camera, background, named materials and objects.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -287,11 +287,7 @@ impl SceneFile {
     /// [`SceneFile::compile`], also returning the description as overridden
     /// (what a checkpoint records).
     pub fn resolve(&self, overrides: &Overrides) -> Result<(SceneDesc, Scene), SceneFileError> {
-        let mut desc = self.desc.clone();
-        overrides.apply(&mut desc);
-        let scene =
-            Scene::from_desc_in(&desc, &self.dir).map_err(|e| self.locate(&e, overrides))?;
-        Ok((desc, scene))
+        self.finish(self.desc.clone(), overrides)
     }
 
     /// [`SceneFile::resolve`], consuming the file: the description is moved
@@ -301,12 +297,21 @@ impl SceneFile {
         mut self,
         overrides: &Overrides,
     ) -> Result<(SceneDesc, Scene), SceneFileError> {
-        let mut desc = std::mem::take(&mut self.desc);
+        let desc = std::mem::take(&mut self.desc);
+        self.finish(desc, overrides)
+    }
+
+    /// `desc` (this file's description) with `overrides` applied, and its
+    /// scene, compiled against the file's folder.
+    fn finish(
+        &self,
+        mut desc: SceneDesc,
+        overrides: &Overrides,
+    ) -> Result<(SceneDesc, Scene), SceneFileError> {
         overrides.apply(&mut desc);
-        match Scene::from_desc_in(&desc, &self.dir) {
-            Ok(scene) => Ok((desc, scene)),
-            Err(e) => Err(self.locate(&e, overrides)),
-        }
+        let scene =
+            Scene::from_desc_in(&desc, &self.dir).map_err(|e| self.locate(&e, overrides))?;
+        Ok((desc, scene))
     }
 
     /// `error`, found when compiling this file's scene, with the file's name,

@@ -131,10 +131,10 @@ impl<'a> TextureTable<'a> {
                 pattern,
                 seed,
             } => Texture::Noise {
-                perlin: {
-                    super::compile::check_seed(&format!("{here}.seed"), *seed)?;
-                    Arc::new(Perlin::new(*seed))
-                },
+                perlin: Arc::new(Perlin::new(super::compile::check_seed(
+                    &format!("{here}.seed"),
+                    *seed,
+                )?)),
                 scale: positive(&format!("{here}.scale"), *scale)?,
                 pattern: match pattern {
                     NoisePatternDesc::Smooth => NoisePattern::Smooth,
