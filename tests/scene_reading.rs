@@ -124,6 +124,8 @@ fn what_serde_would_take_and_the_precise_reader_refuses_is_refused() {
             "[render]\nsampler = \"sobol\"\nsampling = \"sobol\"\n",
             "not both",
         ),
+        // `objects` spelled with an escape, then given again as tables.
+        ("\"\\u006fbjects\" = []\n", "duplicate key `objects`"),
     ] {
         let err = read(&format!("{toml}{materials}{sphere}"), Format::Toml).unwrap_err();
         assert!(err.contains(message), "{err}");

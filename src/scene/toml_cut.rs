@@ -160,11 +160,18 @@ fn close(split: &mut Split, text: &str, section: Range<usize>, object: bool) {
     }
 }
 
+/// Whether `line`, at the top level, may set `objects`: the key spelled
+/// plainly or quoted, or any quoted key with an escape (`"\u006fbjects"`).
 fn top_level_objects(line: &str) -> bool {
-    ["objects", "\"objects\"", "'objects'"].iter().any(|k| {
-        line.strip_prefix(k)
-            .is_some_and(|after| after.is_empty() || after.starts_with([' ', '\t', '=', '.']))
-    })
+    let escaped = line
+        .strip_prefix('"')
+        .and_then(|key| key.split('"').next())
+        .is_some_and(|key| key.contains('\\'));
+    escaped
+        || ["objects", "\"objects\"", "'objects'"].iter().any(|k| {
+            line.strip_prefix(k)
+                .is_some_and(|after| after.is_empty() || after.starts_with([' ', '\t', '=', '.']))
+        })
 }
 
 /// What the header at the start of `line` opens; `None` for a quoted name
