@@ -29,21 +29,7 @@ pub(super) fn objects_as_json(table: &str, out: &mut String) -> Option<()> {
             continue;
         }
         let mut c = Cursor { s: line, i: 0 };
-        let key = c.key()?;
-        // A repeated key is an error in TOML; serde would say so too, but
-        // not for every type: refused here, the `toml` crate words it.
-        if keys.contains(&key) {
-            return None;
-        }
-        keys.push(key);
-        c.expect(b'=')?;
-        if keys.len() > 1 {
-            out.push(',');
-        }
-        out.push('"');
-        out.push_str(key);
-        out.push_str("\":");
-        c.value(out, 0)?;
+        c.entry(&mut keys, out, 0)?;
         c.ws();
         if !(c.done() || c.peek() == Some(b'#')) {
             return None;
@@ -82,6 +68,26 @@ impl<'a> Cursor<'a> {
     }
 
     /// A bare key: letters, digits, `_` and `-`, also valid in a JSON string.
+    /// One `key = value` entry of a table whose keys so far are `keys`,
+    /// written as a JSON member (after a comma unless it is the first).
+    fn entry(&mut self, keys: &mut Vec<&'a str>, out: &mut String, depth: usize) -> Option<()> {
+        let key = self.key()?;
+        // A repeated key is an error in TOML; serde would say so too, but
+        // not for every type: refused here, the `toml` crate words it.
+        if keys.contains(&key) {
+            return None;
+        }
+        if !keys.is_empty() {
+            out.push(',');
+        }
+        keys.push(key);
+        self.expect(b'=')?;
+        out.push('"');
+        out.push_str(key);
+        out.push_str("\":");
+        self.value(out, depth)
+    }
+
     fn key(&mut self) -> Option<&'a str> {
         self.ws();
         let start = self.i;
@@ -139,19 +145,7 @@ impl<'a> Cursor<'a> {
                 }
                 let mut keys: Vec<&str> = Vec::new();
                 loop {
-                    let key = self.key()?;
-                    if keys.contains(&key) {
-                        return None;
-                    }
-                    if !keys.is_empty() {
-                        out.push(',');
-                    }
-                    keys.push(key);
-                    self.expect(b'=')?;
-                    out.push('"');
-                    out.push_str(key);
-                    out.push_str("\":");
-                    self.value(out, depth + 1)?;
+                    self.entry(&mut keys, out, depth + 1)?;
                     self.ws();
                     match self.peek()? {
                         // No comma after the last entry of an inline table.
