@@ -210,19 +210,11 @@ fn render_row_generic(
         }
         let pixel = u64::from(y) * width as u64 + x as u64;
         let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
-        let mut add = |index: u32, c: Color| {
-            stats.samples += 1;
-            if !row.add(x, index, c) {
-                stats.dropped += 1;
-            }
-        };
         if !side_by_side {
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, x as u32, y, &pixel_sampler, index);
-                add(
-                    index,
-                    first_hit_view(scene, ray, s.shading, &mut stats.rays),
-                );
+                let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
+                add_sample(&mut row, &mut stats, x, index, c);
             }
             continue;
         }
@@ -244,12 +236,24 @@ fn render_row_generic(
             );
             // In sample order, as one at a time would add them.
             for (i, &c) in colours[..n].iter().enumerate() {
-                add(start + i as u32, c);
+                add_sample(&mut row, &mut stats, x, start + i as u32, c);
             }
             start += n as u32;
         }
     }
     stats
+}
+
+/// Adds sample `index` of pixel `x` to `row` and counts it in `stats`, as
+/// dropped if the film leaves it out. A function rather than a closure so
+/// that it is inlined into the row loop: the film's fixed-point conversion
+/// made the closure large enough to be called out of line.
+#[inline(always)]
+fn add_sample(row: &mut RowMut, stats: &mut RenderStats, x: usize, index: u32, c: Color) {
+    stats.samples += 1;
+    if !row.add(x, index, c) {
+        stats.dropped += 1;
+    }
 }
 
 /// The camera ray of sample `index` of pixel `(x, y)`, whose sampler is
