@@ -7,33 +7,39 @@
 //! checkpoint only if its own description is the same, so that the image is
 //! bit-identical to one rendered without a stop.
 //!
-//! # File format (version 3)
+//! # File format (version 4)
 //!
 //! All integers little-endian.
 //!
 //! | bytes | content |
 //! | --- | --- |
 //! | 8 | magic `LUMENCKP` |
-//! | 4 | format version (3) |
+//! | 4 | format version (4) |
 //! | 8 | payload length *n* |
 //! | 4 | CRC-32 of the payload |
 //! | *n* | payload |
 //!
-//! The payload: the renderer identity and the description (each as a u32 length
-//! and UTF-8 bytes), the end of the samples done, the share of sample indices
-//! the render takes (start and end: `0` and the spp for a whole render, less
-//! for a part of one), the display gamma (f32), width and height (u32 each),
-//! samples, rays and dropped samples (u64 each), then every pixel's three
-//! sums (`i128`, 64.64 fixed point: [`crate::film::Sum`]) and every pixel's `u32` count (pixels row-major, top row
-//! first), and last a byte saying whether the render samples adaptively (1)
-//! or not (0), followed, if it does, by the same sums and counts for the
-//! samples of odd index and a byte a pixel: 1 while the pixel is still being
-//! sampled, 0 once it stopped.
+//! The payload: the renderer identity and the description (each as a u32
+//! length and UTF-8 bytes), the end of the samples done, the share of
+//! sample indices the render takes (start and end: `0` and the spp for a
+//! whole render, less for a part of one), the display gamma (f32), the
+//! film's width and height, the column and row of its top left pixel in the
+//! image and the image's width and height (u32 each: a film of the whole
+//! image, or of a tile of it), samples, rays and dropped samples (u64 each),
+//! then the film's pixels (row-major, top row first): every pixel's `u32`
+//! count, and every row's sums in a compact form (see `pixels.rs`: each row
+//! its length in bytes, then for each pixel the three sums of
+//! [`crate::film::Sum`], shifted right past their common trailing zeros and
+//! stored in as few bytes as they need). Last, a byte saying whether the
+//! render samples adaptively (1) or not (0), followed, if it does, by the
+//! same counts and sums for the samples of odd index and a byte a pixel: 1
+//! while the pixel is still being sampled, 0 once it stopped.
 
 use crate::film::Film;
 use crate::output::{self, OutputError};
 use crate::render::RenderStats;
 use crate::scene::SceneDesc;
+use crate::tile::Tile;
 use std::io::Read;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -43,15 +49,18 @@ mod consistency;
 mod format;
 mod header;
 mod identity;
+mod pixels;
 
+pub(crate) use format::Unpacked;
 pub use header::{inspect, remove, Existing};
 pub(crate) use identity::{describe_differences, same_render};
 pub use identity::{description_text, identity_text};
+pub(crate) use pixels::PixelError;
 
 /// First bytes of every checkpoint file.
 pub const MAGIC: &[u8; 8] = b"LUMENCKP";
 /// The format version this lumen writes and reads.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 /// Identifies the code that computes samples: the crate version and a
 /// revision of the sample computation. Any change that alters the value of a
 /// sample (random stream, sampling, intersection arithmetic, materials) must
@@ -76,6 +85,11 @@ pub struct Checkpoint {
     /// The sample indices this render takes in every pixel: `0..spp` for a
     /// whole render, a share of them for a part of one ([`crate::part`]).
     pub share: Range<u32>,
+    /// The pixels of the image the film holds: all of them, or a part's
+    /// tile.
+    pub tile: Tile,
+    /// The whole image's width and height.
+    pub image: (u32, u32),
     /// End of the samples the film holds: samples `share.start..spp_done`
     /// of every pixel.
     pub spp_done: u32,
@@ -187,6 +201,10 @@ pub struct CheckpointView<'a> {
     pub description: &'a str,
     /// The sample indices this render takes (see [`Checkpoint::share`]).
     pub share: Range<u32>,
+    /// The pixels the film holds (see [`Checkpoint::tile`]).
+    pub tile: Tile,
+    /// The whole image's width and height.
+    pub image: (u32, u32),
     /// End of the samples the film holds.
     pub spp_done: u32,
     /// The display gamma (see [`Checkpoint::gamma`]).
@@ -214,6 +232,8 @@ impl Checkpoint {
             renderer_id: &self.renderer_id,
             description: &self.description,
             share: self.share.clone(),
+            tile: self.tile,
+            image: self.image,
             spp_done: self.spp_done,
             gamma: self.gamma,
             stats: self.stats,
@@ -230,17 +250,7 @@ impl Checkpoint {
     /// Reads a checkpoint from `bytes`; `path` only names it in errors.
     pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, CheckpointError> {
         let path_buf = || path.to_path_buf();
-        let head = &bytes[..bytes.len().min(HEADER_LEN)];
-        header::check(head, bytes.len() as u64, path)?;
-        let crc = u32::from_le_bytes(
-            bytes[HEADER_LEN - 4..HEADER_LEN]
-                .try_into()
-                .expect("4 bytes"),
-        );
-        let payload = &bytes[HEADER_LEN..];
-        if crc32fast::hash(payload) != crc {
-            return Err(CheckpointError::Corrupted { path: path_buf() });
-        }
+        let payload = Self::verify(bytes, path)?;
         let ckpt = Self::decode_payload(payload).map_err(|message| CheckpointError::Malformed {
             path: path_buf(),
             message: message.to_string(),
@@ -253,6 +263,25 @@ impl Checkpoint {
         Ok(ckpt)
     }
 
+    /// The payload of the checkpoint file `bytes` (read from `path`, which
+    /// names it in errors), once its header and checksum are checked.
+    pub(crate) fn verify<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a [u8], CheckpointError> {
+        let head = &bytes[..bytes.len().min(HEADER_LEN)];
+        header::check(head, bytes.len() as u64, path)?;
+        let crc = u32::from_le_bytes(
+            bytes[HEADER_LEN - 4..HEADER_LEN]
+                .try_into()
+                .expect("4 bytes"),
+        );
+        let payload = &bytes[HEADER_LEN..];
+        if crc32fast::hash(payload) != crc {
+            return Err(CheckpointError::Corrupted {
+                path: path.to_path_buf(),
+            });
+        }
+        Ok(payload)
+    }
+
     /// Writes the checkpoint to `path` atomically.
     pub fn write(&self, path: &Path) -> Result<(), OutputError> {
         self.view().write(path)
@@ -263,23 +292,32 @@ impl Checkpoint {
     /// its size): a device or a pipe given as a checkpoint is refused
     /// rather than read for ever.
     pub fn read(path: &Path) -> Result<Self, CheckpointError> {
+        let mut bytes = Vec::new();
+        Self::read_bytes(path, &mut bytes)?;
+        Self::decode(&bytes, path)
+    }
+
+    /// Reads the checkpoint file at `path` into `bytes` (replacing what it
+    /// held, and keeping its allocation when it is large enough), checking
+    /// the header as [`Checkpoint::read`] does; the payload is not checked.
+    pub(crate) fn read_bytes(path: &Path, bytes: &mut Vec<u8>) -> Result<(), CheckpointError> {
         let io = |e: std::io::Error| CheckpointError::Io {
             path: path.to_path_buf(),
             message: e.to_string(),
         };
         let (mut file, len) = header::open_regular(path)?;
-        let mut bytes = Vec::with_capacity(HEADER_LEN);
+        bytes.clear();
         (&mut file)
             .take(HEADER_LEN as u64)
-            .read_to_end(&mut bytes)
+            .read_to_end(bytes)
             .map_err(io)?;
-        let payload_len = header::check(&bytes, len, path)?;
-        bytes.reserve_exact(usize::try_from(payload_len).unwrap_or(0));
+        let payload_len = header::check(bytes, len, path)?;
+        bytes.reserve(usize::try_from(payload_len).unwrap_or(0));
         (&mut file)
             .take(payload_len)
-            .read_to_end(&mut bytes)
+            .read_to_end(bytes)
             .map_err(io)?;
-        Self::decode(&bytes, path)
+        Ok(())
     }
 
     /// Checks that this checkpoint was made for a render of `desc` (overrides
@@ -337,6 +375,8 @@ mod tests {
             renderer_id: RENDERER_ID.into(),
             description: description_text(&desc),
             share: 0..16,
+            tile: Tile::whole(8, h),
+            image: (8, h),
             spp_done: 16,
             gamma: 2.0,
             stats: RenderStats {

@@ -158,6 +158,25 @@ impl Film {
         }
     }
 
+    /// [`Film::new`], or `None` if this machine's memory cannot hold it.
+    pub fn try_new(width: u32, height: u32) -> Option<Self> {
+        let n = width as usize * height as usize;
+        let mut sums = Vec::new();
+        let mut counts = Vec::new();
+        sums.try_reserve_exact(n).ok()?;
+        counts.try_reserve_exact(n).ok()?;
+        sums.resize(n, Sum::ZERO);
+        counts.resize(n, 0);
+        Some(Self {
+            width,
+            height,
+            sums,
+            counts,
+            odd_sums: Vec::new(),
+            odd_counts: Vec::new(),
+        })
+    }
+
     /// A black film that also keeps the sums of each pixel's samples of odd
     /// index, for adaptive sampling's error estimate ([`Film::halves`]).
     pub fn with_halves(width: u32, height: u32) -> Self {

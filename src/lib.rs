@@ -81,3 +81,4 @@ pub mod scene;
 #[cfg(test)]
 mod testing;
 pub mod texture;
+pub mod tile;

@@ -37,9 +37,10 @@
 
 use crate::checkpoint::{identity_text, Checkpoint, CheckpointError, CheckpointView};
 use crate::film::Film;
-use crate::part::Part;
+use crate::part::{Part, Share};
 use crate::render::{render_pixels, RenderStats};
 use crate::scene::{Scene, SceneDesc, SceneError};
+use crate::tile::Tile;
 use std::ops::Range;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -131,8 +132,11 @@ pub struct Session {
     backup: Film,
     stats: RenderStats,
     /// The sample indices this session renders in every pixel: all of them,
-    /// or a part's share ([`Session::with_part`]).
+    /// or a part's share ([`Session::with_share`]).
     share: Range<u32>,
+    /// The pixels of the image the film holds: all of them, or a part's
+    /// tile.
+    tile: Tile,
     /// End of the samples rendered: the film holds `share.start..spp_done`.
     spp_done: u32,
     /// With adaptive sampling, the pixels still being sampled.
@@ -149,11 +153,20 @@ pub enum SessionError {
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
     /// Adaptive sampling decides each pass from all the samples before it,
-    /// which a part of the samples does not have.
-    #[error("part {part}: a render split into parts by samples cannot sample adaptively (render.noise_target is set); leave out the noise target")]
+    /// which a part of the samples does not have; its parts are not split
+    /// by tiles either.
+    #[error("{share}: a render split into parts cannot sample adaptively (render.noise_target is set); leave out the noise target")]
     AdaptivePart {
-        /// The part asked for.
-        part: Part,
+        /// The share asked for.
+        share: Share,
+    },
+    /// The share's pixels are not in the image.
+    #[error("{message}")]
+    Tile {
+        /// The share asked for.
+        share: Share,
+        /// What is wrong.
+        message: String,
     },
 }
 
@@ -210,6 +223,7 @@ impl Session {
         let share = 0..scene.settings.samples_per_pixel;
         Self {
             description: identity_text(desc, &scene.sources),
+            tile: Tile::whole(w, h),
             scene,
             film,
             backup: Film::new(0, 0),
@@ -221,22 +235,47 @@ impl Session {
     }
 
     /// A new render of `part` of the samples of `desc`, already compiled
-    /// into `scene`: the same film as the whole render, with the part's
-    /// share of every pixel's samples. Refused with adaptive sampling.
+    /// into `scene`: [`Session::with_share`] of that part.
     pub fn with_part(desc: &SceneDesc, scene: Scene, part: Part) -> Result<Self, SessionError> {
-        if scene.settings.noise_target.is_some() {
-            return Err(SessionError::AdaptivePart { part });
+        let share = Share {
+            part: Some(part),
+            ..Share::default()
+        };
+        Self::with_share(desc, scene, share)
+    }
+
+    /// A new render of `share` of `desc`, already compiled into `scene`:
+    /// a film of the share's pixels, to which the share's samples of every
+    /// pixel are added. Refused with adaptive sampling (unless the share is
+    /// the whole render), and when the share's pixels are not in the image.
+    pub fn with_share(desc: &SceneDesc, scene: Scene, share: Share) -> Result<Self, SessionError> {
+        if share.is_whole() {
+            return Ok(Self::with_scene(desc, scene));
         }
-        let share = part.samples(scene.settings.samples_per_pixel);
+        if scene.settings.noise_target.is_some() {
+            return Err(SessionError::AdaptivePart { share });
+        }
+        let s = &scene.settings;
+        let tile = share
+            .tile(s.width, s.height)
+            .map_err(|message| SessionError::Tile { share, message })?;
+        let samples = share.samples(s.samples_per_pixel);
         let mut session = Self::with_scene(desc, scene);
-        session.spp_done = share.start;
-        session.share = share;
+        session.film = Film::new(tile.width(), tile.height());
+        session.tile = tile;
+        session.spp_done = samples.start;
+        session.share = samples;
         Ok(session)
     }
 
     /// The sample indices this session renders in every pixel.
     pub fn share(&self) -> Range<u32> {
         self.share.clone()
+    }
+
+    /// The pixels of the image this session renders (its film's).
+    pub fn tile(&self) -> Tile {
+        self.tile
     }
 
     /// Continues the render of `desc` saved in `checkpoint` (read from
@@ -277,13 +316,17 @@ impl Session {
         };
         // Checked on decoding too; a checkpoint built in memory is not.
         checkpoint.check_consistency().map_err(malformed)?;
-        if (checkpoint.film.width(), checkpoint.film.height()) != (s.width, s.height) {
+        if checkpoint.image != (s.width, s.height) {
             return Err(malformed(format!(
                 "its image is {}x{}, the render's {}x{}",
-                checkpoint.film.width(),
-                checkpoint.film.height(),
-                s.width,
-                s.height
+                checkpoint.image.0, checkpoint.image.1, s.width, s.height
+            ))
+            .into());
+        }
+        if checkpoint.tile != self.tile {
+            return Err(malformed(format!(
+                "it holds the pixels {}, the render takes {}",
+                checkpoint.tile, self.tile
             ))
             .into());
         }
@@ -375,6 +418,8 @@ impl Session {
             renderer_id: crate::checkpoint::RENDERER_ID,
             description: &self.description,
             share: self.share.clone(),
+            tile: self.tile,
+            image: (self.scene.settings.width, self.scene.settings.height),
             spp_done: self.spp_done,
             gamma: self.scene.settings.gamma,
             stats: self.stats,
@@ -410,6 +455,7 @@ impl Session {
         let result = render_pixels(
             &self.scene,
             &mut self.film,
+            (self.tile.x0, self.tile.y0),
             samples.clone(),
             self.active.as_deref(),
             progress,

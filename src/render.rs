@@ -104,15 +104,20 @@ pub fn render_samples_cancellable(
     progress: &(dyn Fn(u64) + Sync),
     should_stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<RenderStats> {
-    render_pixels(scene, film, samples, None, progress, should_stop)
+    render_pixels(scene, film, (0, 0), samples, None, progress, should_stop)
 }
 
-/// [`render_samples_cancellable`] for the pixels whose entry in `active`
-/// (row-major, one per pixel) is `true` only, or for every pixel when
-/// `active` is `None`; `progress` counts the samples of those pixels.
+/// [`render_samples_cancellable`] into a film of some of the image's
+/// pixels, whose top left pixel is pixel `origin` of the image (a tile:
+/// `(0, 0)` for a film of the whole image), and for the pixels whose entry
+/// in `active` (row-major, one per film pixel) is `true` only, or for every
+/// pixel when `active` is `None`; `progress` counts the samples of those
+/// pixels. A pixel's samples are those it has in a render of the whole
+/// image.
 pub fn render_pixels(
     scene: &Scene,
     film: &mut Film,
+    origin: (u32, u32),
     samples: Range<u32>,
     active: Option<&[bool]>,
     progress: &(dyn Fn(u64) + Sync),
@@ -131,7 +136,8 @@ pub fn render_pixels(
                 return None;
             }
             let active = active.map(|a| &a[y * width..(y + 1) * width]);
-            let stats = render_row(isa, scene, y as u32, samples.clone(), row, active);
+            let at = (origin.0, origin.1 + y as u32);
+            let stats = render_row(isa, scene, at, samples.clone(), row, active);
             let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
             progress(pixels as u64 * per_pixel);
             Some(stats)
@@ -146,13 +152,14 @@ pub fn render_pixels(
         )
 }
 
-/// Renders samples `samples` of every pixel of row `y` (of those whose
-/// `active` flag is set, if given) with the code compiled for `isa` (which
-/// must be supported: use [`Isa::detect`]).
+/// Renders samples `samples` of every pixel of `row`, which holds the
+/// pixels of image row `at.1` from column `at.0` on (of those whose `active`
+/// flag is set, if given), with the code compiled for `isa` (which must be
+/// supported: use [`Isa::detect`]).
 fn render_row(
     isa: Isa,
     scene: &Scene,
-    y: u32,
+    at: (u32, u32),
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
@@ -164,10 +171,10 @@ fn render_row(
             // processor has every feature `render_row_avx2` is compiled for.
             #[allow(unsafe_code)]
             unsafe {
-                render_row_avx2(scene, y, samples, row, active)
+                render_row_avx2(scene, at, samples, row, active)
             }
         }
-        _ => render_row_generic(scene, y, samples, row, active),
+        _ => render_row_generic(scene, at, samples, row, active),
     }
 }
 
@@ -176,19 +183,19 @@ fn render_row(
 #[allow(unsafe_code)]
 unsafe fn render_row_avx2(
     scene: &Scene,
-    y: u32,
+    at: (u32, u32),
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
 ) -> RenderStats {
-    render_row_generic(scene, y, samples, row, active)
+    render_row_generic(scene, at, samples, row, active)
 }
 
 /// The body of the row loop, inlined into each instruction-set version.
 #[inline(always)]
 fn render_row_generic(
     scene: &Scene,
-    y: u32,
+    (x0, y): (u32, u32),
     samples: Range<u32>,
     mut row: RowMut,
     active: Option<&[bool]>,
@@ -208,23 +215,25 @@ fn render_row_generic(
         if active.is_some_and(|a| !a[x]) {
             continue;
         }
-        let pixel = u64::from(y) * width as u64 + x as u64;
+        // The pixel's column in the image, which addresses its samples.
+        let column = x0 + x as u32;
+        let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
         let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
         if !side_by_side {
             for index in samples.clone() {
-                let (ray, _) = camera_sample(scene, x as u32, y, &pixel_sampler, index);
+                let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
                 add_sample(&mut row, &mut stats, x, index, c);
             }
             continue;
         }
-        let reference = scene.camera.central_ray(x as u32, y);
+        let reference = scene.camera.central_ray(column, y);
         let mut start = samples.start;
         while start < samples.end {
             let n = (samples.end - start).min(PATHS as u32) as usize;
             for (i, (ray, sampler)) in rays.iter_mut().zip(&mut samplers).take(n).enumerate() {
                 (*ray, *sampler) =
-                    camera_sample(scene, x as u32, y, &pixel_sampler, start + i as u32);
+                    camera_sample(scene, column, y, &pixel_sampler, start + i as u32);
             }
             trace_paths(
                 scene,
@@ -305,7 +314,7 @@ mod tests {
             let render_with = |isa| {
                 let mut film = Film::with_halves(width, 1);
                 let row = film.rows_mut().collect::<Vec<_>>().pop().unwrap();
-                let stats = render_row(isa, scene, y, 0..37, row, None);
+                let stats = render_row(isa, scene, (0, y), 0..37, row, None);
                 (film, stats)
             };
             let (base, a) = render_with(Isa::Baseline);

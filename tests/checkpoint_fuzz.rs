@@ -86,24 +86,38 @@ fn layout(bytes: &[u8]) -> Layout {
     let id = HEADER_LEN + 4..HEADER_LEN + 4 + u32_at(HEADER_LEN);
     let desc = id.end + 4..id.end + 4 + u32_at(id.end);
     let spp = desc.end;
-    // After spp_done: the share (start, end) and the gamma.
+    // After spp_done: the share (start, end) and the gamma; after the
+    // film's size, the tile's corner and the image's size.
     let width = spp + 16;
-    let pixels = u32_at(width) * u32_at(width + 4);
-    let sums = width + 8 + 24;
-    let counts = sums + 48 * pixels;
-    let adaptive = counts + 4 * pixels;
+    let height = u32_at(width + 4);
+    let pixels = u32_at(width) * height;
+    let counts = width + 24 + 24;
+    // The sums, row by row, each row after its length.
+    let rows_end = |mut at: usize| {
+        for _ in 0..height {
+            at += 4 + u32_at(at);
+        }
+        at
+    };
+    let adaptive = rows_end(counts + 4 * pixels);
+    let odd_counts = adaptive + 1;
+    let flags = if bytes[adaptive] == 1 {
+        rows_end(odd_counts + 4 * pixels)
+    } else {
+        0
+    };
     Layout {
         id,
         desc,
         spp,
         width,
-        samples: width + 8,
-        rays: width + 16,
-        dropped: width + 24,
+        samples: width + 24,
+        rays: width + 32,
+        dropped: width + 40,
         counts,
         adaptive,
-        odd_counts: adaptive + 1 + 48 * pixels,
-        flags: adaptive + 1 + 52 * pixels,
+        odd_counts,
+        flags,
         pixels,
     }
 }
@@ -181,7 +195,9 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
             "spp done".into()
         }
         3 => {
-            let at = l.width + 4 * rng.below(2);
+            // The film's width and height, the tile's corner, the image's
+            // width and height.
+            let at = l.width + 4 * rng.below(6);
             if rng.below(2) == 0 {
                 // The other side's value, or one more if they are equal.
                 let old = get_u32(bytes, at);
@@ -190,7 +206,7 @@ fn craft(rng: &mut Rng, bytes: &mut Vec<u8>, l: &Layout, active: bool) -> String
             } else {
                 perturb_u32(rng, bytes, at);
             }
-            "image size".into()
+            format!("image size field at {at}")
         }
         4 => {
             // The ray count only feeds the closing summary: a change is

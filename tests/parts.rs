@@ -7,32 +7,22 @@ mod common;
 mod lumen_process;
 
 use common::builtin_desc as desc;
-use lumen::part::{self, MergeError, Part};
+use lumen::part::{self, MergeError, Part, Share};
 use lumen::progressive::{Session, StopReason};
 use lumen::render::render;
 use lumen::scene::{Scene, SceneDesc};
 use lumen_process::*;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 /// Renders `part` of `desc` through the library, stopping after `passes`
 /// passes if given, and writes its part file into `dir`.
 fn write_part(desc: &SceneDesc, part: Part, dir: &Path, passes: Option<u32>) -> PathBuf {
-    let scene = Scene::from_desc(desc).unwrap();
-    let mut session = Session::with_part(desc, scene, part).unwrap();
-    let stop = AtomicBool::new(false);
-    session
-        .run(&stop, None, &|_| {}, &mut |_, pass| {
-            if Some(pass.number) == passes {
-                stop.store(true, Ordering::SeqCst);
-            }
-            Ok::<(), ()>(())
-        })
-        .unwrap();
-    std::fs::create_dir_all(dir).unwrap();
-    let path = part::file_name(dir, part);
-    session.checkpoint().write(&path).unwrap();
-    path
+    let share = Share {
+        part: Some(part),
+        ..Share::default()
+    };
+    common::write_share(desc, share, &part::file_name(dir, part), passes)
 }
 
 fn one_machine(desc: &SceneDesc) -> lumen::film::Film {

@@ -3,9 +3,11 @@
 //! twice, and read back with every length checked, since the file may say
 //! anything.
 
+use super::pixels::{write_counts, write_sums, Pixels};
 use super::{Checkpoint, CheckpointView, MAGIC, VERSION};
-use crate::film::{Film, Sum};
+use crate::film::Film;
 use crate::render::RenderStats;
+use crate::tile::Tile;
 
 impl CheckpointView<'_> {
     /// Feeds the payload to `sink` piece by piece, so that it can be hashed
@@ -22,18 +24,27 @@ impl CheckpointView<'_> {
             self.gamma.to_bits(),
             self.film.width(),
             self.film.height(),
+            self.tile.x0,
+            self.tile.y0,
+            self.image.0,
+            self.image.1,
         ] {
             sink(&v.to_le_bytes())?;
         }
         for v in [self.stats.samples, self.stats.rays, self.stats.dropped] {
             sink(&v.to_le_bytes())?;
         }
-        write_sums_and_counts(self.film.raw(), sink)?;
+        let width = self.film.width() as usize;
+        let (sums, counts) = self.film.raw();
+        write_counts(counts, sink)?;
+        write_sums(sums, width, sink)?;
         match self.active {
             // Adaptive: the halves' sums and counts, and the pixels' flags.
             Some(active) if self.film.has_halves() => {
                 sink(&[1])?;
-                write_sums_and_counts(self.film.raw_odd(), sink)?;
+                let (odd_sums, odd_counts) = self.film.raw_odd();
+                write_counts(odd_counts, sink)?;
+                write_sums(odd_sums, width, sink)?;
                 let flags: Vec<u8> = active.iter().map(|&a| u8::from(a)).collect();
                 sink(&flags)
             }
@@ -67,43 +78,91 @@ impl CheckpointView<'_> {
     }
 }
 
+/// A checkpoint's payload read, its pixels found but not decoded: what
+/// `lumen merge` adds straight into its film.
+pub(crate) struct Unpacked<'a> {
+    /// Every field but the film, which is empty (0×0).
+    pub(crate) head: Checkpoint,
+    /// The film's size.
+    pub(crate) width: u32,
+    /// The film's size.
+    pub(crate) height: u32,
+    /// The film's sums and counts.
+    pub(crate) pixels: Pixels<'a>,
+    /// With adaptive sampling: the sums and counts of the samples of odd
+    /// index, and a flag a pixel.
+    pub(crate) odd: Option<(Pixels<'a>, &'a [u8])>,
+}
+
 impl Checkpoint {
-    pub(super) fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
+    /// Reads a payload's fields and finds its pixels.
+    pub(crate) fn unpack(payload: &[u8]) -> Result<Unpacked<'_>, &'static str> {
         let mut r = Reader(payload);
         let renderer_id = r.text().ok_or("bad renderer identity")?;
         let description = r.text().ok_or("bad description text")?;
-        let spp_done = r.u32().ok_or("missing sample count")?;
-        let start = r.u32().ok_or("missing share of samples")?;
-        let end = r.u32().ok_or("missing share of samples")?;
-        let gamma = f32::from_bits(r.u32().ok_or("missing gamma")?);
-        let width = r.u32().ok_or("missing width")?;
-        let height = r.u32().ok_or("missing height")?;
+        let mut field = |what| r.u32().ok_or(what);
+        let spp_done = field("missing sample count")?;
+        let start = field("missing share of samples")?;
+        let end = field("missing share of samples")?;
+        let gamma = f32::from_bits(field("missing gamma")?);
+        let width = field("missing width")?;
+        let height = field("missing height")?;
+        let (x0, y0) = (field("missing tile")?, field("missing tile")?);
+        let image = (field("missing image size")?, field("missing image size")?);
+        let tile = Tile {
+            x0,
+            y0,
+            x1: x0.checked_add(width).ok_or("bad tile")?,
+            y1: y0.checked_add(height).ok_or("bad tile")?,
+        };
         let mut stat = || r.u64().ok_or("missing statistics");
         let stats = RenderStats {
             samples: stat()?,
             rays: stat()?,
             dropped: stat()?,
         };
-        // Checked: the size is read from the file, which may say anything.
-        let pixels = u64::from(width) * u64::from(height);
-        let bytes = |per_pixel: u64| pixels.checked_mul(per_pixel).and_then(|b| b.checked_add(1));
-        let rest = Some(r.0.len() as u64);
-        let adaptive = if rest == bytes(PIXEL_LEN as u64) {
-            false
-        } else if rest == bytes(2 * PIXEL_LEN as u64 + 1) {
-            true
-        } else {
-            return Err("pixel data does not match the image size");
+        let (pixels, rest) = Pixels::split(r.0, width, height)?;
+        let odd = match rest {
+            [0] => None,
+            [1, rest @ ..] => {
+                let (odd, flags) = Pixels::split(rest, width, height)?;
+                if flags.len() as u64 != u64::from(width) * u64::from(height) {
+                    return Err("pixel data does not match the image size");
+                }
+                Some((odd, flags))
+            }
+            [] | [0, ..] => return Err("pixel data does not match the image size"),
+            _ => return Err("bad adaptive sampling flags"),
         };
-        let n = pixels as usize;
-        let (whole, rest) = r.0.split_at(n * PIXEL_LEN);
-        let (sums, counts) = sums_and_counts(whole, n);
-        let film = Film::from_raw(width, height, sums, counts).ok_or("bad pixel data")?;
-        let (film, active) = match (adaptive, rest) {
-            (false, [0]) => (film, None),
-            (true, [1, rest @ ..]) => {
-                let (odd, flags) = rest.split_at(n * PIXEL_LEN);
-                let (odd_sums, odd_counts) = sums_and_counts(odd, n);
+        let head = Self {
+            renderer_id,
+            description,
+            share: start..end,
+            tile,
+            image,
+            spp_done,
+            gamma,
+            stats,
+            film: Film::new(0, 0),
+            active: None,
+        };
+        Ok(Unpacked {
+            head,
+            width,
+            height,
+            pixels,
+            odd,
+        })
+    }
+
+    pub(super) fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
+        let u = Self::unpack(payload)?;
+        let (sums, counts) = u.pixels.decode()?;
+        let film = Film::from_raw(u.width, u.height, sums, counts).ok_or("bad pixel data")?;
+        let (film, active) = match u.odd {
+            None => (film, None),
+            Some((odd, flags)) => {
+                let (odd_sums, odd_counts) = odd.decode()?;
                 let film = film
                     .with_odd(odd_sums, odd_counts)
                     .ok_or("bad pixel data of the samples of odd index")?;
@@ -117,64 +176,13 @@ impl Checkpoint {
                     .collect::<Result<Vec<bool>, _>>()?;
                 (film, Some(active))
             }
-            _ => return Err("bad adaptive sampling flags"),
         };
         Ok(Self {
-            renderer_id,
-            description,
-            share: start..end,
-            spp_done,
-            gamma,
-            stats,
             film,
             active,
+            ..u.head
         })
     }
-}
-
-/// Bytes a pixel takes: three `i128` sums and a `u32` count.
-const PIXEL_LEN: usize = 3 * 16 + 4;
-
-/// Feeds every pixel's three sums and then every pixel's `u32` count to
-/// `sink`, a few thousand pixels at a time.
-fn write_sums_and_counts(
-    (sums, counts): (&[Sum], &[u32]),
-    sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let mut buf = Vec::with_capacity(4096 * 48);
-    for chunk in sums.chunks(4096) {
-        buf.clear();
-        for v in chunk.iter().flat_map(|s| s.0) {
-            buf.extend_from_slice(&v.to_le_bytes());
-        }
-        sink(&buf)?;
-    }
-    for chunk in counts.chunks(4096) {
-        buf.clear();
-        for c in chunk {
-            buf.extend_from_slice(&c.to_le_bytes());
-        }
-        sink(&buf)?;
-    }
-    Ok(())
-}
-
-/// The `n` pixels' three sums and then their `u32` counts, decoded from
-/// `bytes` ([`PIXEL_LEN`] bytes a pixel).
-fn sums_and_counts(bytes: &[u8], n: usize) -> (Vec<Sum>, Vec<u32>) {
-    let (sum_bytes, count_bytes) = bytes.split_at(n * 48);
-    let sums = sum_bytes
-        .chunks_exact(48)
-        .map(|p| {
-            let f = |i: usize| i128::from_le_bytes(p[i..i + 16].try_into().expect("16 bytes"));
-            Sum([f(0), f(16), f(32)])
-        })
-        .collect();
-    let counts = count_bytes
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-        .collect();
-    (sums, counts)
 }
 
 /// A cursor over little-endian bytes.

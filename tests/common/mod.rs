@@ -518,3 +518,28 @@ pub fn read_both(
     }
     quick
 }
+
+/// Renders `share` of `desc` through the library, stopping after `passes`
+/// passes if given, and writes its part file to `path`.
+pub fn write_share(
+    desc: &SceneDesc,
+    share: lumen::part::Share,
+    path: &std::path::Path,
+    passes: Option<u32>,
+) -> std::path::PathBuf {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let scene = Scene::from_desc(desc).unwrap();
+    let mut session = lumen::progressive::Session::with_share(desc, scene, share).unwrap();
+    let stop = AtomicBool::new(false);
+    session
+        .run(&stop, None, &|_| {}, &mut |_, pass| {
+            if Some(pass.number) == passes {
+                stop.store(true, Ordering::SeqCst);
+            }
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    session.checkpoint().write(path).unwrap();
+    path.to_path_buf()
+}

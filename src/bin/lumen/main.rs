@@ -276,6 +276,15 @@ struct ProgressiveArgs {
     /// docs/distributed.md.
     #[arg(long, value_name = "K/N")]
     part: Option<lumen::part::Part>,
+    /// What --part splits: `samples` (every part a share of every pixel's
+    /// samples, the default) or `tiles` (part K of N bands of whole rows,
+    /// every sample: for an image whose film does not fit one machine).
+    #[arg(long, value_name = "HOW", requires = "part")]
+    split: Option<lumen::part::Split>,
+    /// Render only the pixels X0..X1 x Y0..Y1 into a part file (-o
+    /// NAME.lumen-part); with --part K/N, that share of their samples.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", conflicts_with = "checkpoint")]
+    tile: Option<lumen::tile::Tile>,
     /// Save the image and the checkpoint at most this often (e.g. 30s, 5m)
     /// instead of after every pass.
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]

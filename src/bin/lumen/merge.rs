@@ -25,7 +25,7 @@ pub(crate) fn merge_command(
     output::check_writable(out)?;
     let _lock = RenderLock::acquire(out)?;
     let merged: Merged = part::merge(parts, partial)?;
-    if merged.held.is_empty() {
+    if merged.samples_held == 0 {
         bail!("the parts hold no samples yet: nothing to merge");
     }
     output::write_image(out, &merged.film, gamma.unwrap_or(merged.gamma))?;
@@ -37,13 +37,24 @@ pub(crate) fn merge_command(
             merged.spp,
             out.display()
         );
-    } else {
+    } else if merged.is_whole_image() {
         errln!(
             "lumen: partial merge: {} holds {} of {} spp (samples {}) of every pixel",
             out.display(),
             merged.held_spp(),
             merged.spp,
             part::ranges_text(&merged.held)
+        );
+    } else {
+        let (w, h) = (merged.film.width(), merged.film.height());
+        let all = u64::from(w) * u64::from(h) * u64::from(merged.spp);
+        errln!(
+            "lumen: partial merge: {} holds {} of the {all} samples of the {w}x{h} image ({:.1}%) from {} tile{}; pixels no part holds are black",
+            out.display(),
+            merged.samples_held,
+            100.0 * merged.samples_held as f64 / all as f64,
+            merged.tiles.len(),
+            if merged.tiles.len() == 1 { "" } else { "s" },
         );
     }
     Ok(ExitCode::SUCCESS)

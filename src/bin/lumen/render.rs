@@ -6,8 +6,9 @@ use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs};
 use anyhow::{bail, Context, Result};
 use lumen::checkpoint::{self, Checkpoint, Existing};
 use lumen::lock::RenderLock;
+use lumen::part::{self, Share};
 use lumen::progressive::{Session, StopReason};
-use lumen::{files, output, part};
+use lumen::{files, output};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -70,24 +71,30 @@ pub(crate) fn render_command(
 ) -> Result<ExitCode> {
     let (desc, scene) = load_scene(name)?.resolve(name, &args.overrides())?;
     let is_part_file = out.extension().is_some_and(|e| e == part::EXTENSION);
-    match prog.part {
-        Some(_) if !is_part_file => bail!(
+    let share = Share {
+        part: prog.part,
+        split: prog.split.unwrap_or_default(),
+        tile: prog.tile,
+    };
+    let is_part = !share.is_whole();
+    match is_part {
+        true if !is_part_file => bail!(
             "{}: a part of a render is written to a part file: -o NAME.{}",
             out.display(),
             part::EXTENSION
         ),
-        None if is_part_file => bail!(
-            "{}: a part file holds a part of a render: give --part K/N",
+        false if is_part_file => bail!(
+            "{}: a part file holds a part of a render: give --part K/N or --tile X0,Y0,X1,Y1",
             out.display()
         ),
-        Some(_) => {}
-        None => {
+        true => {}
+        false => {
             output::ImageFormat::from_path(out)?;
         }
     }
     // What the render saves: the image and its checkpoint, or a part file,
     // which is its own checkpoint.
-    let image = prog.part.is_none().then_some(out);
+    let image = (!is_part).then_some(out);
     let ckpt_path = match image {
         None => out.to_path_buf(),
         Some(_) => {
@@ -114,10 +121,7 @@ pub(crate) fn render_command(
         .map(|t| RenderLock::acquire(t))
         .collect::<Result<Vec<_>, _>>()?;
     remove_stale_temps(&targets);
-    let session = match prog.part {
-        Some(part) => Session::with_part(&desc, scene, part)?,
-        None => Session::with_scene(&desc, scene),
-    };
+    let session = Session::with_share(&desc, scene, share)?;
     let mut session = if prog.resume {
         if !ckpt_path.exists() {
             bail!(
@@ -147,10 +151,20 @@ pub(crate) fn render_command(
 
     let s = session.scene().settings.clone();
     let resumed_from = session.spp_done();
-    let share = session.share();
-    let of_part = prog.part.map_or(String::new(), |p| {
-        format!(", part {p}: samples {}..{}", share.start, share.end)
-    });
+    let tile = session.tile();
+    let samples = session.share();
+    let part_text = match tile.is_whole(s.width, s.height) {
+        true => format!("{share}: samples {}..{}", samples.start, samples.end),
+        false => format!(
+            "{share}: pixels {tile}, samples {}..{}",
+            samples.start, samples.end
+        ),
+    };
+    let of_part = match is_part {
+        true => format!(", {part_text}"),
+        false => String::new(),
+    };
+    let share = samples;
     errln!(
         "{name}: {}x{} at {} spp, depth {}{of_part}{}",
         s.width,
@@ -185,7 +199,7 @@ pub(crate) fn render_command(
         quit_if_asked();
         Ok(())
     };
-    let pixels = u64::from(s.width) * u64::from(s.height);
+    let pixels = tile.area();
     let bar = progress_bar(pixels * u64::from(share.end - resumed_from));
     let start = Instant::now();
     let mut last_save = start;
@@ -224,18 +238,16 @@ pub(crate) fn render_command(
     let elapsed = start.elapsed();
     bar.finish_and_clear();
     let (held, total) = (session.spp_done(), session.spp_total());
-    let code = match (run.reason, prog.part) {
-        (StopReason::Complete, Some(part)) => {
+    let code = match (run.reason, is_part) {
+        (StopReason::Complete, true) => {
             save(&session)?;
             errln!(
-                "{name}: part {part}: samples {}..{} of {total} spp written to {}",
-                share.start,
-                share.end,
+                "{name}: {part_text} of {total} spp written to {}",
                 out.display()
             );
             ExitCode::SUCCESS
         }
-        (StopReason::Complete, None) => {
+        (StopReason::Complete, false) => {
             save(&session)?;
             if let Err(e) = checkpoint::remove(&ckpt_path) {
                 errln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
@@ -262,10 +274,10 @@ pub(crate) fn render_command(
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 // An unfinished part is not a finished task: a job engine
                 // must see it fail, and the merge refuses it.
-                _ if part.is_some() => ("time limit reached", ExitCode::FAILURE),
+                _ if part => ("time limit reached", ExitCode::FAILURE),
                 _ => ("time limit reached", ExitCode::SUCCESS),
             };
-            if part.is_some() {
+            if part {
                 errln!(
                     "lumen: {why}: part {} holds samples {}..{held} of its share {}..{}; continue with --resume",
                     out.display(),

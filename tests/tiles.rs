@@ -1,0 +1,402 @@
+//! A render split by pixel region (`render --tile`, `render --part K/N
+//! --split tiles`) and merged is the render of one machine to the bit, with
+//! each part's film holding its tile only; tiles that do not make one image
+//! are refused, naming the files and the pixels.
+
+mod common;
+mod lumen_process;
+
+use common::{builtin_desc as desc, write_share};
+use lumen::checkpoint::Checkpoint;
+use lumen::part::{self, MergeError, Part, Share, Split};
+use lumen::progressive::{Session, StopReason};
+use lumen::render::render;
+use lumen::scene::{Scene, SceneDesc};
+use lumen::tile::Tile;
+use lumen_process::*;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+fn one_machine(desc: &SceneDesc) -> lumen::film::Film {
+    render(&Scene::from_desc(desc).unwrap(), &|_| {}).0
+}
+
+/// Band `index` of `count`.
+fn band(index: u32, count: u32) -> Share {
+    Share {
+        part: Some(Part { index, count }),
+        split: Split::Tiles,
+        tile: None,
+    }
+}
+
+/// Tile `t`, or part `part` of its samples.
+fn tile(t: &str, part: Option<(u32, u32)>) -> Share {
+    Share {
+        part: part.map(|(index, count)| Part { index, count }),
+        split: Split::Samples,
+        tile: Some(t.parse().unwrap()),
+    }
+}
+
+/// Writes `share` of `desc` as `dir/name.lumen-part`.
+fn write(desc: &SceneDesc, share: Share, dir: &Path, name: &str) -> PathBuf {
+    write_share(desc, share, &dir.join(format!("{name}.lumen-part")), None)
+}
+
+#[test]
+fn merged_tiles_are_the_one_machine_film_for_any_count_and_order() {
+    let dir = temp_dir("tiles-counts");
+    for (name, width, spp, counts) in [
+        ("cover", 24, 9, &[1, 2, 3, 7][..]),
+        ("cornell-box", 20, 5, &[4, 20][..]),
+    ] {
+        let d = desc(name, width, spp, 5);
+        let whole = one_machine(&d);
+        let height = whole.height();
+        for &count in counts {
+            let sub = dir.join(format!("{name}-{count}"));
+            let mut paths: Vec<PathBuf> = (0..count)
+                .map(|k| write(&d, band(k, count), &sub, &format!("part-{k}")))
+                .collect();
+            // Each part's film is its band only.
+            let rows: u32 = (paths.iter())
+                .map(|p| {
+                    let c = Checkpoint::read(p).unwrap();
+                    assert_eq!(c.film.width(), whole.width());
+                    assert_eq!(c.film.height(), c.tile.height());
+                    c.film.height()
+                })
+                .sum();
+            assert_eq!(rows, height);
+            for turn in 0..3 {
+                match turn {
+                    1 => paths.reverse(),
+                    2 => paths.rotate_left(count as usize / 2),
+                    _ => {}
+                }
+                let merged = part::merge(&paths, false).unwrap();
+                assert!(merged.is_complete());
+                assert_eq!(merged.held, vec![0..spp]);
+                assert!(
+                    merged.film == whole,
+                    "{name}: {count} bands, order {turn}: film differs"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn tiles_of_any_shape_and_tiles_split_by_samples_merge_exactly() {
+    let dir = temp_dir("tiles-grid");
+    let d = desc("cover", 30, 11, 8);
+    let whole = one_machine(&d);
+    let (w, h) = (whole.width(), whole.height());
+    assert!(h > 10, "{h}");
+    // An uneven grid: a left column, and the right side in two rows, the
+    // lower one split again by samples into three.
+    let paths = [
+        write(&d, tile(&format!("0,0,7,{h}"), None), &dir, "left"),
+        write(&d, tile(&format!("7,0,{w},5"), None), &dir, "top"),
+        write(&d, tile(&format!("7,5,{w},{h}"), Some((2, 3))), &dir, "c"),
+        write(&d, tile(&format!("7,5,{w},{h}"), Some((0, 3))), &dir, "a"),
+        write(&d, tile(&format!("7,5,{w},{h}"), Some((1, 3))), &dir, "b"),
+    ];
+    let merged = part::merge(&paths, false).unwrap();
+    assert!(merged.film == whole);
+    assert_eq!(merged.tiles.len(), 3);
+    assert_eq!(
+        merged.stats.samples,
+        u64::from(w) * u64::from(h) * 11,
+        "every sample counted once"
+    );
+}
+
+#[test]
+fn tiles_that_do_not_make_one_image_are_refused_naming_files_and_pixels() {
+    let dir = temp_dir("tiles-refused");
+    let d = desc("cover", 16, 6, 1);
+    let (w, h) = (16, 9);
+    let top = write(&d, tile(&format!("0,0,{w},4"), None), &dir, "top");
+    let bottom = write(&d, tile(&format!("0,4,{w},{h}"), None), &dir, "bottom");
+    let err = |paths: &[PathBuf]| part::merge(paths, false).unwrap_err();
+
+    // A tile missing: the first pixel no part holds, and how many more.
+    match err(std::slice::from_ref(&top)) {
+        MergeError::MissingPixels {
+            image,
+            example,
+            others,
+        } => {
+            assert_eq!((image, example, others), ((w, h), (0, 4), 16 * 5 - 1));
+        }
+        e => panic!("{e}"),
+    }
+    let e = err(std::slice::from_ref(&top)).to_string();
+    assert!(
+        e.contains("no part holds pixel (0, 4) of the 16x9 image, nor 79 other pixels"),
+        "{e}"
+    );
+    // A partial merge holds the top's samples; the rest is black.
+    let partial = part::merge(std::slice::from_ref(&top), true).unwrap();
+    assert!(!partial.is_complete());
+    assert_eq!(partial.samples_held, 16 * 4 * 6);
+    assert!(partial.held.is_empty());
+    assert_eq!(partial.film.pixel(3, 7), lumen::math::Color::ZERO);
+    assert_eq!(partial.film.pixel(3, 2), one_machine(&d).pixel(3, 2));
+
+    // Overlapping tiles that are not the same tile.
+    let middle = write(&d, tile(&format!("0,3,{w},6"), None), &dir, "middle");
+    let e = err(&[top.clone(), middle.clone(), bottom.clone()]).to_string();
+    assert!(
+        e.contains("top.lumen-part and")
+            && e.contains("middle.lumen-part hold overlapping tiles (0,0,16,4 and 0,3,16,6, sharing 0,3,16,4)"),
+        "{e}"
+    );
+    // The same tile twice.
+    let e = err(&[top.clone(), bottom.clone(), top.clone()]).to_string();
+    assert!(
+        e.contains("both hold samples 0..6 of the pixels of tile 0,0,16,4"),
+        "{e}"
+    );
+    // A tile split by samples with a share missing.
+    let half = write(
+        &d,
+        tile(&format!("0,4,{w},{h}"), Some((0, 2))),
+        &dir,
+        "half",
+    );
+    let e = err(&[top.clone(), half.clone()]).to_string();
+    assert!(
+        e.contains("no part holds samples 3..6 of the pixels of tile 0,4,16,9 of the 6 spp render"),
+        "{e}"
+    );
+    // A tile and a band of the same image split another way.
+    let other = write(&d, band(1, 3), &dir, "band");
+    assert!(matches!(
+        err(&[top.clone(), other]),
+        MergeError::TilesOverlap { .. }
+    ));
+    // A part of a different image size is another render.
+    let e = err(&[
+        top.clone(),
+        write(&desc("cover", 20, 6, 1), band(1, 2), &dir, "wide"),
+    ]);
+    assert!(matches!(e, MergeError::DifferentRenders { .. }), "{e}");
+    assert!(part::merge(&[top, bottom], false).unwrap().is_complete());
+}
+
+#[test]
+fn a_tile_must_lie_in_the_image_and_bands_must_hold_rows() {
+    let d = desc("cover", 16, 4, 1);
+    let start = |share: Share| {
+        Session::with_share(&d, Scene::from_desc(&d).unwrap(), share)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let e = start(tile("8,0,17,4", None)).unwrap();
+    assert!(
+        e.contains("tile 8,0,17,4 reaches beyond the 16x9 image"),
+        "{e}"
+    );
+    let e = start(band(0, 10)).unwrap();
+    assert!(
+        e.contains("part 0/10 (tiles): the 9 rows of the image cannot be split into 10 bands"),
+        "{e}"
+    );
+    let both = Share {
+        split: Split::Tiles,
+        ..tile("0,0,4,4", Some((0, 2)))
+    };
+    assert!(start(both).unwrap().contains("not both"));
+    assert_eq!(start(band(8, 9)), None);
+    // Adaptive sampling decides from neighbouring passes of every pixel:
+    // refused for a tile as for a share of samples.
+    let mut adaptive = d.clone();
+    adaptive.render.sampler = lumen::scene::Sampling::Sobol;
+    adaptive.render.noise_target = Some(0.05);
+    let e = Session::with_share(
+        &adaptive,
+        Scene::from_desc(&adaptive).unwrap(),
+        tile("0,0,4,4", None),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        e.contains("tile 0,0,4,4") && e.contains("noise_target"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_tile_stopped_and_resumed_merges_exactly_and_only_as_that_tile() {
+    let dir = temp_dir("tiles-resume");
+    let d = desc("cover", 24, 32, 2);
+    let top = write(&d, band(0, 2), &dir, "part-0");
+    let path = dir.join("part-1.lumen-part");
+    write_share(&d, band(1, 2), &path, Some(2));
+    assert!(matches!(
+        part::merge(&[top.clone(), path.clone()], false),
+        Err(MergeError::Unfinished { .. })
+    ));
+    // The same tile resumes; another tile is refused, naming both.
+    let ckpt = Checkpoint::read(&path).unwrap();
+    let other = Session::with_share(&d, Scene::from_desc(&d).unwrap(), band(0, 2)).unwrap();
+    let e = other
+        .restore(ckpt.clone(), &path)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("it holds the pixels 0,6,24,13, the render takes 0,0,24,6"),
+        "{e}"
+    );
+    let mut session = Session::with_share(&d, Scene::from_desc(&d).unwrap(), band(1, 2))
+        .unwrap()
+        .restore(ckpt, &path)
+        .unwrap();
+    let run = session
+        .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+    assert_eq!(run.reason, StopReason::Complete);
+    session.checkpoint().write(&path).unwrap();
+    assert!(part::merge(&[path, top], false).unwrap().film == one_machine(&d));
+}
+
+#[test]
+fn the_command_line_splits_by_tiles_and_merges_to_the_bit() {
+    let dir = temp_dir("tiles-cli");
+    let args = ["cover", "--width", "40", "--spp", "6", "--seed", "4"];
+    let run = |extra: &[&str], out: &str| {
+        let out = lumen()
+            .arg("render")
+            .args(args)
+            .args(extra)
+            .arg("-o")
+            .arg(dir.join(out))
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    assert_eq!(run(&[], "one.pfm").0, Some(0));
+    for k in [2, 0, 1] {
+        let (code, said) = run(
+            &["--part", &format!("{k}/3"), "--split", "tiles"],
+            &format!("band-{k}.lumen-part"),
+        );
+        assert_eq!(code, Some(0), "{said}");
+        assert!(
+            said.contains(&format!("part {k}/3 (tiles): pixels 0,")),
+            "{said}"
+        );
+    }
+    // The image by explicit tiles, the right one split by samples.
+    for (extra, name) in [
+        (&["--tile", "0,0,25,22"][..], "left"),
+        (&["--tile", "25,0,40,22", "--part", "0/2"][..], "right-0"),
+        (&["--tile", "25,0,40,22", "--part", "1/2"][..], "right-1"),
+    ] {
+        let (code, said) = run(extra, &format!("{name}.lumen-part"));
+        assert_eq!(code, Some(0), "{said}");
+    }
+    let merge = |parts: &[&str], extra: &[&str], to: &str| {
+        let out = lumen()
+            .arg("merge")
+            .args(parts.iter().map(|p| dir.join(format!("{p}.lumen-part"))))
+            .args(extra)
+            .arg("-o")
+            .arg(dir.join(to))
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let one = std::fs::read(dir.join("one.pfm")).unwrap();
+    let (code, said) = merge(&["band-1", "band-2", "band-0"], &[], "bands.pfm");
+    assert_eq!(code, Some(0), "{said}");
+    assert_eq!(std::fs::read(dir.join("bands.pfm")).unwrap(), one);
+    let (code, said) = merge(&["right-1", "left", "right-0"], &[], "tiles.pfm");
+    assert_eq!(code, Some(0), "{said}");
+    assert_eq!(std::fs::read(dir.join("tiles.pfm")).unwrap(), one);
+    // Missing a tile: refused, nothing written; --partial says what it holds.
+    let (code, said) = merge(&["left", "right-0"], &[], "some.png");
+    assert_eq!(code, Some(1));
+    assert!(
+        said.contains("no part holds samples 3..6 of the pixels of tile 25,0,40,22"),
+        "{said}"
+    );
+    assert!(!dir.join("some.png").exists());
+    let (code, said) = merge(&["left"], &["--partial"], "some.png");
+    assert_eq!(code, Some(0), "{said}");
+    let held = 25 * 22 * 6;
+    assert!(
+        said.contains(&format!(
+            "holds {held} of the 5280 samples of the 40x22 image (62.5%) from 1 tile"
+        )),
+        "{said}"
+    );
+    // Refusals on the command line: exit 1 and the reason.
+    for (extra, expect) in [
+        (
+            &["--tile", "0,0,41,5"][..],
+            "reaches beyond the 40x22 image",
+        ),
+        (
+            &["--part", "0/23", "--split", "tiles"][..],
+            "cannot be split into 23 bands",
+        ),
+        (
+            &["--tile", "0,0,4,4", "--part", "0/2", "--split", "tiles"][..],
+            "not both",
+        ),
+    ] {
+        let (code, said) = run(extra, "x.lumen-part");
+        assert_eq!(code, Some(1), "{extra:?}: {said}");
+        assert!(said.contains(expect), "{extra:?}: {said}");
+    }
+    // A tile is written to a part file; malformed values are usage errors.
+    let (code, said) = run(&["--tile", "0,0,4,4"], "x.png");
+    assert_eq!(code, Some(1));
+    assert!(said.contains("-o NAME.lumen-part"), "{said}");
+    for extra in [
+        &["--tile", "4,0,4,4"][..],
+        &["--tile", "1,2,3"],
+        &["--split", "tiles"],
+    ] {
+        assert_eq!(run(extra, "x.lumen-part").0, Some(2), "{extra:?}");
+    }
+}
+
+#[test]
+fn a_tile_is_read_back_as_written() {
+    let dir = temp_dir("tiles-read");
+    let d = desc("cover", 16, 3, 1);
+    let path = write(&d, tile("3,2,11,7", None), &dir, "t");
+    let c = Checkpoint::read(&path).unwrap();
+    assert_eq!(
+        c.tile,
+        Tile {
+            x0: 3,
+            y0: 2,
+            x1: 11,
+            y1: 7
+        }
+    );
+    assert_eq!(c.image, (16, 9));
+    assert_eq!((c.film.width(), c.film.height()), (8, 5));
+    let whole = one_machine(&d);
+    for y in 0..5 {
+        for x in 0..8 {
+            assert_eq!(c.film.pixel(x, y), whole.pixel(x + 3, y + 2));
+        }
+    }
+}
