@@ -169,11 +169,22 @@ pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputErr
             })
         }
         ImageFormat::Exr => write_atomic(path, |tmp| {
-            exr::prelude::write_rgb_file(tmp, w as usize, h as usize, |x, y| {
+            use exr::prelude::*;
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
                 let c = film.pixel(x as u32, y as u32);
                 (c.x, c.y, c.z)
-            })
-            .map_err(|e| e.to_string())
+            });
+            // Blocks are compressed in parallel; in increasing order they
+            // are also written in order, so the same image gives the same
+            // file.
+            let encoding = Encoding {
+                line_order: LineOrder::Increasing,
+                ..Encoding::default()
+            };
+            Image::from_encoded_channels((w as usize, h as usize), encoding, channels)
+                .write()
+                .to_file(tmp)
+                .map_err(|e| e.to_string())
         }),
     }
 }

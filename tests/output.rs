@@ -212,3 +212,34 @@ fn colours_too_large_for_f32_are_refused_rather_than_rendered_as_infinity() {
     };
     assert!(Scene::from_desc(&desc).is_ok());
 }
+
+#[test]
+fn the_same_film_gives_the_same_exr_file_every_time() {
+    // Many blocks, compressed in parallel: they must still be written in
+    // one order. Noise, so that blocks take different times to compress.
+    let dir = scratch_dir("exr-order");
+    let (w, h) = (1920u32, 1080u32);
+    let mut x = 0x9e37_79b9u32;
+    let pixels: Vec<Option<[f64; 3]>> = (0..w * h)
+        .map(|i| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let v = if (i / 97) % 3 == 0 {
+                0.25
+            } else {
+                f64::from(x) / 4e9
+            };
+            Some([v, 0.5, v * 2.0])
+        })
+        .collect();
+    let film = film_of(w, h, &pixels);
+    let first = dir.join("first.exr");
+    write_image(&first, &film, 2.0).unwrap();
+    let bytes = std::fs::read(&first).unwrap();
+    for i in 0..6 {
+        let again = dir.join(format!("again-{i}.exr"));
+        write_image(&again, &film, 2.0).unwrap();
+        assert!(std::fs::read(&again).unwrap() == bytes, "write {i} differs");
+    }
+}
