@@ -312,7 +312,13 @@ impl Checkpoint {
             .read_to_end(bytes)
             .map_err(io)?;
         let payload_len = header::check(bytes, len, path)?;
-        bytes.reserve(usize::try_from(payload_len).unwrap_or(0));
+        let room = usize::try_from(payload_len).unwrap_or(usize::MAX);
+        bytes
+            .try_reserve_exact(room)
+            .map_err(|_| CheckpointError::Io {
+                path: path.to_path_buf(),
+                message: format!("{payload_len} bytes do not fit in memory"),
+            })?;
         (&mut file)
             .take(payload_len)
             .read_to_end(bytes)

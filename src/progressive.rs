@@ -215,21 +215,28 @@ impl Session {
     /// `Scene::from_desc(desc)`): spares building the scene twice.
     pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Self {
         let (w, h) = (scene.settings.width, scene.settings.height);
+        let samples = 0..scene.settings.samples_per_pixel;
+        Self::of_share(desc, scene, samples, Tile::whole(w, h))
+    }
+
+    /// A new render of samples `samples` of the pixels `tile` of `desc`,
+    /// compiled into `scene`: a film of the tile only.
+    fn of_share(desc: &SceneDesc, scene: Scene, samples: Range<u32>, tile: Tile) -> Self {
+        let (w, h) = (tile.width(), tile.height());
         let film = match scene.settings.noise_target {
             Some(_) => Film::with_halves(w, h),
             None => Film::new(w, h),
         };
         let active = scene.settings.noise_target.map(|_| vec![true; film.len()]);
-        let share = 0..scene.settings.samples_per_pixel;
         Self {
             description: identity_text(desc, &scene.sources),
-            tile: Tile::whole(w, h),
+            tile,
             scene,
             film,
             backup: Film::new(0, 0),
             stats: RenderStats::default(),
-            share,
-            spp_done: 0,
+            spp_done: samples.start,
+            share: samples,
             active,
         }
     }
@@ -260,12 +267,7 @@ impl Session {
             .tile(s.width, s.height)
             .map_err(|message| SessionError::Tile { share, message })?;
         let samples = share.samples(s.samples_per_pixel);
-        let mut session = Self::with_scene(desc, scene);
-        session.film = Film::new(tile.width(), tile.height());
-        session.tile = tile;
-        session.spp_done = samples.start;
-        session.share = samples;
-        Ok(session)
+        Ok(Self::of_share(desc, scene, samples, tile))
     }
 
     /// The sample indices this session renders in every pixel.

@@ -31,9 +31,10 @@ pub struct RenderStats {
 impl RenderStats {
     /// Adds another set of counts to this one.
     pub fn add(&mut self, other: RenderStats) {
-        self.samples += other.samples;
-        self.rays += other.rays;
-        self.dropped += other.dropped;
+        // Saturating: counts read from files may be anything.
+        self.samples = self.samples.saturating_add(other.samples);
+        self.rays = self.rays.saturating_add(other.rays);
+        self.dropped = self.dropped.saturating_add(other.dropped);
     }
 
     /// A warning when more than [`DROPPED_WARNING`] of the samples were

@@ -400,3 +400,66 @@ fn a_tile_is_read_back_as_written() {
         }
     }
 }
+
+#[test]
+fn crafted_parts_are_refused_naming_the_field_and_the_pixel() {
+    let dir = temp_dir("tiles-crafted");
+    let d = desc("cover", 16, 8, 1);
+    let whole = write(&d, Share::default(), &dir, "whole");
+    let err = |paths: &[PathBuf]| part::merge(paths, false).unwrap_err().to_string();
+    let rewrite = |c: &Checkpoint, name: &str| {
+        let path = dir.join(format!("{name}.lumen-part"));
+        c.view().write(&path).unwrap();
+        path
+    };
+
+    // A share beyond the render's samples: samples 8..16 of a 16 spp
+    // render, given the 8 spp render's description.
+    let mut more = d.clone();
+    more.render.samples_per_pixel = 16;
+    let second_half = write(&more, band_of_samples(1, 2), &dir, "second-half");
+    let mut beyond = Checkpoint::read(&second_half).unwrap();
+    beyond.description = Checkpoint::read(&whole).unwrap().description;
+    let beyond = rewrite(&beyond, "beyond");
+    let e = err(&[whole.clone(), beyond.clone()]);
+    assert!(
+        e.contains("beyond.lumen-part: malformed: it holds samples 8..16 of a 8 spp render"),
+        "{e}"
+    );
+
+    // An image size other than the description's, first or not.
+    let mut wider = Checkpoint::read(&whole).unwrap();
+    wider.image.0 += 1;
+    let wider = rewrite(&wider, "wider");
+    let e = err(&[wider.clone(), whole.clone()]);
+    assert!(
+        e.contains("wider.lumen-part: malformed: its image is 17x9, which is not the size its scene description gives"),
+        "{e}"
+    );
+    let e = err(&[whole.clone(), wider]);
+    assert!(e.contains("an image of 16x9 and of 17x9"), "{e}");
+
+    // A pixel of a tile with more samples than its share: named by its
+    // place in the image.
+    let t = write(&d, tile("4,3,12,9", None), &dir, "tile");
+    let mut c = Checkpoint::read(&t).unwrap();
+    let (sums, counts) = c.film.raw();
+    let (sums, mut counts) = (sums.to_vec(), counts.to_vec());
+    counts[8 + 2] += 1;
+    c.film = lumen::film::Film::from_raw(8, 6, sums, counts).unwrap();
+    let bad = rewrite(&c, "bad-pixel");
+    let rest = write(&d, tile("0,0,16,3", None), &dir, "rest");
+    let e = err(&[rest, bad]);
+    assert!(
+        e.contains("bad-pixel.lumen-part: malformed: pixel (6, 4) has 9 samples, more than the 8 its spp allow"),
+        "{e}"
+    );
+}
+
+/// Part `index` of `count` shares of the samples.
+fn band_of_samples(index: u32, count: u32) -> Share {
+    Share {
+        part: Some(Part { index, count }),
+        ..Share::default()
+    }
+}

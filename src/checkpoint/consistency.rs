@@ -17,7 +17,12 @@ impl Checkpoint {
     pub(crate) fn check_consistency(&self) -> Result<(), String> {
         let (w, h) = (self.film.width(), self.film.height());
         let done = self.check_fields(w, h)?;
-        let at = |i: usize| format!("pixel ({}, {})", i % w as usize, i / w as usize);
+        // Named by their place in the image.
+        let (x0, y0) = (self.tile.x0 as usize, self.tile.y0 as usize);
+        let at = |i: usize| {
+            let (x, y) = (x0 + i % w as usize, y0 + i / w as usize);
+            format!("pixel ({x}, {y})")
+        };
         let (sums, counts) = self.film.raw();
         check_pixels(sums, counts, done, &at, "")?;
         let counted: u64 = counts.iter().map(|&c| u64::from(c)).sum();
@@ -75,7 +80,7 @@ impl Checkpoint {
     /// checkpoint holds.
     pub(crate) fn check_fields(&self, w: u32, h: u32) -> Result<u32, String> {
         if w == 0 || h == 0 {
-            return Err(format!("its image is {w}x{h} pixels"));
+            return Err(format!("its film is {w}x{h} pixels"));
         }
         let (iw, ih) = self.image;
         if (self.tile.width(), self.tile.height()) != (w, h) {

@@ -196,14 +196,17 @@ impl<'a> Pixels<'a> {
         let n = self.width * self.height();
         let (mut sums, mut counts) = (vec![Sum::ZERO; n], vec![0u32; n]);
         if n > 0 {
-            sums.par_chunks_mut(self.width)
+            let rows: Vec<Result<u64, PixelError>> = (sums.par_chunks_mut(self.width))
                 .zip(counts.par_chunks_mut(self.width))
                 .enumerate()
-                .try_for_each(|(y, (s, c))| match self.add_row(y, s, c, None) {
-                    Ok(_) => Ok(()),
-                    Err(PixelError::Malformed(m)) => Err(m),
-                    Err(PixelError::Pixel { .. }) => Err("bad pixel data"),
-                })?;
+                .map(|(y, (s, c))| self.add_row(y, s, c, None))
+                .collect();
+            // The first bad row, whichever thread found it first.
+            match rows.into_iter().find_map(Result::err) {
+                Some(PixelError::Malformed(m)) => return Err(m),
+                Some(PixelError::Pixel { .. }) => return Err("bad pixel data"),
+                None => {}
+            }
         }
         Ok((sums, counts))
     }

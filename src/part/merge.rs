@@ -10,6 +10,7 @@ use crate::checkpoint::{
 };
 use crate::film::Film;
 use crate::render::RenderStats;
+use crate::scene::desc::RenderDesc;
 use crate::tile::Tile;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -87,9 +88,9 @@ pub enum MergeError {
         /// How many more no part holds.
         others: u64,
     },
-    /// A part's description does not say how many samples the render takes.
-    #[error("{}: its scene description has no render.samples_per_pixel", .0.display())]
-    NoSampleCount(PathBuf),
+    /// A part's description has no render settings that can be read.
+    #[error("{}: its scene description has no render settings that can be read", .0.display())]
+    NoRenderSettings(PathBuf),
     /// The image is too large for this machine's memory.
     #[error("{}: its image of {}x{} pixels is too large to merge in this machine's memory", .path.display(), .image.0, .image.1)]
     TooLarge {
@@ -248,12 +249,19 @@ impl Merger {
             });
         }
         self.check_fits(path, part)?;
-        let held = part.share.start..part.spp_done;
-        self.seen.push((part.tile, held, path.to_path_buf()));
         if self.merged.is_none() {
             self.merged = Some(start(path, part)?);
         }
         let m = self.merged.as_mut().expect("made above");
+        if part.share.end > m.spp {
+            return Err(malformed(format!(
+                "it holds samples {}..{} of a {} spp render",
+                part.share.start, part.share.end, m.spp
+            ))
+            .into());
+        }
+        let held = part.share.start..part.spp_done;
+        self.seen.push((part.tile, held, path.to_path_buf()));
         let counted = add_pixels(&mut m.film, &unpacked, done).map_err(malformed)?;
         part.check_counted(counted, done).map_err(malformed)?;
         m.stats.add(part.stats);
@@ -377,9 +385,19 @@ impl Merger {
 /// The merge of the first part, `part` (read from `path`): an empty film of
 /// its image.
 fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
-    let spp = samples_per_pixel(&part.description)
-        .ok_or_else(|| MergeError::NoSampleCount(path.to_path_buf()))?;
+    let render = render_settings(&part.description)
+        .ok_or_else(|| MergeError::NoRenderSettings(path.to_path_buf()))?;
+    let spp = render.samples_per_pixel;
     let (w, h) = part.image;
+    if render.size() != Some(part.image) {
+        return Err(CheckpointError::Malformed {
+            path: path.to_path_buf(),
+            message: format!(
+                "its image is {w}x{h}, which is not the size its scene description gives"
+            ),
+        }
+        .into());
+    }
     let film = Film::try_new(w, h).ok_or_else(|| MergeError::TooLarge {
         path: path.to_path_buf(),
         image: part.image,
@@ -405,6 +423,7 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
     use rayon::prelude::*;
     let tile = part.head.tile;
     let (x0, x1) = (tile.x0 as usize, tile.x1 as usize);
+    let y0 = tile.y0 as usize;
     let rows: Vec<Result<u64, PixelError>> = film
         .rows_mut()
         .skip(tile.y0 as usize)
@@ -425,7 +444,7 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
             Ok(n) => n,
             Err(PixelError::Malformed(m)) => return Err(m.into()),
             Err(PixelError::Pixel { x, message }) => {
-                return Err(format!("pixel ({x}, {y}) {message}"))
+                return Err(format!("pixel ({}, {}) {message}", x0 + x, y0 + y))
             }
         };
     }
@@ -476,11 +495,10 @@ fn first_uncovered(tiles: &[Tile], w: u32, h: u32) -> (u32, u32) {
     (0, 0)
 }
 
-/// The samples per pixel a render identity text names.
-fn samples_per_pixel(description: &str) -> Option<u32> {
-    let value: serde_json::Value = serde_json::from_str(description).ok()?;
-    let spp = value.get("render")?.get("samples_per_pixel")?.as_u64()?;
-    u32::try_from(spp).ok()
+/// The render settings a render identity text names.
+fn render_settings(description: &str) -> Option<RenderDesc> {
+    let mut value: serde_json::Value = serde_json::from_str(description).ok()?;
+    serde_json::from_value(value.get_mut("render")?.take()).ok()
 }
 
 #[cfg(test)]

@@ -145,6 +145,25 @@ pub struct RenderDesc {
     pub shading: ShadingDesc,
 }
 
+impl RenderDesc {
+    /// The image's width and height: `height`, or else `width /
+    /// aspect_ratio` rounded down (at least 1); `None` when they give no
+    /// size (compiling the scene says why).
+    pub fn size(&self) -> Option<(u32, u32)> {
+        let height = match self.height {
+            Some(h) => h,
+            None => {
+                let h = (f64::from(self.width) / self.aspect_ratio).floor();
+                if !(h.is_finite() && h <= f64::from(u32::MAX)) {
+                    return None;
+                }
+                (h as u32).max(1)
+            }
+        };
+        (self.width > 0 && height > 0).then_some((self.width, height))
+    }
+}
+
 impl Default for RenderDesc {
     fn default() -> Self {
         Self {
