@@ -360,6 +360,53 @@ fn merge_script_names_missing_parts_and_merges_a_complete_set_in_index_order() {
 }
 
 #[test]
+fn the_scripts_split_by_tiles_with_the_real_lumen_and_merge_to_the_bit() {
+    // The Kubernetes path: the index set as JOB_COMPLETION_INDEX, the
+    // split given in LUMEN_ARGS.
+    let (dir, parts) = with_parts("tiles");
+    let args = "--width 40 --spp 6 --seed 3 --split tiles";
+    for k in [2, 0, 1] {
+        let out = clean_command("sh")
+            .arg(deploy_dir().join("task.sh"))
+            .env("LUMEN_BIN", LUMEN)
+            .env("JOB_COMPLETION_INDEX", k.to_string())
+            .env("LUMEN_PARTS", "3")
+            .env("LUMEN_SCENE", "cover")
+            .env("LUMEN_PARTS_DIR", &parts)
+            .env("LUMEN_ARGS", args)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert!(
+            text(&out.stderr).contains(&format!("part {k}/3 (tiles): pixels 0,")),
+            "{}",
+            text(&out.stderr)
+        );
+    }
+    let merged = dir.join("final.pfm");
+    let out = clean_command("sh")
+        .arg(deploy_dir().join("merge.sh"))
+        .env("LUMEN_BIN", LUMEN)
+        .env("LUMEN_TASK_COUNT", "3")
+        .env("LUMEN_PARTS_DIR", &parts)
+        .env("LUMEN_OUT", &merged)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let one = dir.join("one.pfm");
+    let out = Command::new(LUMEN)
+        .args([
+            "render", "cover", "--width", "40", "--spp", "6", "--seed", "3", "-o",
+        ])
+        .arg(&one)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(fs::read(&merged).unwrap() == fs::read(&one).unwrap());
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn submit_script_checks_its_arguments_before_submitting() {
     let dir = fresh_dir("submit");
     let submit = deploy_dir().join("slurm/submit.sh");
