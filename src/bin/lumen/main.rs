@@ -64,9 +64,10 @@ enum Command {
         #[command(flatten)]
         progressive: ProgressiveArgs,
     },
-    /// Merge the part files of a render split with `render --part K/N` into
-    /// its image (.ppm, .png, .pfm or .exr): the same to the bit as the
-    /// render on one machine. See docs/distributed.md.
+    /// Merge the part files of a render split with `render --part K/N`
+    /// (by samples or by tiles) or `render --tile` into its image (.ppm,
+    /// .png, .pfm or .exr): the same to the bit as the render on one
+    /// machine. See docs/distributed.md.
     Merge {
         /// The part files, in any order.
         #[arg(required = true)]
@@ -269,11 +270,11 @@ struct ProgressiveArgs {
     /// [default: the output path + .lumen-ckpt].
     #[arg(long, value_name = "FILE", conflicts_with = "part")]
     checkpoint: Option<PathBuf>,
-    /// Render only part K of N equal shares of every pixel's samples (K
-    /// from 0, as job array task ids count) into a part file (-o
-    /// NAME.lumen-part), its own checkpoint; `lumen merge` joins the parts
-    /// into the image of the whole render, to the bit. See
-    /// docs/distributed.md.
+    /// Render only part K of N (K from 0, as job array task ids count):
+    /// an equal share of every pixel's samples, or with --split tiles a
+    /// band of rows, into a part file (-o NAME.lumen-part), its own
+    /// checkpoint; `lumen merge` joins the parts into the image of the
+    /// whole render, to the bit. See docs/distributed.md.
     #[arg(long, value_name = "K/N")]
     part: Option<lumen::part::Part>,
     /// What --part splits: `samples` (every part a share of every pixel's
