@@ -14,11 +14,11 @@ spp=${2:-256}
 shift $(($# < 2 ? $# : 2))
 seeds=${*:-10 11 12 13}
 mkdir -p "$refs/lumen"
-cargo build --release --quiet
+cargo build --profile dist --quiet
 b=""
 for s in $seeds; do
     out="$refs/lumen/bunny-${spp}spp-seed$s.pfm"
-    ./target/release/lumen render scripts/peers/bunny-scene.toml -o "$out" --spp "$spp" --seed "$s"
+    ./target/dist/lumen render scripts/peers/bunny-scene.toml -o "$out" --spp "$spp" --seed "$s"
     b="$b $out"
 done
 eval "$(scripts/peers/setup.sh --env)"

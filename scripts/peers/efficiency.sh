@@ -38,7 +38,7 @@
 #   OUT=/tmp/lumen-peers-eff   images and results.jsonl
 #   SEEDS="1 2"                the two seeds
 #   MESH=assets/bunny_235k.glb the bunny mesh (bunny scene)
-#   LUMEN=target/release/lumen the lumen binary
+#   LUMEN=target/dist/lumen the lumen binary
 #   THREADS=2                  worker threads of every renderer
 #   CORNELL_WIDTH=300          image width of the cornell scene
 #   MAX_LOAD=1.5 WAIT=600      wait up to WAIT s before each configuration for the
@@ -75,7 +75,7 @@ OUT=${OUT:-/tmp/lumen-peers-eff}
 read -r SEED_A SEED_B <<<"${SEEDS:-1 2}"
 MESH=${MESH:-$ROOT/assets/bunny_235k.glb}
 MESH=$(cd "$(dirname "$MESH")" && pwd)/$(basename "$MESH")
-LUMEN=${LUMEN:-$ROOT/target/release/lumen}
+LUMEN=${LUMEN:-$ROOT/target/dist/lumen}
 MAX_LOAD=${MAX_LOAD:-1.5}
 BUSY_MAX=${BUSY_MAX:-0.3}
 OTHER_MAX=${OTHER_MAX:-0.15}

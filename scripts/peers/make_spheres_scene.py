@@ -4,7 +4,7 @@ spheres under a white sky, for comparing lumen with peer renderers.
 
     lumen scenes export cover > cover.toml
     python3 scripts/peers/make_spheres_scene.py cover.toml -o scripts/peers/spheres-scene.toml
-    python3 scripts/peers/make_spheres_scene.py --lumen target/release/lumen   # runs the export itself
+    python3 scripts/peers/make_spheres_scene.py --lumen target/dist/lumen   # runs the export itself
 
 Rule (applied to the exported cover scene, nothing else changes):
 
@@ -130,7 +130,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("cover", nargs="?", help="exported cover scene (TOML); default: run `LUMEN scenes export cover`")
     ap.add_argument("--lumen", default=str(REPO_ROOT / "target" / "release" / "lumen"),
-                    help="lumen binary for the export (default target/release/lumen)")
+                    help="lumen binary for the export (default target/dist/lumen)")
     ap.add_argument("-o", "--out", default=str(HERE / "spheres-scene.toml"))
     args = ap.parse_args(argv)
     if args.cover:
