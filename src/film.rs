@@ -34,9 +34,9 @@ impl Sum {
 
     /// [`Sum::of`] a sample's colour, from the bits of its `f32`s: shifting
     /// the significand by the exponent gives the same integers as
-    /// converting through `f64` (truncated towards zero), without the three
-    /// float-to-`i128` conversions (library calls), which made the cover
-    /// render about a tenth slower (see `docs/performance.md`).
+    /// converting through `f64` (truncated towards zero), without a
+    /// float-to-`i128` conversion, which is a library call, per channel
+    /// (see `docs/performance.md`).
     #[inline(always)]
     pub fn of_color(c: Color) -> Option<Self> {
         Some(Sum([fixed(c.x)?, fixed(c.y)?, fixed(c.z)?]))
@@ -161,20 +161,12 @@ impl Film {
     /// [`Film::new`], or `None` if this machine's memory cannot hold it.
     pub fn try_new(width: u32, height: u32) -> Option<Self> {
         let n = width as usize * height as usize;
-        let mut sums = Vec::new();
-        let mut counts = Vec::new();
+        let (mut sums, mut counts) = (Vec::new(), Vec::new());
         sums.try_reserve_exact(n).ok()?;
         counts.try_reserve_exact(n).ok()?;
         sums.resize(n, Sum::ZERO);
         counts.resize(n, 0);
-        Some(Self {
-            width,
-            height,
-            sums,
-            counts,
-            odd_sums: Vec::new(),
-            odd_counts: Vec::new(),
-        })
+        Self::from_raw(width, height, sums, counts)
     }
 
     /// A black film that also keeps the sums of each pixel's samples of odd

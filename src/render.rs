@@ -255,9 +255,8 @@ fn render_row_generic(
 }
 
 /// Adds sample `index` of pixel `x` to `row` and counts it in `stats`, as
-/// dropped if the film leaves it out. A function rather than a closure so
-/// that it is inlined into the row loop: the film's fixed-point conversion
-/// made the closure large enough to be called out of line.
+/// dropped if the film leaves it out. A function marked to be inlined
+/// rather than a closure, which the compiler may call out of line.
 #[inline(always)]
 fn add_sample(row: &mut RowMut, stats: &mut RenderStats, x: usize, index: u32, c: Color) {
     stats.samples += 1;

@@ -8,12 +8,11 @@ mod lumen_process;
 
 use common::builtin_desc as desc;
 use lumen::part::{self, MergeError, Part, Share};
-use lumen::progressive::{Session, StopReason};
+use lumen::progressive::Session;
 use lumen::render::render;
 use lumen::scene::{Scene, SceneDesc};
 use lumen_process::*;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 /// Renders `part` of `desc` through the library, stopping after `passes`
 /// passes if given, and writes its part file into `dir`.
@@ -89,19 +88,11 @@ fn a_part_stopped_and_resumed_merges_exactly() {
     assert_eq!(preview.held.len(), 1);
     assert_eq!(preview.held[0].start, 0);
     // The task run again resumes from its part file.
-    let ckpt = lumen::checkpoint::Checkpoint::read(&second).unwrap();
-    let scene = Scene::from_desc(&d).unwrap();
-    let mut session = Session::with_part(&d, scene, b)
-        .unwrap()
-        .restore(ckpt, &second)
-        .unwrap();
-    let run = session
-        .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {
-            Ok::<(), ()>(())
-        })
-        .unwrap();
-    assert_eq!(run.reason, StopReason::Complete);
-    session.checkpoint().write(&second).unwrap();
+    let share = Share {
+        part: Some(b),
+        ..Share::default()
+    };
+    common::finish_share(&d, share, &second);
     assert!(part::merge(&paths, false).unwrap().film == one_machine(&d));
 }
 

@@ -9,13 +9,12 @@ mod lumen_process;
 use common::{builtin_desc as desc, write_share};
 use lumen::checkpoint::Checkpoint;
 use lumen::part::{self, MergeError, Part, Share, Split};
-use lumen::progressive::{Session, StopReason};
+use lumen::progressive::Session;
 use lumen::render::render;
 use lumen::scene::{Scene, SceneDesc};
 use lumen::tile::Tile;
 use lumen_process::*;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 fn one_machine(desc: &SceneDesc) -> lumen::film::Film {
     render(&Scene::from_desc(desc).unwrap(), &|_| {}).0
@@ -244,26 +243,12 @@ fn a_tile_stopped_and_resumed_merges_exactly_and_only_as_that_tile() {
     // The same tile resumes; another tile is refused, naming both.
     let ckpt = Checkpoint::read(&path).unwrap();
     let other = Session::with_share(&d, Scene::from_desc(&d).unwrap(), band(0, 2)).unwrap();
-    let e = other
-        .restore(ckpt.clone(), &path)
-        .err()
-        .unwrap()
-        .to_string();
+    let e = other.restore(ckpt, &path).err().unwrap().to_string();
     assert!(
         e.contains("it holds the pixels 0,6,24,13, the render takes 0,0,24,6"),
         "{e}"
     );
-    let mut session = Session::with_share(&d, Scene::from_desc(&d).unwrap(), band(1, 2))
-        .unwrap()
-        .restore(ckpt, &path)
-        .unwrap();
-    let run = session
-        .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {
-            Ok::<(), ()>(())
-        })
-        .unwrap();
-    assert_eq!(run.reason, StopReason::Complete);
-    session.checkpoint().write(&path).unwrap();
+    common::finish_share(&d, band(1, 2), &path);
     assert!(part::merge(&[path, top], false).unwrap().film == one_machine(&d));
 }
 
@@ -272,18 +257,12 @@ fn the_command_line_splits_by_tiles_and_merges_to_the_bit() {
     let dir = temp_dir("tiles-cli");
     let args = ["cover", "--width", "40", "--spp", "6", "--seed", "4"];
     let run = |extra: &[&str], out: &str| {
-        let out = lumen()
-            .arg("render")
-            .args(args)
-            .args(extra)
-            .arg("-o")
-            .arg(dir.join(out))
-            .output()
-            .unwrap();
-        (
-            out.status.code(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
+        let (status, said) = run(
+            &[&["render"][..], &args, extra].concat(),
+            &dir.join(out),
+            &[],
+        );
+        (status.code(), said)
     };
     assert_eq!(run(&[], "one.pfm").0, Some(0));
     for k in [2, 0, 1] {
@@ -307,18 +286,15 @@ fn the_command_line_splits_by_tiles_and_merges_to_the_bit() {
         assert_eq!(code, Some(0), "{said}");
     }
     let merge = |parts: &[&str], extra: &[&str], to: &str| {
-        let out = lumen()
-            .arg("merge")
-            .args(parts.iter().map(|p| dir.join(format!("{p}.lumen-part"))))
-            .args(extra)
-            .arg("-o")
-            .arg(dir.join(to))
-            .output()
-            .unwrap();
-        (
-            out.status.code(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
+        let files: Vec<String> = (parts.iter())
+            .map(|p| dir.join(format!("{p}.lumen-part")).display().to_string())
+            .collect();
+        let args: Vec<&str> = ["merge"]
+            .into_iter()
+            .chain(files.iter().map(|f| f.as_str()))
+            .collect();
+        let (status, said) = lumen_process::run(&args, &dir.join(to), extra);
+        (status.code(), said)
     };
     let one = std::fs::read(dir.join("one.pfm")).unwrap();
     let (code, said) = merge(&["band-1", "band-2", "band-0"], &[], "bands.pfm");

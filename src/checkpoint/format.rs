@@ -3,7 +3,7 @@
 //! twice, and read back with every length checked, since the file may say
 //! anything.
 
-use super::pixels::{write_counts, write_sums, Pixels};
+use super::pixels::{write_pixels, Pixels};
 use super::{Checkpoint, CheckpointView, MAGIC, VERSION};
 use crate::film::Film;
 use crate::render::RenderStats;
@@ -35,16 +35,12 @@ impl CheckpointView<'_> {
             sink(&v.to_le_bytes())?;
         }
         let width = self.film.width() as usize;
-        let (sums, counts) = self.film.raw();
-        write_counts(counts, sink)?;
-        write_sums(sums, width, sink)?;
+        write_pixels(self.film.raw(), width, sink)?;
         match self.active {
             // Adaptive: the halves' sums and counts, and the pixels' flags.
             Some(active) if self.film.has_halves() => {
                 sink(&[1])?;
-                let (odd_sums, odd_counts) = self.film.raw_odd();
-                write_counts(odd_counts, sink)?;
-                write_sums(odd_sums, width, sink)?;
+                write_pixels(self.film.raw_odd(), width, sink)?;
                 let flags: Vec<u8> = active.iter().map(|&a| u8::from(a)).collect();
                 sink(&flags)
             }
@@ -81,12 +77,9 @@ impl CheckpointView<'_> {
 /// A checkpoint's payload read, its pixels found but not decoded: what
 /// `lumen merge` adds straight into its film.
 pub(crate) struct Unpacked<'a> {
-    /// Every field but the film, which is empty (0×0).
+    /// Every field but the film, which is empty (0×0): its size is the
+    /// tile's.
     pub(crate) head: Checkpoint,
-    /// The film's size.
-    pub(crate) width: u32,
-    /// The film's size.
-    pub(crate) height: u32,
     /// The film's sums and counts.
     pub(crate) pixels: Pixels<'a>,
     /// With adaptive sampling: the sums and counts of the samples of odd
@@ -146,19 +139,14 @@ impl Checkpoint {
             film: Film::new(0, 0),
             active: None,
         };
-        Ok(Unpacked {
-            head,
-            width,
-            height,
-            pixels,
-            odd,
-        })
+        Ok(Unpacked { head, pixels, odd })
     }
 
     pub(super) fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
         let u = Self::unpack(payload)?;
         let (sums, counts) = u.pixels.decode()?;
-        let film = Film::from_raw(u.width, u.height, sums, counts).ok_or("bad pixel data")?;
+        let (w, h) = (u.head.tile.width(), u.head.tile.height());
+        let film = Film::from_raw(w, h, sums, counts).ok_or("bad pixel data")?;
         let (film, active) = match u.odd {
             None => (film, None),
             Some((odd, flags)) => {

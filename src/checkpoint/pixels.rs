@@ -13,10 +13,14 @@
 //! decoded, and decoded in parallel straight into a film (`lumen merge`).
 
 use crate::film::Sum;
+use rayon::prelude::*;
 
-/// Appends a pixel's count bytes: `u32` little-endian each.
-pub(super) fn write_counts(
-    counts: &[u32],
+/// Feeds the pixels of a film `width` pixels wide to `sink`, as
+/// [`Pixels::split`] finds them: every count (`u32`), then the sums row by
+/// row, each row after its byte length (`u32`).
+pub(super) fn write_pixels(
+    (sums, counts): (&[Sum], &[u32]),
+    width: usize,
     sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let mut buf = Vec::with_capacity(4096 * 4);
@@ -27,24 +31,13 @@ pub(super) fn write_counts(
         }
         sink(&buf)?;
     }
-    Ok(())
-}
-
-/// Writes `sums`, rows of `width` pixels, row by row: each row's byte
-/// length (`u32`) and its pixels.
-pub(super) fn write_sums(
-    sums: &[Sum],
-    width: usize,
-    sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let mut row_bytes = Vec::new();
     for row in sums.chunks(width.max(1)) {
-        row_bytes.clear();
+        buf.clear();
         for sum in row {
-            put_sum(&mut row_bytes, sum);
+            put_sum(&mut buf, sum);
         }
-        sink(&(row_bytes.len() as u32).to_le_bytes())?;
-        sink(&row_bytes)?;
+        sink(&(buf.len() as u32).to_le_bytes())?;
+        sink(&buf)?;
     }
     Ok(())
 }
@@ -135,16 +128,31 @@ impl<'a> Pixels<'a> {
         Ok((pixels, rest))
     }
 
-    /// The film's height in rows.
-    pub(crate) fn height(&self) -> usize {
-        self.rows.len()
+    /// Adds every row to `rows` (its sums and counts, a row of this film
+    /// each, top first), in parallel, and returns the samples they count.
+    /// With `most`, every pixel is checked first: at most `most` samples,
+    /// and a sum of zero without samples. The error is the first in reading
+    /// order, with its row, whichever thread found it.
+    pub(crate) fn add_rows<'r>(
+        &self,
+        rows: impl IndexedParallelIterator<Item = (&'r mut [Sum], &'r mut [u32])>,
+        most: Option<u32>,
+    ) -> Result<u64, (usize, PixelError)> {
+        let counted: Vec<Result<u64, PixelError>> = rows
+            .enumerate()
+            .map(|(y, (sums, counts))| self.add_row(y, sums, counts, most))
+            .collect();
+        counted
+            .into_iter()
+            .enumerate()
+            .map(|(y, row)| row.map_err(|e| (y, e)))
+            .sum()
     }
 
     /// Adds the pixels of row `y` to `sums` and `counts` (the row's width
-    /// long) and returns the samples they count. With `most`, every pixel
-    /// is checked first: at most `most` samples, and a sum of zero
-    /// without samples.
-    pub(crate) fn add_row(
+    /// long) and returns the samples they count, checking them against
+    /// `most` as [`Pixels::add_rows`] does.
+    fn add_row(
         &self,
         y: usize,
         sums: &mut [Sum],
@@ -192,21 +200,15 @@ impl<'a> Pixels<'a> {
 
     /// The sums and counts, decoded into new vectors (rows in parallel).
     pub(super) fn decode(&self) -> Result<(Vec<Sum>, Vec<u32>), &'static str> {
-        use rayon::prelude::*;
-        let n = self.width * self.height();
+        let n = self.width * self.rows.len();
         let (mut sums, mut counts) = (vec![Sum::ZERO; n], vec![0u32; n]);
         if n > 0 {
-            let rows: Vec<Result<u64, PixelError>> = (sums.par_chunks_mut(self.width))
-                .zip(counts.par_chunks_mut(self.width))
-                .enumerate()
-                .map(|(y, (s, c))| self.add_row(y, s, c, None))
-                .collect();
-            // The first bad row, whichever thread found it first.
-            match rows.into_iter().find_map(Result::err) {
-                Some(PixelError::Malformed(m)) => return Err(m),
-                Some(PixelError::Pixel { .. }) => return Err("bad pixel data"),
-                None => {}
-            }
+            let rows = (sums.par_chunks_mut(self.width)).zip(counts.par_chunks_mut(self.width));
+            // Unchecked, so no pixel error: the caller checks the film.
+            self.add_rows(rows, None).map_err(|(_, e)| match e {
+                PixelError::Malformed(m) => m,
+                PixelError::Pixel { .. } => "bad pixel data",
+            })?;
         }
         Ok((sums, counts))
     }
@@ -282,12 +284,7 @@ mod tests {
         }
         let width = 20;
         let mut bytes = Vec::new();
-        write_counts(&vec![7; sums.len()], &mut |b| {
-            bytes.extend_from_slice(b);
-            Ok(())
-        })
-        .unwrap();
-        write_sums(&sums, width, &mut |b| {
+        write_pixels((&sums, &vec![7; sums.len()]), width, &mut |b| {
             bytes.extend_from_slice(b);
             Ok(())
         })

@@ -238,9 +238,7 @@ impl Merger {
                 malformed("it is the checkpoint of an adaptive render, not a part".into()).into(),
             );
         }
-        let done = part
-            .check_fields(unpacked.width, unpacked.height)
-            .map_err(malformed)?;
+        let done = (part.check_fields(part.tile.width(), part.tile.height())).map_err(malformed)?;
         if part.spp_done < part.share.end && !self.partial {
             return Err(MergeError::Unfinished {
                 path: path.to_path_buf(),
@@ -248,7 +246,8 @@ impl Merger {
                 done: part.spp_done,
             });
         }
-        self.check_fits(path, part)?;
+        let held = part.share.start..part.spp_done;
+        self.check_fits(path, part, &held)?;
         if self.merged.is_none() {
             self.merged = Some(start(path, part)?);
         }
@@ -260,7 +259,6 @@ impl Merger {
             ))
             .into());
         }
-        let held = part.share.start..part.spp_done;
         self.seen.push((part.tile, held, path.to_path_buf()));
         let counted = add_pixels(&mut m.film, &unpacked, done).map_err(malformed)?;
         part.check_counted(counted, done).map_err(malformed)?;
@@ -268,9 +266,14 @@ impl Merger {
         Ok(())
     }
 
-    /// Checks that `part` (read from `path`) belongs with the parts read
-    /// so far and holds none of their samples.
-    fn check_fits(&self, path: &Path, part: &Checkpoint) -> Result<(), MergeError> {
+    /// Checks that `part` (read from `path`), holding samples `held`,
+    /// belongs with the parts read so far and holds none of their samples.
+    fn check_fits(
+        &self,
+        path: &Path,
+        part: &Checkpoint,
+        held: &Range<u32>,
+    ) -> Result<(), MergeError> {
         if let (Some(m), Some((_, _, first))) = (&self.merged, self.seen.first()) {
             let differences = if part.renderer_id != m.renderer_id {
                 format!(
@@ -303,7 +306,6 @@ impl Merger {
                 });
             }
         }
-        let held = part.share.start..part.spp_done;
         for (tile, other, other_path) in &self.seen {
             if *tile != part.tile {
                 if let Some(common) = tile.overlap(&part.tile) {
@@ -319,12 +321,11 @@ impl Merger {
             // nothing, so it cannot hold anything twice.
             let common = held.start.max(other.start)..held.end.min(other.end);
             if !common.is_empty() {
-                let (w, h) = part.image;
                 return Err(MergeError::Overlap {
                     first: other_path.clone(),
                     other: path.to_path_buf(),
                     common,
-                    tile: (!tile.is_whole(w, h)).then_some(*tile),
+                    tile: unless_whole(*tile, part.image),
                 });
             }
         }
@@ -354,7 +355,7 @@ impl Merger {
                 return Err(MergeError::Missing {
                     spp: m.spp,
                     missing,
-                    tile: (!tile.is_whole(w, h)).then_some(tile),
+                    tile: unless_whole(tile, (w, h)),
                 });
             }
             let spp: u64 = held.iter().map(|r| u64::from(r.end - r.start)).sum();
@@ -415,6 +416,12 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
     })
 }
 
+/// `tile`, unless it is every pixel of an `image`-sized image (a part
+/// split by samples only), for naming the pixels in messages.
+fn unless_whole(tile: Tile, (w, h): (u32, u32)) -> Option<Tile> {
+    (!tile.is_whole(w, h)).then_some(tile)
+}
+
 /// Adds the pixels of `part` to `film`, the whole image's, at its tile,
 /// rows in parallel, checking each pixel against the `done` samples per
 /// pixel the part holds; returns the samples they count. The error names
@@ -423,32 +430,22 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
     use rayon::prelude::*;
     let tile = part.head.tile;
     let (x0, x1) = (tile.x0 as usize, tile.x1 as usize);
-    let y0 = tile.y0 as usize;
-    let rows: Vec<Result<u64, PixelError>> = film
-        .rows_mut()
+    let rows = (film.rows_mut())
         .skip(tile.y0 as usize)
         .take(tile.height() as usize)
-        .enumerate()
-        .map(|(y, row)| {
-            part.pixels.add_row(
-                y,
-                &mut row.sums[x0..x1],
-                &mut row.counts[x0..x1],
-                Some(done),
-            )
-        })
-        .collect();
-    let mut counted = 0;
-    for (y, row) in rows.into_iter().enumerate() {
-        counted += match row {
-            Ok(n) => n,
-            Err(PixelError::Malformed(m)) => return Err(m.into()),
-            Err(PixelError::Pixel { x, message }) => {
-                return Err(format!("pixel ({}, {}) {message}", x0 + x, y0 + y))
+        .map(|row| (&mut row.sums[x0..x1], &mut row.counts[x0..x1]));
+    part.pixels
+        .add_rows(rows, Some(done))
+        .map_err(|(y, e)| match e {
+            PixelError::Malformed(m) => m.into(),
+            PixelError::Pixel { x, message } => {
+                format!(
+                    "pixel ({}, {}) {message}",
+                    tile.x0 as usize + x,
+                    tile.y0 as usize + y
+                )
             }
-        };
-    }
-    Ok(counted)
+        })
 }
 
 /// The sorted sample ranges `ranges` (disjoint), adjacent ones joined, and

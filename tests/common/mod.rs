@@ -527,11 +527,36 @@ pub fn write_share(
     path: &std::path::Path,
     passes: Option<u32>,
 ) -> std::path::PathBuf {
-    use std::sync::atomic::{AtomicBool, Ordering};
     let scene = Scene::from_desc(desc).unwrap();
-    let mut session = lumen::progressive::Session::with_share(desc, scene, share).unwrap();
+    let session = lumen::progressive::Session::with_share(desc, scene, share).unwrap();
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    run_and_write(session, path, passes);
+    path.to_path_buf()
+}
+
+/// Resumes the part file at `path`, of `share` of `desc`, as a task run
+/// again does: renders the rest of its share and rewrites it.
+pub fn finish_share(desc: &SceneDesc, share: lumen::part::Share, path: &std::path::Path) {
+    let ckpt = lumen::checkpoint::Checkpoint::read(path).unwrap();
+    let scene = Scene::from_desc(desc).unwrap();
+    let session = lumen::progressive::Session::with_share(desc, scene, share)
+        .unwrap()
+        .restore(ckpt, path)
+        .unwrap();
+    let run = run_and_write(session, path, None);
+    assert_eq!(run.reason, lumen::progressive::StopReason::Complete);
+}
+
+/// Runs `session`, stopping after `passes` passes if given, and writes its
+/// checkpoint to `path`.
+fn run_and_write(
+    mut session: lumen::progressive::Session,
+    path: &std::path::Path,
+    passes: Option<u32>,
+) -> lumen::progressive::RunSummary {
+    use std::sync::atomic::{AtomicBool, Ordering};
     let stop = AtomicBool::new(false);
-    session
+    let run = session
         .run(&stop, None, &|_| {}, &mut |_, pass| {
             if Some(pass.number) == passes {
                 stop.store(true, Ordering::SeqCst);
@@ -539,7 +564,6 @@ pub fn write_share(
             Ok::<(), ()>(())
         })
         .unwrap();
-    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     session.checkpoint().write(path).unwrap();
-    path.to_path_buf()
+    run
 }

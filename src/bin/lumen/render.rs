@@ -153,18 +153,18 @@ pub(crate) fn render_command(
     let resumed_from = session.spp_done();
     let tile = session.tile();
     let samples = session.share();
-    let part_text = match tile.is_whole(s.width, s.height) {
-        true => format!("{share}: samples {}..{}", samples.start, samples.end),
-        false => format!(
-            "{share}: pixels {tile}, samples {}..{}",
-            samples.start, samples.end
-        ),
+    let pixels_text = match tile.is_whole(s.width, s.height) {
+        true => String::new(),
+        false => format!("pixels {tile}, "),
     };
+    let part_text = format!(
+        "{share}: {pixels_text}samples {}..{}",
+        samples.start, samples.end
+    );
     let of_part = match is_part {
         true => format!(", {part_text}"),
         false => String::new(),
     };
-    let share = samples;
     errln!(
         "{name}: {}x{} at {} spp, depth {}{of_part}{}",
         s.width,
@@ -200,7 +200,7 @@ pub(crate) fn render_command(
         Ok(())
     };
     let pixels = tile.area();
-    let bar = progress_bar(pixels * u64::from(share.end - resumed_from));
+    let bar = progress_bar(pixels * u64::from(samples.end - resumed_from));
     let start = Instant::now();
     let mut last_save = start;
     let run = session.run(&stop, prog.time_limit, &|n| bar.inc(n), &mut |session,
@@ -263,27 +263,27 @@ pub(crate) fn render_command(
             errln!("{name}: {spp} written to {}", out.display());
             ExitCode::SUCCESS
         }
-        (reason, _) if held == share.start => {
+        (reason, _) if held == samples.start => {
             debug_assert_eq!(reason, StopReason::Interrupted);
             errln!("lumen: interrupted before the first pass finished; nothing written");
             ExitCode::from(EXIT_INTERRUPTED)
         }
-        (reason, part) => {
+        (reason, _) => {
             save(&session)?;
             let (why, code) = match reason {
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 // An unfinished part is not a finished task: a job engine
                 // must see it fail, and the merge refuses it.
-                _ if part => ("time limit reached", ExitCode::FAILURE),
+                _ if is_part => ("time limit reached", ExitCode::FAILURE),
                 _ => ("time limit reached", ExitCode::SUCCESS),
             };
-            if part {
+            if is_part {
                 errln!(
                     "lumen: {why}: part {} holds samples {}..{held} of its share {}..{}; continue with --resume",
                     out.display(),
-                    share.start,
-                    share.start,
-                    share.end
+                    samples.start,
+                    samples.start,
+                    samples.end
                 );
             } else {
                 errln!(
