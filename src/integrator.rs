@@ -2,6 +2,7 @@
 //! ([`trace_path`]), and the same for a group of camera rays of one pixel
 //! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
+use crate::bsdf::Bsdf;
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
@@ -91,9 +92,9 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 /// The end of segment `depth` (0 for the camera ray) of a path: `ray` met
 /// `hit` (or nothing, and the background lights it). The surface's emission
 /// is added to what the path gathered; its material absorbs the path or
-/// scatters it (bounce `depth`), multiplying the throughput by its
-/// attenuation. With the `path` integrator, a surface whose scattering has
-/// a density (see [`Material::has_density`]) also samples a light
+/// scatters it (bounce `depth`), multiplying the throughput by the sample's
+/// value. With the `path` integrator, a surface whose scattering has
+/// a density (see [`Bsdf::has_density`]) also samples a light
 /// (next-event estimation): a shadow ray towards a point chosen on it, the
 /// light it brings weighted against the chance that the bounce would have
 /// found the same light (multiple importance sampling).
@@ -119,29 +120,32 @@ fn step(
         return Step::Done(path.radiance + sky);
     };
     let record = scene.record(ray, hit);
-    let material = scene.material_at(&record);
-    if let Material::Emissive(_) = material {
-        return Step::Done(path.radiance + emission(scene, &record, &hit, material, path));
+    let material = scene.material(&record);
+    if material.emission.is_some() {
+        path.radiance += emission(scene, &record, &hit, material, path);
     }
+    let Some(bsdf) = material.bsdf(&record, &scene.textures) else {
+        return Step::Done(path.radiance);
+    };
     sampler.start_bounce(depth);
-    let wo = ray.direction;
-    let nee = samples_lights(scene, depth) && material.has_density();
+    let wo = -ray.direction;
+    let nee = samples_lights(scene, depth) && bsdf.has_density();
     if nee {
-        let (light, traced) = light_at_surface(scene, &record, material, wo, ray.time(), sampler);
+        let (light, traced) = light_at_surface(scene, &record, &bsdf, wo, ray.time(), sampler);
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
-    let Some(scatter) = material.scatter(wo, &record, sampler) else {
+    let Some(sample) = bsdf.sample(wo, sampler) else {
         return Step::Done(path.radiance);
     };
-    path.sampled_from = nee.then(|| (record.point, material.pdf(&record, wo, scatter.direction)));
-    path.throughput *= scatter.attenuation;
+    path.sampled_from = (nee && !sample.flags.is_specular()).then_some((record.point, sample.pdf));
+    path.throughput *= sample.value;
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);
     }
     Step::Continue(Ray::timed(
-        record.spawn_origin(scatter.direction),
-        scatter.direction,
+        record.spawn_origin(sample.wi),
+        sample.wi,
         ray.time(),
     ))
 }
@@ -154,10 +158,10 @@ fn emission(
     scene: &Scene,
     record: &HitRecord,
     hit: &Hit,
-    material: Material,
+    material: &Material,
     path: &PathState,
 ) -> Color {
-    let emitted = path.throughput * material.emitted(record);
+    let emitted = path.throughput * material.emitted(record, &scene.textures);
     match (path.sampled_from, scene.light_of(hit)) {
         (Some((from, bsdf_pdf)), Some(i)) => {
             let light_pdf = scene
@@ -169,13 +173,13 @@ fn emission(
     }
 }
 
-/// [`direct_light`] at a surface point `record` of `material`, seen along
-/// `wo`.
+/// [`direct_light`] at a surface point `record` scattering by `bsdf`,
+/// seen from `wo` (pointing back along the ray).
 #[inline(never)]
 fn light_at_surface(
     scene: &Scene,
     record: &HitRecord,
-    material: Material,
+    bsdf: &Bsdf,
     wo: Vec3,
     time: f32,
     sampler: &mut impl Sampler,
@@ -184,7 +188,7 @@ fn light_at_surface(
         scene,
         record.point,
         time,
-        |wi| material.eval_and_pdf(record, wo, wi),
+        |wi| bsdf.eval_and_pdf(wo, wi),
         |wi| record.spawn_origin(wi),
         sampler,
     )

@@ -53,6 +53,7 @@
 
 pub mod adaptive;
 pub mod bench;
+pub mod bsdf;
 pub mod camera;
 pub mod checkpoint;
 pub mod distribution;

@@ -7,7 +7,7 @@
 //! (a fixed number of standard errors) or from the DKW inequality; the seeds
 //! are fixed, so every run draws the same samples.
 
-use lumen::material::diffuse::bounce_direction;
+use lumen::bsdf::diffuse::bounce_direction;
 use lumen::material::BounceModel;
 use lumen::math::Vec3;
 use lumen::rng::Rng;

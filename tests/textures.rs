@@ -5,7 +5,7 @@
 mod common;
 
 use common::{compile_file, pixel_stats, scene_file_error, scratch_dir, tiles_agree};
-use lumen::material::Material;
+use lumen::bsdf::Lobe;
 use lumen::math::{Color, Interval, Vec3};
 use lumen::ray::Ray;
 use lumen::scene::Scene;
@@ -17,11 +17,14 @@ fn colour_at(scene: &Scene, from: Vec3, towards: Vec3) -> Color {
     let record = scene
         .hit(&ray, Interval::new(1e-4, f32::INFINITY))
         .expect("a hit");
-    match scene.material_at(&record) {
-        Material::Diffuse(d) => d.albedo,
-        Material::Metal(m) => m.albedo,
-        Material::Emissive(e) => e.radiance,
-        Material::Dielectric(_) => panic!("glass has no colour"),
+    let material = scene.material(&record);
+    if material.emits() {
+        return material.emitted(&record, &scene.textures);
+    }
+    match material.bsdf(&record, &scene.textures).map(|b| b.lobe) {
+        Some(Lobe::Diffuse(d)) => d.albedo,
+        Some(Lobe::Metal(m)) => m.albedo,
+        other => panic!("no colour: {other:?}"),
     }
 }
 

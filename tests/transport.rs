@@ -10,8 +10,9 @@ mod common;
 use common::{
     assert_agree, builtin_scene, furnace, pixel_stats, FURNACE_CENTER, FURNACE_RADIUS, K,
 };
-use lumen::geometry::HitRecord;
-use lumen::material::{Attenuation, BounceModel, Diffuse, Metal};
+use lumen::bsdf::diffuse::{Attenuation, BookDiffuse, BounceModel};
+use lumen::bsdf::metal::FuzzyMetal;
+use lumen::bsdf::{Bsdf, Frame, Lobe};
 use lumen::math::{Color, Vec3};
 use lumen::rng::Rng;
 use lumen::scene::desc::{AttenuationDesc, BounceDesc, MaterialDesc};
@@ -20,18 +21,9 @@ use lumen::scene::{Sampling, Scene};
 const W: u32 = 48;
 const H: u32 = 32;
 
-fn hit_facing_up() -> HitRecord {
-    HitRecord {
-        point: Vec3::ZERO,
-        normal: Vec3::Y,
-        shading_normal: Vec3::Y,
-        uv: [0.0, 0.0],
-        t: 1.0,
-        front_face: true,
-        material: 0,
-        object: 0,
-        error: 0.0,
-    }
+/// The lobe `lobe` on a flat surface facing up.
+fn facing_up(lobe: Lobe) -> Bsdf {
+    Bsdf::new(Frame::from_normal(Vec3::Y), Vec3::Y, lobe)
 }
 
 fn diffuse_desc(albedo: f64, bounce: BounceDesc, attenuation: AttenuationDesc) -> MaterialDesc {
@@ -56,18 +48,16 @@ fn sphere_area_fraction() -> f64 {
 fn absorb_attenuation_has_expected_throughput_equal_to_the_albedo() {
     let n = 400_000;
     for albedo in [Color::splat(0.5), Color::new(0.8, 0.3, 0.1), Color::ZERO] {
-        let m = Diffuse {
+        let m = facing_up(Lobe::Diffuse(BookDiffuse {
             albedo,
             bounce: BounceModel::Lambertian,
             attenuation: Attenuation::Absorb,
-        };
+        }));
         let mut rng = Rng::new(5);
         let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
         let mut survivors = 0u32;
         for _ in 0..n {
-            let t = m
-                .scatter(&hit_facing_up(), &mut rng)
-                .map_or(Color::ZERO, |s| s.attenuation);
+            let t = m.sample(Vec3::Y, &mut rng).map_or(Color::ZERO, |s| s.value);
             survivors += u32::from(t != Color::ZERO);
             for c in 0..3 {
                 sum[c] += f64::from(t[c]);
@@ -96,13 +86,11 @@ fn absorb_attenuation_has_expected_throughput_equal_to_the_albedo() {
         }
     }
     // The scaling form never absorbs and always multiplies by the albedo.
-    let m = Diffuse::lambertian(Color::new(0.8, 0.3, 0.1));
+    let albedo = Color::new(0.8, 0.3, 0.1);
+    let m = facing_up(Lobe::Diffuse(BookDiffuse::lambertian(albedo)));
     let mut rng = Rng::new(6);
     for _ in 0..1000 {
-        assert_eq!(
-            m.scatter(&hit_facing_up(), &mut rng).unwrap().attenuation,
-            m.albedo
-        );
+        assert_eq!(m.sample(Vec3::Y, &mut rng).unwrap().value, albedo);
     }
 }
 
@@ -216,16 +204,16 @@ fn fuzz_absorption(c: f64, fuzz: f64) -> f64 {
 #[test]
 fn fuzzy_metal_absorbs_the_analytic_fraction() {
     let n = 200_000;
-    let m = Metal {
+    let m = facing_up(Lobe::Metal(FuzzyMetal {
         albedo: Color::ONE,
         fuzz: 0.5,
-    };
+    }));
     for deg in [0.0f64, 45.0, 70.0, 85.0] {
         let th = deg.to_radians();
         let incoming = Vec3::new(th.sin() as f32, -th.cos() as f32, 0.0);
         let mut rng = Rng::new(9);
         let survived = (0..n)
-            .filter(|_| m.scatter(incoming, &hit_facing_up(), &mut rng).is_some())
+            .filter(|_| m.sample(-incoming, &mut rng).is_some())
             .count();
         let p = 1.0 - fuzz_absorption(th.cos(), 0.5);
         let se = (p * (1.0 - p) / n as f64).sqrt().max(1.0 / n as f64);

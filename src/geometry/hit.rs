@@ -69,21 +69,6 @@ impl HitRecord {
             -self.normal
         }
     }
-
-    /// `direction` kept on the side of the surface it was meant for: a
-    /// reflection scattered around a smooth shading normal can point below
-    /// the true (geometric) surface, where the path would enter the object
-    /// and darken it; it is mirrored back above. Transmitted directions and
-    /// flat surfaces are left alone.
-    #[inline(always)]
-    pub fn reflected_above(&self, direction: Vec3) -> Vec3 {
-        let cos = direction.dot(self.normal);
-        if self.is_smooth() && cos <= 0.0 {
-            (direction - 2.0 * cos * self.normal).normalize()
-        } else {
-            direction
-        }
-    }
 }
 
 /// Orients an outward normal against the ray and records which side was hit.

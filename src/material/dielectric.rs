@@ -1,10 +1,7 @@
-//! Dielectrics: Snell refraction, total internal reflection and Schlick's
-//! approximation of Fresnel reflectance.
+//! The dielectric material: clear glass, water, diamond.
 
-use super::{reflect, Scatter};
+use crate::bsdf::dielectric::SmoothDielectric;
 use crate::geometry::HitRecord;
-use crate::math::{Color, Vec3};
-use crate::sampler::{Dim, Sampler};
 
 /// A clear refracting material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,108 +14,17 @@ pub struct Dielectric {
     pub refract_only: bool,
 }
 
-/// Refracts the unit vector `uv` through a surface with unit normal `n`
-/// (facing against `uv`), with `eta_ratio` = η/η′. Returns `None` when
-/// η/η′·sinθ > 1: no refracted ray exists (total internal reflection).
-///
-/// Snell's law η·sinθ = η′·sinθ′ fixes the refracted ray's component along the
-/// surface, r⊥ = η/η′·(uv + cosθ·n); its normal component makes it unit length,
-/// r∥ = −√(1 − |r⊥|²)·n.
-#[inline]
-pub fn refract(uv: Vec3, n: Vec3, eta_ratio: f32) -> Option<Vec3> {
-    let cos_theta = (-uv).dot(n).min(1.0);
-    let sin_theta2 = (1.0 - cos_theta * cos_theta).max(0.0);
-    if eta_ratio * eta_ratio * sin_theta2 > 1.0 {
-        return None;
-    }
-    let perp = eta_ratio * (uv + cos_theta * n);
-    let parallel = -(1.0 - perp.length_squared()).abs().sqrt() * n;
-    Some(perp + parallel)
-}
-
-/// Schlick's approximation of the fraction of light reflected at incidence
-/// cosine `cosine` with η/η′ = `eta_ratio`: R₀ + (1 − R₀)(1 − cosθ)⁵,
-/// R₀ = ((1 − η/η′)/(1 + η/η′))².
-#[inline]
-pub fn reflectance(cosine: f32, eta_ratio: f32) -> f32 {
-    let r0 = (1.0 - eta_ratio) / (1.0 + eta_ratio);
-    let r0 = r0 * r0;
-    r0 + (1.0 - r0) * (1.0 - cosine).powi(5)
-}
-
 impl Dielectric {
-    /// Reflects or refracts the unit `direction` at `hit`; never absorbs.
-    #[inline]
-    pub fn scatter(
-        &self,
-        direction: Vec3,
-        hit: &HitRecord,
-        sampler: &mut impl Sampler,
-    ) -> Option<Scatter> {
-        let eta_ratio = if hit.front_face {
-            1.0 / self.ior
-        } else {
-            self.ior
-        };
-        let cos_theta = (-direction).dot(hit.shading_normal).min(1.0);
-        let refracted = refract(direction, hit.shading_normal, eta_ratio);
-        let direction = match refracted {
-            Some(r)
-                if self.refract_only
-                    || reflectance(cos_theta, eta_ratio) <= sampler.get_1d(Dim::BsdfChoice) =>
-            {
-                r.normalize()
-            }
-            // The normal (P − C)/R is unit only to within ~1e-4 on small
-            // spheres far from the origin; the sphere tests need unit rays.
-            _ => hit.reflected_above(reflect(direction, hit.shading_normal).normalize()),
-        };
-        Some(Scatter {
-            attenuation: Color::ONE,
-            direction,
-        })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn normal_incidence_passes_straight_through() {
-        let r = refract(-Vec3::Y, Vec3::Y, 1.0 / 1.5).unwrap();
-        assert!((r - -Vec3::Y).length() < 1e-6);
-    }
-
-    #[test]
-    fn refraction_obeys_snells_law() {
-        let eta = 1.0 / 1.5;
-        for deg in [10.0f32, 30.0, 60.0, 85.0] {
-            let th = deg.to_radians();
-            let uv = Vec3::new(th.sin(), -th.cos(), 0.0);
-            let r = refract(uv, Vec3::Y, eta).unwrap();
-            assert!((r.length() - 1.0).abs() < 1e-5);
-            let sin_out = r.x;
-            assert!((sin_out - eta * th.sin()).abs() < 1e-5, "at {deg}°");
-            assert!(r.y < 0.0, "continues into the surface");
+    /// The lobe at `hit`: η/η′ by the side the ray arrives from.
+    #[inline(always)]
+    pub fn at(&self, hit: &HitRecord) -> SmoothDielectric {
+        SmoothDielectric {
+            eta_ratio: if hit.front_face {
+                1.0 / self.ior
+            } else {
+                self.ior
+            },
+            refract_only: self.refract_only,
         }
-    }
-
-    #[test]
-    fn total_internal_reflection_starts_at_the_critical_angle() {
-        // Leaving glass (η/η′ = 1.5): critical angle asin(1/1.5) ≈ 41.81°.
-        let critical = (1.0f32 / 1.5).asin();
-        let at = |th: f32| refract(Vec3::new(th.sin(), -th.cos(), 0.0), Vec3::Y, 1.5);
-        assert!(at(critical - 0.01).is_some());
-        assert!(at(critical + 0.01).is_none());
-    }
-
-    #[test]
-    fn schlick_limits() {
-        // Normal incidence: R0 = ((1 − 1.5)/(1 + 1.5))² = 0.04.
-        assert!((reflectance(1.0, 1.5) - 0.04).abs() < 1e-6);
-        assert!((reflectance(1.0, 1.0 / 1.5) - 0.04).abs() < 1e-6);
-        // Grazing incidence reflects everything.
-        assert!((reflectance(0.0, 1.5) - 1.0).abs() < 1e-6);
     }
 }

@@ -1,18 +1,53 @@
-//! Emissive materials: surfaces that give off light, such as a lamp's shade,
-//! a window or the light quad of a Cornell box.
+//! Emission: the light a surface gives off, such as a lamp's shade, a
+//! window or the light quad of a Cornell box. Any material may emit.
 
+use super::ColorParam;
 use crate::geometry::HitRecord;
 use crate::math::Color;
+use crate::texture::Texture;
 
-/// A surface that emits light and scatters none: a ray that meets it ends
-/// there, carrying the emitted radiance back.
+/// The light a material gives off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// Radiance emitted per channel (≥ 0; may exceed 1), or a texture of it.
+    pub radiance: ColorParam,
+    /// Emit from both sides; otherwise only from the side the surface's
+    /// outward normal points to (a sphere's outside, the side of a quad
+    /// its u × v points to, the counter-clockwise side of a triangle).
+    pub two_sided: bool,
+}
+
+impl Emission {
+    /// The radiance leaving the surface at `hit` towards the ray that hit
+    /// it.
+    #[inline(always)]
+    pub fn emitted(&self, hit: &HitRecord, textures: &[Texture]) -> Color {
+        if hit.front_face || self.two_sided {
+            self.radiance.at(hit, textures)
+        } else {
+            Color::ZERO
+        }
+    }
+
+    /// The emission's constant part as a light sees it: its radiance when
+    /// it has no texture (else zero: the texture gives it), and its sides.
+    pub fn constant(&self) -> Emissive {
+        Emissive {
+            radiance: match self.radiance {
+                ColorParam::Const(c) => c,
+                ColorParam::Texture(_) => Color::ZERO,
+            },
+            two_sided: self.two_sided,
+        }
+    }
+}
+
+/// A constant emission, as a light carries it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Emissive {
     /// Radiance emitted per channel (≥ 0; may exceed 1).
     pub radiance: Color,
-    /// Emit from both sides; otherwise only from the side the surface's
-    /// outward normal points to (a sphere's outside, the side of a quad
-    /// its u × v points to, the counter-clockwise side of a triangle).
+    /// Emit from both sides; otherwise only from the outward side.
     pub two_sided: bool,
 }
 
@@ -26,12 +61,5 @@ impl Emissive {
         } else {
             Color::ZERO
         }
-    }
-
-    /// The radiance leaving the surface at `hit` towards the ray that hit
-    /// it.
-    #[inline(always)]
-    pub fn emitted(&self, hit: &HitRecord) -> Color {
-        self.towards(hit.front_face)
     }
 }

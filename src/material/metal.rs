@@ -1,80 +1,28 @@
-//! Metal: mirror reflection, tinted by an albedo and blurred by fuzz.
+//! The metal material of the notes: a mirror tinted by an albedo and
+//! blurred by fuzz.
 
-use super::Scatter;
+use super::ColorParam;
+use crate::bsdf::metal::FuzzyMetal;
 use crate::geometry::HitRecord;
-use crate::math::{Color, Vec3};
-use crate::sampler::{Dim, Sampler};
-use crate::sampling;
+use crate::texture::Texture;
 
 /// A reflective metal surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Metal {
     /// Colour of the reflection.
-    pub albedo: Color,
+    pub albedo: ColorParam,
     /// Radius in [0, 1] of the sphere around the tip of the reflected direction
     /// from which the actual direction is drawn; 0 is a perfect mirror.
     pub fuzz: f32,
 }
 
-/// Mirror reflection of `v` about the unit normal `n`: v − 2(v·n)n.
-///
-/// (v·n)n is the projection of v on n; subtracting it once gives the part of v
-/// along the surface, subtracting it twice flips v to the other side.
-#[inline]
-pub fn reflect(v: Vec3, n: Vec3) -> Vec3 {
-    v - 2.0 * v.dot(n) * n
-}
-
 impl Metal {
-    /// Reflects the unit `direction` at `hit`; rays fuzzed below the surface
-    /// are absorbed.
+    /// The lobe at `hit`.
     #[inline(always)]
-    pub fn scatter(
-        &self,
-        direction: Vec3,
-        hit: &HitRecord,
-        sampler: &mut impl Sampler,
-    ) -> Option<Scatter> {
-        let mut reflected = reflect(direction, hit.shading_normal);
-        if self.fuzz > 0.0 {
-            reflected = reflected.normalize()
-                + self.fuzz * sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
-        }
-        if reflected.dot(hit.shading_normal) <= 0.0 {
-            return None;
-        }
-        Some(Scatter {
-            attenuation: self.albedo,
-            direction: hit.reflected_above(reflected.normalize()),
-        })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reflect_mirrors_about_the_normal() {
-        // 45° in, 45° out.
-        let r = reflect(Vec3::new(1.0, -1.0, 0.0), Vec3::Y);
-        assert_eq!(r, Vec3::new(1.0, 1.0, 0.0));
-        // Head-on reverses; grazing is unchanged.
-        assert_eq!(reflect(-Vec3::Y, Vec3::Y), Vec3::Y);
-        assert_eq!(reflect(Vec3::X, Vec3::Y), Vec3::X);
-    }
-
-    #[test]
-    fn reflect_keeps_length_and_the_tangential_part_and_flips_the_normal_part() {
-        let n = Vec3::new(1.0, 2.0, 2.0) / 3.0;
-        for v in [Vec3::new(0.3, -0.4, 2.0), Vec3::new(-1.0, -1.0, 0.5)] {
-            let r = reflect(v, n);
-            assert!((r.length() - v.length()).abs() < 1e-6);
-            assert!((r.dot(n) + v.dot(n)).abs() < 1e-6);
-            let tangential = |u: Vec3| u - u.dot(n) * n;
-            assert!((tangential(r) - tangential(v)).length() < 1e-6);
-            // Reflecting twice gives the original back.
-            assert!((reflect(r, n) - v).length() < 1e-6);
+    pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> FuzzyMetal {
+        FuzzyMetal {
+            albedo: self.albedo.albedo_at(hit, textures),
+            fuzz: self.fuzz,
         }
     }
 }

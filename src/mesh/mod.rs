@@ -24,7 +24,7 @@ mod gltf;
 mod obj;
 mod ply;
 
-use crate::material::{Dielectric, Diffuse, Emissive, Material, Metal};
+use crate::material::{ColorParam, Dielectric, Diffuse, Emission, Kind, Material, Metal};
 use crate::math::Color;
 use crate::texture::Image;
 use glam::Mat4;
@@ -180,7 +180,7 @@ impl Default for MeshMaterial {
 impl MeshMaterial {
     /// The nearest of lumen's materials:
     ///
-    /// - any emission (a channel > 0) → [`Emissive`] with that radiance
+    /// - any emission (a channel > 0) → an emitter with that radiance
     ///   (negative, infinite and NaN channels taken as 0), two-sided when the
     ///   material is double-sided; such a surface emits and reflects
     ///   nothing;
@@ -199,8 +199,8 @@ impl MeshMaterial {
             .emission
             .map(|x| if x > 0.0 && x.is_finite() { x } else { 0.0 });
         if radiance.iter().any(|&x| x > 0.0) {
-            Material::Emissive(Emissive {
-                radiance: Color::from_array(radiance),
+            Material::emitter(Emission {
+                radiance: ColorParam::Const(Color::from_array(radiance)),
                 two_sided: self.double_sided,
             })
         } else if self.transmission > 0.0 {
@@ -209,18 +209,18 @@ impl MeshMaterial {
             } else {
                 DEFAULT_IOR
             };
-            Material::Dielectric(Dielectric {
+            Material::new(Kind::Dielectric(Dielectric {
                 ior,
                 refract_only: false,
-            })
+            }))
         } else if self.metallic >= 0.5 {
             let r = unit(self.roughness);
-            Material::Metal(Metal {
-                albedo,
+            Material::new(Kind::Metal(Metal {
+                albedo: ColorParam::Const(albedo),
                 fuzz: r * r,
-            })
+            }))
         } else {
-            Material::Diffuse(Diffuse::lambertian(albedo))
+            Material::new(Kind::Diffuse(Diffuse::lambertian(albedo)))
         }
     }
 }

@@ -240,40 +240,42 @@ fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
     // `Ke` makes a light, one-sided (MTL has no two-sided materials).
     assert_eq!(
         mat("red"),
-        Material::Emissive(Emissive {
-            radiance: Color::new(0.0, 0.0, 4.0),
+        Material::emitter(Emission {
+            radiance: ColorParam::Const(Color::new(0.0, 0.0, 4.0)),
             two_sided: false
         })
     );
     assert_eq!(m.materials[0].emission, [0.0, 0.0, 4.0]);
-    match mat("chrome") {
-        Material::Metal(Metal { albedo, fuzz }) => {
-            assert_eq!(albedo, Color::new(0.9, 0.8, 0.7));
+    match mat("chrome").kind {
+        Kind::Metal(Metal { albedo, fuzz }) => {
+            assert_eq!(albedo, ColorParam::Const(Color::new(0.9, 0.8, 0.7)));
             assert!((fuzz - (2.0f32 / 1002.0).sqrt()).abs() < 1e-5, "{fuzz}");
         }
         other => panic!("chrome is {other:?}"),
     }
     assert_eq!(
         mat("glass"),
-        Material::Dielectric(Dielectric {
+        Material::new(Kind::Dielectric(Dielectric {
             ior: 1.45,
             refract_only: false
-        })
+        }))
     );
     assert_eq!(
         mat("water"),
-        Material::Dielectric(Dielectric {
+        Material::new(Kind::Dielectric(Dielectric {
             ior: 1.33,
             refract_only: false
-        })
+        }))
     );
     assert_eq!(
         mat("grey"),
-        Material::Diffuse(Diffuse::lambertian(Color::splat(0.5)))
+        Material::new(Kind::Diffuse(Diffuse::lambertian(Color::splat(0.5))))
     );
     assert_eq!(
         mat("hot"),
-        Material::Diffuse(Diffuse::lambertian(Color::new(1.0, 0.0, 0.5)))
+        Material::new(Kind::Diffuse(Diffuse::lambertian(Color::new(
+            1.0, 0.0, 0.5
+        ))))
     );
 }
 
@@ -287,8 +289,8 @@ fn metal_fuzz_falls_as_the_phong_exponent_rises() {
             "m.obj",
             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
         );
-        match load(&p).unwrap().materials[0].to_material() {
-            Material::Metal(m) => m.fuzz,
+        match load(&p).unwrap().materials[0].to_material().kind {
+            Kind::Metal(m) => m.fuzz,
             other => panic!("{other:?}"),
         }
     };
@@ -575,8 +577,8 @@ fn gltf_hierarchy_composes_transforms_and_shares_the_mesh() {
     // It glows, from both sides; without its glow it is a metal.
     assert_eq!(
         steel.to_material(),
-        Material::Emissive(Emissive {
-            radiance: Color::new(0.1, 0.2, 0.3),
+        Material::emitter(Emission {
+            radiance: ColorParam::Const(Color::new(0.1, 0.2, 0.3)),
             two_sided: true
         })
     );
@@ -586,10 +588,10 @@ fn gltf_hierarchy_composes_transforms_and_shares_the_mesh() {
     };
     assert_eq!(
         dark.to_material(),
-        Material::Metal(Metal {
-            albedo: Color::new(0.5, 0.6, 0.7),
+        Material::new(Kind::Metal(Metal {
+            albedo: ColorParam::Const(Color::new(0.5, 0.6, 0.7)),
             fuzz: 0.25
-        })
+        }))
     );
 }
 
@@ -700,10 +702,10 @@ fn gltf_transmission_and_strips_and_fans() {
     assert_eq!(m.materials[0].name, "material 0");
     assert_eq!(
         m.materials[0].to_material(),
-        Material::Dielectric(Dielectric {
+        Material::new(Kind::Dielectric(Dielectric {
             ior: 1.7,
             refract_only: false
-        })
+        }))
     );
 }
 

@@ -16,7 +16,9 @@ use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
-use crate::material::{Attenuation, BounceModel, Dielectric, Diffuse, Emissive, Material, Metal};
+use crate::material::{
+    Attenuation, BounceModel, ColorParam, Dielectric, Diffuse, Emission, Kind, Material, Metal,
+};
 use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
@@ -96,16 +98,13 @@ impl Scene {
         // when it is known whether anything moves.
         compile_camera(desc, &settings, true)?;
         let mut materials = Vec::with_capacity(desc.materials.len());
-        let mut material_textures = Vec::with_capacity(desc.materials.len());
         let mut material_index = HashMap::with_capacity(desc.materials.len());
         let mut table = TextureTable::new(&desc.textures, base);
         let mut sources = Vec::new();
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);
             let field = format!("materials.{name}");
-            let (material, texture) = compile_material(&field, m, &mut table, &mut sources)?;
-            materials.push(material);
-            material_textures.push(texture);
+            materials.push(compile_material(&field, m, &mut table, &mut sources)?);
         }
         let textures = table.textures;
         let mut objects = Objects {
@@ -114,7 +113,6 @@ impl Scene {
             materials,
             material_index,
             textures,
-            material_textures,
             top: Shapes::default(),
             spheres: Vec::with_capacity(desc.objects.len()),
             groups: Vec::new(),
@@ -133,7 +131,6 @@ impl Scene {
         let Objects {
             materials,
             textures,
-            material_textures,
             top,
             spheres,
             groups,
@@ -148,7 +145,7 @@ impl Scene {
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
-        let (lights, light_ids) = world.lights(&materials, &material_textures);
+        let (lights, light_ids) = world.lights(&materials);
         // A smooth sky is found as well by the bounces, which follow the
         // surface's cosine, as by a shadow ray drawn over the whole sphere;
         // the shadow rays would cost time for nothing (half the efficiency
@@ -171,7 +168,6 @@ impl Scene {
             background,
             materials,
             textures,
-            material_textures,
             spheres,
             sources,
             stats,
@@ -294,8 +290,6 @@ struct Objects<'a> {
     materials: Vec<Material>,
     material_index: HashMap<&'a str, u32>,
     textures: Vec<Texture>,
-    /// Per material, its colour's texture (see [`Scene::material_textures`]).
-    material_textures: Vec<Option<u32>>,
     top: Shapes,
     spheres: Vec<Sphere>,
     groups: Vec<Group>,
@@ -311,8 +305,7 @@ impl<'a> Objects<'a> {
     /// Whether material `m`'s texture uses the surface's (u, v), which
     /// spheres then work out.
     fn uses_uv(&self, m: u32) -> bool {
-        self.material_textures[m as usize]
-            .is_some_and(|t| self.textures[t as usize].uses_uv(&self.textures))
+        self.materials[m as usize].uses_uv(&self.textures)
     }
 
     fn material(&self, i: usize, name: &str) -> Result<u32, SceneError> {
@@ -593,20 +586,22 @@ impl<'a> Objects<'a> {
         let mesh_material = loaded.model.materials.get(slot).unwrap_or(&default);
         let mut material = mesh_material.to_material();
         // A base colour image, times the base colour, becomes the albedo's
-        // texture (the material's own albedo a placeholder).
-        let texture = match (&mesh_material.base_color_texture, material) {
-            (Some(image), Material::Diffuse(_) | Material::Metal(_)) => {
+        // texture.
+        if let Some(image) = &mesh_material.base_color_texture {
+            let albedo = match &mut material.kind {
+                Kind::Diffuse(d) => Some(&mut d.albedo),
+                Kind::Metal(m) => Some(&mut m.albedo),
+                _ => None,
+            };
+            if let Some(albedo) = albedo {
                 let factor = Color::from_array(mesh_material.base_color);
                 self.textures
                     .push(Texture::Image(Arc::new(image.scaled(factor))));
-                material = material.with_color(Color::ZERO);
-                Some(self.textures.len() as u32 - 1)
+                *albedo = ColorParam::Texture(self.textures.len() as u32 - 1);
             }
-            _ => None,
-        };
+        }
         let index = self.materials.len() as u32;
         self.materials.push(material);
-        self.material_textures.push(texture);
         loaded.materials[slot] = Some(index);
         index
     }
@@ -943,33 +938,27 @@ pub(super) fn check_seed(field: &str, seed: u64) -> Result<u64, SceneError> {
     Ok(seed)
 }
 
-/// The material `m` of field `field`, and the texture that gives its
-/// colour (albedo or radiance), if one does.
+/// The material `m` of field `field`.
 fn compile_material<'a>(
     field: &str,
     m: &'a MaterialDesc,
     textures: &mut TextureTable<'a>,
     sources: &mut Vec<MeshSource>,
-) -> Result<(Material, Option<u32>), SceneError> {
-    // A textured colour leaves a placeholder that the texture replaces
-    // where a ray hits: 0 radiance, so that a textured emitter is not taken
-    // for a light of known power (it is found by the bounces).
-    let mut texture = None;
-    let mut colour = |name: &str, c: &'a ColorDesc, check| -> Result<Color, SceneError> {
-        match textures.color(&format!("{field}.{name}"), c, check, sources)? {
-            ColorRef::Rgb(c) => Ok(c),
-            ColorRef::Texture(t) => {
-                texture = Some(t);
-                Ok(Color::ZERO)
-            }
-        }
+) -> Result<Material, SceneError> {
+    let mut colour = |name: &str, c: &'a ColorDesc, check| -> Result<ColorParam, SceneError> {
+        Ok(
+            match textures.color(&format!("{field}.{name}"), c, check, sources)? {
+                ColorRef::Rgb(c) => ColorParam::Const(c),
+                ColorRef::Texture(t) => ColorParam::Texture(t),
+            },
+        )
     };
-    let material = match m {
+    let kind = match m {
         MaterialDesc::Diffuse {
             albedo: a,
             bounce,
             attenuation,
-        } => Material::Diffuse(Diffuse {
+        } => Kind::Diffuse(Diffuse {
             albedo: colour("albedo", a, albedo)?,
             bounce: match bounce {
                 BounceDesc::Cube => BounceModel::Cube,
@@ -990,7 +979,7 @@ fn compile_material<'a>(
                     format!("must be in [0, 1], got {fuzz}"),
                 ));
             }
-            Material::Metal(Metal {
+            Kind::Metal(Metal {
                 albedo: colour("albedo", a, albedo)?,
                 fuzz: *fuzz as f32,
             })
@@ -1003,7 +992,7 @@ fn compile_material<'a>(
                     format!("index of refraction must be greater than 0, got {ior}"),
                 ));
             }
-            Material::Dielectric(Dielectric {
+            Kind::Dielectric(Dielectric {
                 ior: *ior as f32,
                 refract_only: *refract_only,
             })
@@ -1011,12 +1000,14 @@ fn compile_material<'a>(
         MaterialDesc::Emissive {
             radiance,
             two_sided,
-        } => Material::Emissive(Emissive {
-            radiance: colour("radiance", radiance, color)?,
-            two_sided: *two_sided,
-        }),
+        } => {
+            return Ok(Material::emitter(Emission {
+                radiance: colour("radiance", radiance, color)?,
+                two_sided: *two_sided,
+            }))
+        }
     };
-    Ok((material, texture))
+    Ok(Material::new(kind))
 }
 
 #[cfg(test)]

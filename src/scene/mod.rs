@@ -170,14 +170,10 @@ pub struct Scene {
     pub camera: Camera,
     /// What rays that escape the scene see: the environment.
     pub background: Environment,
-    /// Material table indexed by [`HitRecord::material`]. A material whose
-    /// colour is a texture holds a placeholder here; [`Scene::material_at`]
-    /// gives it its colour where a ray hits.
+    /// Material table indexed by [`HitRecord::material`].
     pub materials: Vec<Material>,
     /// The textures materials refer to.
     pub textures: Vec<Texture>,
-    /// Per material, the texture of its colour (albedo or radiance), if any.
-    pub material_textures: Vec<Option<u32>>,
     /// The spheres placed directly in the world, in description order.
     pub spheres: Vec<Sphere>,
     /// The mesh files the scene reads, with a hash of their content: part
@@ -251,19 +247,10 @@ impl Scene {
         self.light_ids.of(hit)
     }
 
-    /// The material at `record`, its colour given by its texture there
-    /// when it has one.
+    /// The material of the surface at `record`.
     #[inline(always)]
-    pub fn material_at(&self, record: &HitRecord) -> Material {
-        let i = record.material as usize;
-        let material = self.materials[i];
-        match self.material_textures.get(i) {
-            Some(&Some(t)) => {
-                let c = self.textures[t as usize].value(&self.textures, record.uv, record.point);
-                material.with_color(c)
-            }
-            _ => material,
-        }
+    pub fn material(&self, record: &HitRecord) -> &Material {
+        &self.materials[record.material as usize]
     }
 
     /// Whether `ray` hits anything within `interval` (a shadow ray's

@@ -501,23 +501,16 @@ impl LightIds {
 
 impl World {
     /// Every emissive primitive as a light in world space, and where each
-    /// primitive's light is. A light's radiance and sides are its
-    /// material's, its radiance a texture where `material_textures` gives
-    /// the material one; an instance holding any light gets one entry per
+    /// primitive's light is. A light's radiance (constant or a texture) and
+    /// sides are its material's emission's; an instance holding any light gets one entry per
     /// primitive of its tree (black for the others), so that a hit's light
     /// is found by arithmetic.
-    pub(crate) fn lights(
-        &self,
-        materials: &[Material],
-        material_textures: &[Option<u32>],
-    ) -> (Vec<Light>, LightIds) {
+    pub(crate) fn lights(&self, materials: &[Material]) -> (Vec<Light>, LightIds) {
         // What material `m` emits: its emission and texture, if any.
         let emitter = |m: u32| -> Option<Emission> {
-            let texture = material_textures.get(m as usize).copied().flatten();
-            match materials[m as usize] {
-                Material::Emissive(e) if texture.is_some() => Some((e, texture)),
-                other => other.light().map(|e| (e, None)),
-            }
+            let material = &materials[m as usize];
+            let emission = material.emission.filter(|_| material.emits())?;
+            Some((emission.constant(), emission.radiance.texture()))
         };
         let mut lights = Vec::new();
         let mut ids = LightIds::default();

@@ -1,0 +1,247 @@
+//! How a surface scatters light at one point: a [`Bsdf`] is a shading
+//! [`Frame`] and one [`Lobe`] (a closed enum, dispatched with `match`), made by
+//! a [`Material`](crate::material::Material) where a ray hits it.
+//!
+//! Every lobe answers three questions, in the surface's local frame (z along
+//! the shading normal, on the side the ray came from; `wo` points away from
+//! the surface, back along the ray, and so does `wi`, towards the light):
+//!
+//! - `sample(wo, …)`: a direction `wi` drawn with density `pdf`, and the
+//!   *value* f(wo, wi)·|cos θi| / pdf that a path's throughput is multiplied
+//!   by ([`BsdfSample`]);
+//! - `eval(wo, wi)`: f(wo, wi)·|cos θi|, the light scattered towards `wo` per
+//!   unit light arriving from `wi`;
+//! - `pdf(wo, wi)`: the density (per unit solid angle) with which `sample`
+//!   draws `wi`.
+//!
+//! [`Bsdf`] turns world directions into local ones and back, and keeps a
+//! lobe's reflection and transmission on the sides of the true (geometric)
+//! surface that they belong to.
+//!
+//! The notes' lobes ([`diffuse`], [`metal`], [`dielectric`]) scatter around
+//! the shading normal in world space exactly as the book does, so that its
+//! figures keep their bits; the fuzzy metal and the bounce models other than
+//! the Lambertian have no density written down and are sampled only.
+
+pub mod dielectric;
+pub mod diffuse;
+pub mod metal;
+
+use crate::math::{Color, Vec3};
+use crate::sampler::Sampler;
+
+/// An orthonormal frame: tangent `t`, bitangent `b` and normal `n`, with
+/// `t × b = n`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// The tangent (x in the local frame).
+    pub t: Vec3,
+    /// The bitangent (y).
+    pub b: Vec3,
+    /// The normal (z).
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// Some frame around unit `n` (for a lobe that is the same whichever
+    /// way round the normal it is turned).
+    #[inline]
+    pub fn from_normal(n: Vec3) -> Frame {
+        let (t, b) = n.any_orthonormal_pair();
+        Frame { t, b, n }
+    }
+
+    /// The frame around unit `n` whose tangent is `tangent` made
+    /// perpendicular to it (Gram–Schmidt); [`Frame::from_normal`] when
+    /// `tangent` is zero or along `n`.
+    #[inline]
+    pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Frame {
+        let t = (tangent - n * n.dot(tangent)).normalize_or_zero();
+        if t == Vec3::ZERO {
+            return Frame::from_normal(n);
+        }
+        Frame {
+            t,
+            b: n.cross(t),
+            n,
+        }
+    }
+
+    /// `v` in this frame's coordinates.
+    #[inline(always)]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
+    }
+
+    /// The world vector whose coordinates in this frame are `v`.
+    #[inline(always)]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.t * v.x + self.b * v.y + self.n * v.z
+    }
+}
+
+/// What kind of scattering a sample or a lobe does: reflection or
+/// transmission, and diffuse, glossy or specular (a single direction, which
+/// no light sample can find).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct LobeFlags(u8);
+
+impl LobeFlags {
+    /// Back to the side the light came from.
+    pub const REFLECTION: LobeFlags = LobeFlags(1);
+    /// Through to the other side.
+    pub const TRANSMISSION: LobeFlags = LobeFlags(2);
+    /// Spread over the hemisphere.
+    pub const DIFFUSE: LobeFlags = LobeFlags(4);
+    /// Spread about a direction.
+    pub const GLOSSY: LobeFlags = LobeFlags(8);
+    /// Along a single direction (a delta distribution).
+    pub const SPECULAR: LobeFlags = LobeFlags(16);
+
+    /// Both sets of flags.
+    #[inline(always)]
+    pub const fn union(self, other: LobeFlags) -> LobeFlags {
+        LobeFlags(self.0 | other.0)
+    }
+
+    /// Whether every flag of `other` is set.
+    #[inline(always)]
+    pub const fn contains(self, other: LobeFlags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether the sample or lobe is a delta (a mirror's, clear glass's).
+    #[inline(always)]
+    pub const fn is_specular(self) -> bool {
+        self.contains(LobeFlags::SPECULAR)
+    }
+
+    /// Whether it goes through the surface.
+    #[inline(always)]
+    pub const fn is_transmission(self) -> bool {
+        self.contains(LobeFlags::TRANSMISSION)
+    }
+}
+
+impl std::ops::BitOr for LobeFlags {
+    type Output = LobeFlags;
+    #[inline(always)]
+    fn bitor(self, other: LobeFlags) -> LobeFlags {
+        self.union(other)
+    }
+}
+
+/// A direction drawn by a lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// f(wo, wi)·|cos θi| / pdf: what the path's throughput is multiplied
+    /// by.
+    pub value: Color,
+    /// The unit direction drawn, pointing away from the surface.
+    pub wi: Vec3,
+    /// Its density per unit solid angle (for a specular sample, the
+    /// probability of choosing that component; 0 for a lobe sampled only).
+    pub pdf: f32,
+    /// What kind of scattering it is.
+    pub flags: LobeFlags,
+}
+
+/// The lobe of a [`Bsdf`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lobe {
+    /// The notes' diffuse surface: four bounce models, two attenuations.
+    Diffuse(diffuse::BookDiffuse),
+    /// The notes' metal: a mirror blurred by a fuzz sphere.
+    Metal(metal::FuzzyMetal),
+    /// The notes' glass: Snell refraction, Schlick reflection.
+    Dielectric(dielectric::SmoothDielectric),
+}
+
+/// How a surface scatters at one point: its frame and its lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bsdf {
+    /// The shading frame, its normal on the side the ray came from.
+    pub frame: Frame,
+    /// The unit geometric normal on the same side.
+    pub ng: Vec3,
+    /// The lobe.
+    pub lobe: Lobe,
+}
+
+impl Bsdf {
+    /// A lobe in the frame around shading normal `n` (unit, on the side
+    /// the ray came from), on a surface of unit geometric normal `ng` (same
+    /// side).
+    #[inline(always)]
+    pub fn new(frame: Frame, ng: Vec3, lobe: Lobe) -> Bsdf {
+        Bsdf { frame, ng, lobe }
+    }
+
+    /// Whether the shading normal differs from the geometric one.
+    #[inline(always)]
+    pub fn is_smooth(&self) -> bool {
+        self.frame.n != self.ng
+    }
+
+    /// Whether [`eval`](Self::eval) and [`pdf`](Self::pdf) describe how it
+    /// scatters, so that a light can be sampled from here and weighed
+    /// against the lobe's own sampling: every lobe but the deltas and the
+    /// notes' sampled-only models.
+    #[inline(always)]
+    pub fn has_density(&self) -> bool {
+        match &self.lobe {
+            Lobe::Diffuse(d) => d.is_lambertian(),
+            Lobe::Metal(_) | Lobe::Dielectric(_) => false,
+        }
+    }
+
+    /// Draws a direction towards which light leaving along unit `wo`
+    /// (pointing away from the surface) is scattered from; `None` when the
+    /// path is absorbed.
+    #[inline(always)]
+    pub fn sample(&self, wo: Vec3, sampler: &mut impl Sampler) -> Option<BsdfSample> {
+        match &self.lobe {
+            Lobe::Diffuse(d) => d.sample(self, sampler),
+            Lobe::Metal(m) => m.sample(self, wo, sampler),
+            Lobe::Dielectric(d) => d.sample(self, wo, sampler),
+        }
+    }
+
+    /// f(wo, wi)·|cos θi| for unit world directions `wo` and `wi` (both
+    /// pointing away from the surface); zero for the deltas and for lobes
+    /// without a density.
+    #[inline(always)]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Color {
+        self.eval_and_pdf(wo, wi).0
+    }
+
+    /// The density with which [`sample`](Self::sample) draws `wi` for `wo`.
+    #[inline(always)]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval_and_pdf(wo, wi).1
+    }
+
+    /// [`eval`](Self::eval) and [`pdf`](Self::pdf) together.
+    #[inline(always)]
+    pub fn eval_and_pdf(&self, _wo: Vec3, wi: Vec3) -> (Color, f32) {
+        match &self.lobe {
+            Lobe::Diffuse(d) => d.eval_and_pdf(self, wi),
+            Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),
+        }
+    }
+
+    /// `direction` kept on the side of the surface it was meant for: a
+    /// reflection scattered around a smooth shading normal can point below
+    /// the true (geometric) surface, where the path would enter the object
+    /// and darken it; it is mirrored back above. Transmitted directions and
+    /// flat surfaces are left alone.
+    #[inline(always)]
+    pub fn reflected_above(&self, direction: Vec3) -> Vec3 {
+        let cos = direction.dot(self.ng);
+        if self.is_smooth() && cos <= 0.0 {
+            (direction - 2.0 * cos * self.ng).normalize()
+        } else {
+            direction
+        }
+    }
+}
