@@ -51,6 +51,18 @@ impl Frame {
         Frame { t, b, n }
     }
 
+    /// A frame of which only the normal `n` is known, for the notes'
+    /// lobes, which scatter about the normal in world space and never turn
+    /// a direction into local coordinates (its tangents are zero).
+    #[inline(always)]
+    pub fn normal_only(n: Vec3) -> Frame {
+        Frame {
+            t: Vec3::ZERO,
+            b: Vec3::ZERO,
+            n,
+        }
+    }
+
     /// The frame around unit `n` whose tangent is `tangent` made
     /// perpendicular to it (Gram–Schmidt); [`Frame::from_normal`] when
     /// `tangent` is zero or along `n`.

@@ -109,17 +109,20 @@ impl Material {
     /// `None` where it scatters nothing.
     #[inline(always)]
     pub fn bsdf(&self, hit: &HitRecord, textures: &[Texture]) -> Option<Bsdf> {
-        let lobe = match &self.kind {
-            Kind::Black => return None,
-            Kind::Diffuse(d) => Lobe::Diffuse(d.at(hit, textures)),
-            Kind::Metal(m) => Lobe::Metal(m.at(hit, textures)),
-            Kind::Dielectric(d) => Lobe::Dielectric(d.at(hit)),
+        // The notes' lobes scatter about the normal alone.
+        let notes = |lobe| {
+            Some(Bsdf::new(
+                Frame::normal_only(hit.shading_normal),
+                hit.normal,
+                lobe,
+            ))
         };
-        Some(Bsdf::new(
-            Frame::from_normal(hit.shading_normal),
-            hit.normal,
-            lobe,
-        ))
+        match &self.kind {
+            Kind::Black => None,
+            Kind::Diffuse(d) => notes(Lobe::Diffuse(d.at(hit, textures))),
+            Kind::Metal(m) => notes(Lobe::Metal(m.at(hit, textures))),
+            Kind::Dielectric(d) => notes(Lobe::Dielectric(d.at(hit))),
+        }
     }
 
     /// The radiance the surface at `hit` sends back along the ray that hit
