@@ -3,17 +3,11 @@
 
 pub mod builtin;
 mod compile;
-mod decode;
 pub mod desc;
-pub mod export;
-mod fast;
 pub mod file;
-pub mod hint;
-mod plain_toml;
-pub mod source;
-mod textures;
-mod toml_cut;
 mod world;
+
+pub use file::{export, hint, source};
 
 pub use desc::SceneDesc;
 

@@ -13,13 +13,13 @@
 //! document and the objects in batches, on every core, each batch's
 //! document dropped as soon as it is read.
 
-use super::desc::{
+use super::plain_toml;
+use super::toml_cut;
+use super::Format;
+use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, MaterialDesc, ObjectDesc, RenderDesc,
     ScaleDesc, SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
 };
-use super::file::Format;
-use super::plain_toml;
-use super::toml_cut;
 use rayon::prelude::*;
 use serde::Deserialize;
 use std::ops::Range;

@@ -6,7 +6,6 @@ use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc,
     ScaleDesc, TransformDesc, MAX_SEED,
 };
-use super::textures::{read_image, ColorRef, TextureTable};
 use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
 use super::{
     invalid, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings, MAX_COORDINATE,
@@ -26,6 +25,9 @@ use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use textures::{read_image, ColorRef, TextureTable};
+
+mod textures;
 
 /// The factor of [`HitRecord::error`]: the hit point and its offset from the
 /// centre are each rounded to about 2⁻²⁴ of their size (the point's
@@ -933,7 +935,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
 /// user: scene files are checked when read), which TOML could not write.
 pub(super) fn check_seed(field: &str, seed: u64) -> Result<u64, SceneError> {
     if seed > MAX_SEED {
-        return Err(invalid(field, super::desc::seed_too_large(seed)));
+        return Err(invalid(field, crate::scene::desc::seed_too_large(seed)));
     }
     Ok(seed)
 }

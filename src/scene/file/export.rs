@@ -1,10 +1,10 @@
 //! Writing a description out as a scene file, one object at a time, and
 //! the checks that keep an export from destroying its own input.
 
-use super::desc::{
+use super::Format;
+use crate::scene::desc::{
     BackgroundDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc, SceneDesc, TextureDesc,
 };
-use super::file::Format;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;

@@ -3,9 +3,10 @@
 //! between textures followed and cycles refused; image files read once and
 //! recorded as sources of the scene.
 
-use super::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
-use super::{hint, invalid, MeshSource, SceneError};
 use crate::math::Color;
+use crate::scene::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
+use crate::scene::file::hint;
+use crate::scene::{invalid, MeshSource, SceneError};
 use crate::texture::{Image, NoisePattern, Perlin, Texture};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -72,7 +73,7 @@ impl<'a> TextureTable<'a> {
     ) -> Result<u32, SceneError> {
         match c {
             ColorDesc::Rgb(rgb) => {
-                let colour = super::compile::color(field, *rgb)?;
+                let colour = super::color(field, *rgb)?;
                 self.textures.push(Texture::Solid(colour));
                 Ok(self.textures.len() as u32 - 1)
             }
@@ -131,7 +132,7 @@ impl<'a> TextureTable<'a> {
                 pattern,
                 seed,
             } => Texture::Noise {
-                perlin: Arc::new(Perlin::new(super::compile::check_seed(
+                perlin: Arc::new(Perlin::new(super::check_seed(
                     &format!("{here}.seed"),
                     *seed,
                 )?)),
@@ -153,7 +154,7 @@ impl<'a> TextureTable<'a> {
 
 /// A scale of field `field`: finite and above 0 in `f32`.
 fn positive(field: &str, value: f64) -> Result<f32, SceneError> {
-    super::compile::finite(field, &[value])?;
+    super::finite(field, &[value])?;
     if !(value as f32 > 0.0) {
         return Err(invalid(
             field,
@@ -168,7 +169,7 @@ pub const EMBEDDED_PREFIX: &str = "lumen:";
 
 /// The images built into lumen (for the built-in scenes, which must render
 /// anywhere without files): name and file bytes.
-const EMBEDDED: &[(&str, &[u8])] = &[("earth.png", include_bytes!("../../assets/earth.png"))];
+const EMBEDDED: &[(&str, &[u8])] = &[("earth.png", include_bytes!("../../../assets/earth.png"))];
 
 /// The bytes of the built-in image `name`.
 fn embedded(name: &str) -> Option<&'static [u8]> {

@@ -8,14 +8,14 @@
 //! by [`Scene::from_desc`](super::Scene::from_desc), for files and library
 //! users alike.
 
-use super::desc::{
+use super::hint;
+use super::source::{Entry, Node, Value};
+use crate::light::LightSelection;
+use crate::scene::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
     IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
     ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, MAX_SEED,
 };
-use super::hint;
-use super::source::{Entry, Node, Value};
-use crate::light::LightSelection;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -206,9 +206,11 @@ fn integer(node: &Node, path: &str, min: u64, max: u64) -> Result<u64> {
 /// always be exported to TOML (whose integers are signed 64-bit).
 fn seed(node: &Node, path: &str) -> Result<u64> {
     match node.value {
-        Value::Integer(i) if i > i128::from(MAX_SEED) => {
-            Err(error(path, &node.span, super::desc::seed_too_large(i)))
-        }
+        Value::Integer(i) if i > i128::from(MAX_SEED) => Err(error(
+            path,
+            &node.span,
+            crate::scene::desc::seed_too_large(i),
+        )),
         _ => integer(node, path, 0, MAX_SEED),
     }
 }

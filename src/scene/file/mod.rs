@@ -19,10 +19,17 @@
 //! assert!(err.to_string().contains("did you mean `radius`?"));
 //! ```
 
-use super::decode;
-use super::fast;
-use super::source::{self, Node, Value};
+mod decode;
+pub mod export;
+mod fast;
+pub mod hint;
+mod plain_toml;
+pub mod source;
+mod toml_cut;
+
 use super::{Overrides, Scene, SceneDesc, SceneError};
+use source::{Node, Value};
+
 use std::fmt;
 use std::ops::Range;
 use std::path::Path;
@@ -140,11 +147,11 @@ pub struct ExportError {
 
 /// Writes `desc` as a scene file of the given format. Reading the text back
 /// gives `desc` again, and writing that gives the same text (see
-/// [`super::export::write_scene`], which writes it to a file or a pipe as
+/// [`export::write_scene`], which writes it to a file or a pipe as
 /// it goes).
 pub fn export(desc: &SceneDesc, format: Format) -> Result<String, ExportError> {
     let mut text = Vec::new();
-    super::export::write_scene(desc, format, &mut text).map_err(|e| ExportError {
+    export::write_scene(desc, format, &mut text).map_err(|e| ExportError {
         format,
         message: e.to_string(),
     })?;
