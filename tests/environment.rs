@@ -14,7 +14,7 @@ use common::{
     assert_tiles_agree, compile_file, furnace_desc, pixel_stats, scene_file, scene_file_error,
     scratch_dir, tiles_agree, PixelStats, K,
 };
-use lumen::scene::desc::MaterialDesc;
+use lumen::scene::desc::{DiffuseDesc, EmissiveDesc, MaterialDesc, MetalDesc};
 use lumen::scene::{Integrator, LightSelection, Overrides, Sampling, Scene};
 use std::path::Path;
 
@@ -58,11 +58,12 @@ fn assert_white(what: &str, stats: &PixelStats) {
 
 #[test]
 fn white_furnace_with_next_event_estimation_and_mis_is_white() {
-    let lambertian = MaterialDesc::Diffuse {
+    let lambertian = MaterialDesc::Diffuse(DiffuseDesc {
         albedo: [1.0; 3].into(),
         bounce: Default::default(),
         attenuation: Default::default(),
-    };
+        ..Default::default()
+    });
     for sampler in [Sampling::Sobol, Sampling::Independent] {
         let mut desc = furnace_desc(lambertian.clone(), 32, 24, 32, 50);
         desc.render.integrator = Integrator::Path;

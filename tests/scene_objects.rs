@@ -5,7 +5,9 @@
 mod common;
 
 use common::{scene_file, scratch_dir};
-use lumen::scene::desc::{BoundaryDesc, MaterialDesc, ObjectDesc, ScaleDesc, TransformDesc};
+use lumen::scene::desc::{
+    BoundaryDesc, DiffuseDesc, MaterialDesc, MetalDesc, ObjectDesc, ScaleDesc, TransformDesc,
+};
 use lumen::scene::file::{export, Format, SceneFile};
 use lumen::scene::{Overrides, SceneDesc};
 use std::process::Command;
@@ -138,18 +140,20 @@ fn expected() -> SceneDesc {
     desc.camera.shutter = [0.25, 0.75];
     desc.materials.insert(
         "grey".into(),
-        MaterialDesc::Diffuse {
+        MaterialDesc::Diffuse(DiffuseDesc {
             albedo: [0.5; 3].into(),
             bounce: Default::default(),
             attenuation: Default::default(),
-        },
+            ..Default::default()
+        }),
     );
     desc.materials.insert(
         "gold".into(),
-        MaterialDesc::Metal {
+        MaterialDesc::Metal(MetalDesc {
             albedo: [0.8, 0.6, 0.2].into(),
             fuzz: 0.1,
-        },
+            ..Default::default()
+        }),
     );
     desc.objects = vec![
         ObjectDesc::Sphere {

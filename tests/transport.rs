@@ -15,7 +15,9 @@ use lumen::bsdf::metal::FuzzyMetal;
 use lumen::bsdf::{Bsdf, Frame, Lobe};
 use lumen::math::{Color, Vec3};
 use lumen::rng::Rng;
-use lumen::scene::desc::{AttenuationDesc, BounceDesc, MaterialDesc};
+use lumen::scene::desc::{
+    AttenuationDesc, BounceDesc, DielectricDesc, DiffuseDesc, MaterialDesc, MetalDesc,
+};
 use lumen::scene::{Sampling, Scene};
 
 const W: u32 = 48;
@@ -27,11 +29,12 @@ fn facing_up(lobe: Lobe) -> Bsdf {
 }
 
 fn diffuse_desc(albedo: f64, bounce: BounceDesc, attenuation: AttenuationDesc) -> MaterialDesc {
-    MaterialDesc::Diffuse {
+    MaterialDesc::Diffuse(DiffuseDesc {
         albedo: [albedo; 3].into(),
         bounce,
         attenuation,
-    }
+        ..Default::default()
+    })
 }
 
 /// Fraction of the image plane covered by the furnace sphere. The default
@@ -178,18 +181,20 @@ fn white_furnace_diffuse_albedo_one_is_white() {
 
 #[test]
 fn white_furnace_mirror_and_glass_are_white() {
-    let mirror = MaterialDesc::Metal {
+    let mirror = MaterialDesc::Metal(MetalDesc {
         albedo: [1.0; 3].into(),
         fuzz: 0.0,
-    };
+        ..Default::default()
+    });
     assert_white("mirror", mirror, 50);
     // Glass never absorbs; light refracted into a sphere always meets the
     // inside at an angle below the critical angle, so it eventually leaves.
     for refract_only in [false, true] {
-        let glass = MaterialDesc::Dielectric {
+        let glass = MaterialDesc::Dielectric(DielectricDesc {
             ior: 1.5,
             refract_only,
-        };
+            ..Default::default()
+        });
         assert_white(&format!("glass refract_only={refract_only}"), glass, 500);
     }
 }
@@ -244,10 +249,11 @@ fn white_furnace_fuzzy_metal_loses_exactly_the_absorbed_light() {
         .sum();
     let expected = 1.0 - lost / (4.0 * f64::from(W) / f64::from(H));
 
-    let material = MaterialDesc::Metal {
+    let material = MaterialDesc::Metal(MetalDesc {
         albedo: [1.0; 3].into(),
         fuzz,
-    };
+        ..Default::default()
+    });
     let stats = pixel_stats(&furnace(material, W, H, 64, 50));
     let (mean, se) = stats.image(0);
     assert!(

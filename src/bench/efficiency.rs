@@ -10,7 +10,9 @@ use super::{time_renders, BUNNY_235K};
 use crate::film::Film;
 use crate::render::render;
 use crate::scene::builtin;
-use crate::scene::desc::{BackgroundDesc, MaterialDesc, SceneDesc};
+use crate::scene::desc::{
+    BackgroundDesc, DielectricDesc, DiffuseDesc, EmissiveDesc, MaterialDesc, MetalDesc, SceneDesc,
+};
 use crate::scene::{Integrator, Sampling, Scene, SceneError};
 use std::time::Duration;
 
@@ -31,14 +33,16 @@ pub fn sky_spheres() -> SceneDesc {
     };
     for material in desc.materials.values_mut() {
         match material {
-            MaterialDesc::Dielectric { .. } => {
-                *material = MaterialDesc::Metal {
+            MaterialDesc::Dielectric(DielectricDesc { .. }) => {
+                *material = MaterialDesc::Metal(MetalDesc {
                     albedo: [1.0, 1.0, 1.0].into(),
                     fuzz: 0.0,
-                }
+                    ..Default::default()
+                })
             }
-            MaterialDesc::Metal { fuzz, .. } => *fuzz = 0.0,
-            MaterialDesc::Diffuse { .. } | MaterialDesc::Emissive { .. } => {}
+            MaterialDesc::Metal(MetalDesc { fuzz, .. }) => *fuzz = 0.0,
+            MaterialDesc::Diffuse(DiffuseDesc { .. })
+            | MaterialDesc::Emissive(EmissiveDesc { .. }) => {}
         }
     }
     // As a scene file renders it: `integrator` at its default.
@@ -200,9 +204,10 @@ mod tests {
     fn sky_spheres_has_no_glass_no_fuzz_and_a_white_sky() {
         let desc = sky_spheres();
         assert!(desc.materials.values().all(|m| match m {
-            MaterialDesc::Metal { fuzz, .. } => *fuzz == 0.0,
-            MaterialDesc::Diffuse { .. } => true,
-            MaterialDesc::Dielectric { .. } | MaterialDesc::Emissive { .. } => false,
+            MaterialDesc::Metal(MetalDesc { fuzz, .. }) => *fuzz == 0.0,
+            MaterialDesc::Diffuse(DiffuseDesc { .. }) => true,
+            MaterialDesc::Dielectric(DielectricDesc { .. })
+            | MaterialDesc::Emissive(EmissiveDesc { .. }) => false,
         }));
         assert_eq!(
             desc.background,

@@ -6,7 +6,8 @@ use crate::render::{render, RenderStats};
 use crate::rng::Rng;
 use crate::scene::builtin;
 use crate::scene::desc::{
-    AttenuationDesc, BounceDesc, MaterialDesc, ObjectDesc, SceneDesc, TransformDesc,
+    AttenuationDesc, BounceDesc, DielectricDesc, DiffuseDesc, MaterialDesc, MetalDesc, ObjectDesc,
+    SceneDesc, TransformDesc,
 };
 use crate::scene::{Scene, SceneError};
 use std::time::{Duration, Instant};
@@ -68,10 +69,13 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
     desc.background = crate::scene::desc::BackgroundDesc::Solid {
         color: [1.0, 1.0, 1.0],
     };
-    let diffuse = |a: f64| MaterialDesc::Diffuse {
-        albedo: [a; 3].into(),
-        bounce: BounceDesc::Lambertian,
-        attenuation: AttenuationDesc::Scale,
+    let diffuse = |a: f64| {
+        MaterialDesc::Diffuse(DiffuseDesc {
+            albedo: [a; 3].into(),
+            bounce: BounceDesc::Lambertian,
+            attenuation: AttenuationDesc::Scale,
+            ..Default::default()
+        })
     };
     desc.materials.insert("bunny".into(), diffuse(0.7));
     desc.materials.insert("floor".into(), diffuse(0.5));
@@ -255,25 +259,28 @@ pub fn sphere_field(n: usize) -> SceneDesc {
         .map(|i| match i {
             0..=11 => (
                 format!("field-diffuse{i}"),
-                MaterialDesc::Diffuse {
+                MaterialDesc::Diffuse(DiffuseDesc {
                     albedo: [0; 3].map(|_| rng.next_f64() * rng.next_f64()).into(),
                     bounce: BounceDesc::Lambertian,
                     attenuation: AttenuationDesc::Scale,
-                },
+                    ..Default::default()
+                }),
             ),
             12..=14 => (
                 format!("field-metal{i}"),
-                MaterialDesc::Metal {
+                MaterialDesc::Metal(MetalDesc {
                     albedo: [0; 3].map(|_| 0.5 + 0.5 * rng.next_f64()).into(),
                     fuzz: 0.5 * rng.next_f64(),
-                },
+                    ..Default::default()
+                }),
             ),
             _ => (
                 "glass".to_string(),
-                MaterialDesc::Dielectric {
+                MaterialDesc::Dielectric(DielectricDesc {
                     ior: 1.5,
                     refract_only: false,
-                },
+                    ..Default::default()
+                }),
             ),
         })
         .collect();

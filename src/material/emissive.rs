@@ -1,10 +1,45 @@
 //! Emission: the light a surface gives off, such as a lamp's shade, a
 //! window or the light quad of a Cornell box. Any material may emit.
 
-use super::ColorParam;
+use super::param::{ColorDesc, ColorParam, ColorRange, Invalid, Textures};
+use super::Material;
 use crate::geometry::HitRecord;
 use crate::math::Color;
 use crate::texture::Texture;
+
+material_desc! {
+    /// A light: emits `radiance` and scatters nothing.
+    pub struct EmissiveDesc {
+        /// Emitted radiance per channel, ≥ 0 (may exceed 1), or a texture
+        /// giving it.
+        pub radiance: ColorDesc,
+    }
+}
+
+impl EmissiveDesc {
+    /// A one-sided light of radiance `radiance`.
+    pub fn new(radiance: impl Into<ColorDesc>) -> Self {
+        EmissiveDesc {
+            radiance: radiance.into(),
+            ..Default::default()
+        }
+    }
+
+    pub(super) fn compile(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<Material, Invalid> {
+        Ok(Material::emitter(Emission {
+            radiance: textures.color(
+                &format!("{field}.radiance"),
+                &self.radiance,
+                ColorRange::NonNegative,
+            )?,
+            two_sided: self.two_sided,
+        }))
+    }
+}
 
 /// The light a material gives off.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -37,6 +37,13 @@ pub enum Texture {
     /// image's bottom row at v = 0), repeating outside [0, 1]², blended
     /// bilinearly.
     Image(Arc<Image>),
+    /// Another texture of the table times a colour.
+    Scaled {
+        /// The texture scaled.
+        texture: u32,
+        /// The factor.
+        factor: Color,
+    },
     /// Perlin noise, grey, over the point in space scaled by `scale`.
     Noise {
         /// The noise function.
@@ -76,6 +83,9 @@ impl Texture {
                 table[*which as usize].value(table, uv, p)
             }
             Texture::Image(image) => image.bilinear_repeat(uv[0], 1.0 - uv[1]),
+            Texture::Scaled { texture, factor } => {
+                table[*texture as usize].value(table, uv, p) * *factor
+            }
             Texture::Noise {
                 perlin,
                 scale,
@@ -99,6 +109,7 @@ impl Texture {
             Texture::Checker { even, odd, .. } => {
                 table[*even as usize].uses_uv(table) || table[*odd as usize].uses_uv(table)
             }
+            Texture::Scaled { texture, .. } => table[*texture as usize].uses_uv(table),
             Texture::Solid(_) | Texture::Noise { .. } => false,
         }
     }

@@ -7,8 +7,9 @@
 
 use super::desc::{
     AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
-    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
-    SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple,
+    DielectricDesc, DiffuseDesc, EmissiveDesc, IntegratorDesc, MaterialDesc, MetalDesc,
+    NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, SceneDesc, ShadingDesc, TextureDesc,
+    TransformDesc, Triple,
 };
 use crate::rng::Rng;
 
@@ -289,11 +290,12 @@ fn figure(render: RenderDesc) -> RenderDesc {
 }
 
 fn diffuse(albedo: Triple, bounce: BounceDesc) -> MaterialDesc {
-    MaterialDesc::Diffuse {
+    MaterialDesc::Diffuse(DiffuseDesc {
         albedo: albedo.into(),
         bounce,
         attenuation: AttenuationDesc::Scale,
-    }
+        ..Default::default()
+    })
 }
 
 fn lambertian(albedo: Triple) -> MaterialDesc {
@@ -301,14 +303,19 @@ fn lambertian(albedo: Triple) -> MaterialDesc {
 }
 
 fn metal(albedo: Triple, fuzz: f64) -> MaterialDesc {
-    MaterialDesc::Metal {
+    MaterialDesc::Metal(MetalDesc {
         albedo: albedo.into(),
         fuzz,
-    }
+        ..Default::default()
+    })
 }
 
 fn glass_material(ior: f64, refract_only: bool) -> MaterialDesc {
-    MaterialDesc::Dielectric { ior, refract_only }
+    MaterialDesc::Dielectric(DielectricDesc {
+        ior,
+        refract_only,
+        ..Default::default()
+    })
 }
 
 const BLUE: BackgroundDesc = BackgroundDesc::Solid {
@@ -397,10 +404,13 @@ fn bounce(model: BounceDesc) -> SceneDesc {
 }
 
 fn albedo_grey(attenuation: AttenuationDesc) -> SceneDesc {
-    let m = |a: f64| MaterialDesc::Diffuse {
-        albedo: [a; 3].into(),
-        bounce: BounceDesc::Lambertian,
-        attenuation,
+    let m = |a: f64| {
+        MaterialDesc::Diffuse(DiffuseDesc {
+            albedo: [a; 3].into(),
+            bounce: BounceDesc::Lambertian,
+            attenuation,
+            ..Default::default()
+        })
     };
     sphere_on_ground(render(100, 2.0), m(0.5), m(0.2)).build()
 }
@@ -627,11 +637,12 @@ const NEXT_WEEK_SKY: BackgroundDesc = BackgroundDesc::Solid {
 
 /// A diffuse material whose albedo is texture `texture`.
 fn textured(texture: &str) -> MaterialDesc {
-    MaterialDesc::Diffuse {
+    MaterialDesc::Diffuse(DiffuseDesc {
         albedo: ColorDesc::Texture(texture.to_string()),
         bounce: BounceDesc::Lambertian,
         attenuation: AttenuationDesc::Scale,
-    }
+        ..Default::default()
+    })
 }
 
 /// Two spheres of radius 10, one above the other, touching at the origin,
@@ -744,10 +755,11 @@ fn simple_light() -> SceneDesc {
     }
     .material(
         "light",
-        MaterialDesc::Emissive {
+        MaterialDesc::Emissive(EmissiveDesc {
             radiance: [4.0; 3].into(),
             two_sided: true,
-        },
+            ..Default::default()
+        }),
     )
     .sphere([0.0, 7.0, 0.0], 2.0, "light")
     .quad([3.0, 1.0, -2.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], "light")
@@ -788,10 +800,11 @@ fn cornell_walls(
         .material("green", lambertian([0.12, 0.45, 0.15]))
         .material(
             "light",
-            MaterialDesc::Emissive {
+            MaterialDesc::Emissive(EmissiveDesc {
                 radiance: [radiance; 3].into(),
                 two_sided,
-            },
+                ..Default::default()
+            }),
         )
         .quad(
             [555.0, 0.0, 0.0],
@@ -867,10 +880,11 @@ fn next_week_final() -> SceneDesc {
     b = b
         .material(
             "light",
-            MaterialDesc::Emissive {
+            MaterialDesc::Emissive(EmissiveDesc {
                 radiance: [7.0; 3].into(),
                 two_sided: true,
-            },
+                ..Default::default()
+            }),
         )
         .quad(
             [123.0, 554.0, 147.0],

@@ -3,8 +3,8 @@
 //! placed once in world space or shared by instances.
 
 use super::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc,
-    ScaleDesc, TransformDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc, ScalarDesc, ScaleDesc,
+    TransformDesc, MAX_SEED,
 };
 use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
 use super::{
@@ -15,9 +15,8 @@ use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
-use crate::material::{
-    Attenuation, BounceModel, ColorParam, Dielectric, Diffuse, Emission, Kind, Material, Metal,
-};
+use crate::material::param::{self, ColorRange, Range};
+use crate::material::{ColorParam, Invalid, Kind, Material, ScalarParam, Textures};
 use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
@@ -947,69 +946,55 @@ fn compile_material<'a>(
     textures: &mut TextureTable<'a>,
     sources: &mut Vec<MeshSource>,
 ) -> Result<Material, SceneError> {
-    let mut colour = |name: &str, c: &'a ColorDesc, check| -> Result<ColorParam, SceneError> {
-        Ok(
-            match textures.color(&format!("{field}.{name}"), c, check, sources)? {
-                ColorRef::Rgb(c) => ColorParam::Const(c),
-                ColorRef::Texture(t) => ColorParam::Texture(t),
-            },
-        )
-    };
-    let kind = match m {
-        MaterialDesc::Diffuse {
-            albedo: a,
-            bounce,
-            attenuation,
-        } => Kind::Diffuse(Diffuse {
-            albedo: colour("albedo", a, albedo)?,
-            bounce: match bounce {
-                BounceDesc::Cube => BounceModel::Cube,
-                BounceDesc::SphereVolume => BounceModel::SphereVolume,
-                BounceDesc::Lambertian => BounceModel::Lambertian,
-                BounceDesc::Hemisphere => BounceModel::Hemisphere,
-            },
-            attenuation: match attenuation {
-                AttenuationDesc::Scale => Attenuation::Scale,
-                AttenuationDesc::Absorb => Attenuation::Absorb,
-            },
-        }),
-        MaterialDesc::Metal { albedo: a, fuzz } => {
-            finite(format_args!("{field}.fuzz"), &[*fuzz])?;
-            if !(0.0..=1.0).contains(fuzz) {
-                return Err(invalid(
-                    format!("{field}.fuzz"),
-                    format!("must be in [0, 1], got {fuzz}"),
-                ));
+    m.compile(field, &mut MaterialTextures { textures, sources })
+        .map_err(|e| invalid(e.field, e.message))
+}
+
+/// The scene's textures as a material being compiled finds them.
+struct MaterialTextures<'t, 'a> {
+    textures: &'t mut TextureTable<'a>,
+    sources: &'t mut Vec<MeshSource>,
+}
+
+impl Textures for MaterialTextures<'_, '_> {
+    fn color(
+        &mut self,
+        field: &str,
+        c: &ColorDesc,
+        range: ColorRange,
+    ) -> Result<ColorParam, Invalid> {
+        let check = match range {
+            ColorRange::NonNegative => color,
+            ColorRange::Unit => albedo,
+        };
+        match self.textures.color(field, c, check, self.sources) {
+            Ok(ColorRef::Rgb(c)) => Ok(ColorParam::Const(c)),
+            Ok(ColorRef::Texture(t)) => Ok(ColorParam::Texture(t)),
+            Err(e) => Err(Invalid::new(e.field(), e.message())),
+        }
+    }
+
+    fn scalar(
+        &mut self,
+        field: &str,
+        s: &ScalarDesc,
+        range: Range,
+    ) -> Result<ScalarParam, Invalid> {
+        match s {
+            ScalarDesc::Value(v) => Ok(ScalarParam::Const(param::number(field, *v, range)?)),
+            ScalarDesc::Texture(name) => {
+                let c = ColorDesc::Texture(name.clone());
+                match self.color(field, &c, ColorRange::NonNegative)? {
+                    ColorParam::Texture(t) => Ok(ScalarParam::Texture(t)),
+                    ColorParam::Const(_) => unreachable!("a name is a texture"),
+                }
             }
-            Kind::Metal(Metal {
-                albedo: colour("albedo", a, albedo)?,
-                fuzz: *fuzz as f32,
-            })
         }
-        MaterialDesc::Dielectric { ior, refract_only } => {
-            finite(format_args!("{field}.ior"), &[*ior])?;
-            if !(*ior as f32 > 0.0) {
-                return Err(invalid(
-                    format!("{field}.ior"),
-                    format!("index of refraction must be greater than 0, got {ior}"),
-                ));
-            }
-            Kind::Dielectric(Dielectric {
-                ior: *ior as f32,
-                refract_only: *refract_only,
-            })
-        }
-        MaterialDesc::Emissive {
-            radiance,
-            two_sided,
-        } => {
-            return Ok(Material::emitter(Emission {
-                radiance: colour("radiance", radiance, color)?,
-                two_sided: *two_sided,
-            }))
-        }
-    };
-    Ok(Material::new(kind))
+    }
+
+    fn scaled(&mut self, t: u32, factor: Color) -> u32 {
+        self.textures.push(Texture::Scaled { texture: t, factor })
+    }
 }
 
 #[cfg(test)]

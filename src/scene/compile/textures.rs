@@ -42,12 +42,18 @@ impl<'a> TextureTable<'a> {
         }
     }
 
+    /// Adds `texture` to the table; its index.
+    pub(crate) fn push(&mut self, texture: Texture) -> u32 {
+        self.textures.push(texture);
+        self.textures.len() as u32 - 1
+    }
+
     /// The colour parameter `field` given by `c`; `check` validates a
     /// colour given outright. Image files read are added to `sources`.
     pub(crate) fn color(
         &mut self,
         field: &str,
-        c: &'a ColorDesc,
+        c: &ColorDesc,
         check: fn(&str, [f64; 3]) -> Result<Color, SceneError>,
         sources: &mut Vec<MeshSource>,
     ) -> Result<ColorRef, SceneError> {
@@ -86,7 +92,7 @@ impl<'a> TextureTable<'a> {
     fn named(
         &mut self,
         field: &str,
-        name: &'a str,
+        name: &str,
         chain: &mut Vec<&'a str>,
         sources: &mut Vec<MeshSource>,
     ) -> Result<u32, SceneError> {
@@ -107,7 +113,7 @@ impl<'a> TextureTable<'a> {
             ));
         };
         if chain.contains(&name) {
-            chain.push(name);
+            chain.push(key);
             return Err(invalid(
                 format!("textures.{name}"),
                 format!("refers to itself: {}", chain.join(" → ")),

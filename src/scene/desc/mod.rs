@@ -10,8 +10,10 @@ pub use crate::light::LightSelection;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// An RGB triple or a 3-D point/vector.
-pub type Triple = [f64; 3];
+pub use crate::material::param::{ColorDesc, RoughnessDesc, ScalarDesc, Triple};
+pub use crate::material::{
+    AttenuationDesc, BounceDesc, DielectricDesc, DiffuseDesc, EmissiveDesc, MaterialDesc, MetalDesc,
+};
 
 /// Largest seed (of a render or of a noise texture): 2⁶³−1, the largest
 /// integer TOML can write, so that every scene, however it was made (JSON,
@@ -338,71 +340,6 @@ impl Default for BackgroundDesc {
     }
 }
 
-/// A material.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum MaterialDesc {
-    /// A matte surface.
-    Diffuse {
-        /// Reflected fraction per channel, each in [0, 1], or a texture
-        /// giving it.
-        albedo: ColorDesc,
-        /// Bounce direction model.
-        #[serde(default)]
-        bounce: BounceDesc,
-        /// How the albedo is applied.
-        #[serde(default)]
-        attenuation: AttenuationDesc,
-    },
-    /// A reflective metal.
-    Metal {
-        /// Reflection colour, each channel in [0, 1], or a texture giving
-        /// it.
-        albedo: ColorDesc,
-        /// Blur of the reflection, in [0, 1].
-        #[serde(default)]
-        fuzz: f64,
-    },
-    /// A clear refracting material.
-    Dielectric {
-        /// Index of refraction, > 0.
-        ior: f64,
-        /// Never reflect partially (no Schlick term).
-        #[serde(default)]
-        refract_only: bool,
-    },
-    /// A light: emits `radiance` and scatters nothing.
-    Emissive {
-        /// Emitted radiance per channel, ≥ 0 (may exceed 1), or a texture
-        /// giving it.
-        radiance: ColorDesc,
-        /// Emit from both sides (the book's diffuse light); otherwise only
-        /// from the side the outward normal points to.
-        #[serde(default, skip_serializing_if = "is_false")]
-        two_sided: bool,
-    },
-}
-
-fn is_false(b: &bool) -> bool {
-    !*b
-}
-
-/// A colour given outright, or by naming a texture of `textures`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum ColorDesc {
-    /// The colour.
-    Rgb(Triple),
-    /// The name of a texture.
-    Texture(String),
-}
-
-impl From<Triple> for ColorDesc {
-    fn from(c: Triple) -> Self {
-        ColorDesc::Rgb(c)
-    }
-}
-
 /// A texture (see [`crate::texture::Texture`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
@@ -451,33 +388,6 @@ pub enum NoisePatternDesc {
     Turbulence,
     /// Veined marble along z.
     Marble,
-}
-
-/// Diffuse bounce model (see [`crate::material::BounceModel`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BounceDesc {
-    /// Random point on the surface of a cube around p + N.
-    Cube,
-    /// Random point inside the unit sphere at p + N.
-    SphereVolume,
-    /// Random point on the surface of the unit sphere at p + N.
-    #[default]
-    Lambertian,
-    /// Uniform direction in the hemisphere around N.
-    Hemisphere,
-}
-
-/// Diffuse attenuation form (see [`crate::material::Attenuation`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AttenuationDesc {
-    /// Multiply the colour by the albedo.
-    #[default]
-    Scale,
-    /// Absorb rays with probability 1 − p, p = the albedo's largest
-    /// component; survivors are multiplied by albedo / p.
-    Absorb,
 }
 
 /// An object of the scene. Every kind may be placed with a `transform`.

@@ -9,12 +9,14 @@
 //! users alike.
 
 use super::hint;
+use super::node_de::NodeDe;
 use super::source::{Entry, Node, Value};
 use crate::light::LightSelection;
+use crate::material::KindInfo;
 use crate::scene::desc::{
-    AttenuationDesc, BackgroundDesc, BounceDesc, BoundaryDesc, CameraDesc, ColorDesc,
-    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
-    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, IntegratorDesc, MaterialDesc,
+    NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc,
+    TextureDesc, TransformDesc, Triple, MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -611,109 +613,68 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
     })
 }
 
-const BOUNCES: &[(&str, BounceDesc)] = &[
-    ("cube", BounceDesc::Cube),
-    ("sphere-volume", BounceDesc::SphereVolume),
-    ("lambertian", BounceDesc::Lambertian),
-    ("hemisphere", BounceDesc::Hemisphere),
-];
-
-const ATTENUATIONS: &[(&str, AttenuationDesc)] = &[
-    ("scale", AttenuationDesc::Scale),
-    ("absorb", AttenuationDesc::Absorb),
-];
-
-#[derive(Clone, Copy)]
-enum MaterialKind {
-    Diffuse,
-    Metal,
-    Dielectric,
-    Emissive,
+/// A material: its `type` read first, then the kind's fields as the kind
+/// declares them (see [`crate::material::MaterialDesc`]); a field that
+/// belongs to other kinds says which.
+fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
+    let kinds = crate::material::kinds();
+    let k = kind_of(node, path, "a material", &kinds, "materials")?;
+    MaterialDesc::deserialize_kind(
+        k.name,
+        NodeDe {
+            node,
+            path: path.to_string(),
+            what: k.what,
+            skip: Some("type"),
+        },
+    )
+    .map_err(|e| e.into_decode(path, &node.span, k.what))
 }
 
-const MATERIALS: &[Kind<MaterialKind>] = &[
-    Kind {
-        name: "diffuse",
-        kind: MaterialKind::Diffuse,
-        what: "a diffuse material",
-        fields: &["type", "albedo", "bounce", "attenuation"],
-        elsewhere: &[
-            ("fuzz", "metal materials"),
-            ("ior", "dielectric materials"),
-            ("refract_only", "dielectric materials"),
-            ("radiance", "emissive materials"),
-            ("two_sided", "emissive materials"),
-        ],
-    },
-    Kind {
-        name: "metal",
-        kind: MaterialKind::Metal,
-        what: "a metal material",
-        fields: &["type", "albedo", "fuzz"],
-        elsewhere: &[
-            ("bounce", "diffuse materials"),
-            ("attenuation", "diffuse materials"),
-            ("ior", "dielectric materials"),
-            ("refract_only", "dielectric materials"),
-            ("radiance", "emissive materials"),
-            ("two_sided", "emissive materials"),
-        ],
-    },
-    Kind {
-        name: "dielectric",
-        kind: MaterialKind::Dielectric,
-        what: "a dielectric material",
-        fields: &["type", "ior", "refract_only"],
-        elsewhere: &[
-            ("albedo", "diffuse and metal materials"),
-            ("fuzz", "metal materials"),
-            ("bounce", "diffuse materials"),
-            ("attenuation", "diffuse materials"),
-            ("radiance", "emissive materials"),
-            ("two_sided", "emissive materials"),
-        ],
-    },
-    Kind {
-        name: "emissive",
-        kind: MaterialKind::Emissive,
-        what: "an emissive material",
-        fields: &["type", "radiance", "two_sided"],
-        elsewhere: &[
-            ("albedo", "diffuse and metal materials"),
-            ("fuzz", "metal materials"),
-            ("bounce", "diffuse materials"),
-            ("attenuation", "diffuse materials"),
-            ("ior", "dielectric materials"),
-            ("refract_only", "dielectric materials"),
-        ],
-    },
-];
+/// The kind of `node` among `kinds` by its `type`, its fields checked
+/// against the kind's: `what` names the table in messages ("a material"),
+/// `plural` the kinds in hints ("materials").
+fn kind_of<'k>(
+    node: &Node,
+    path: &str,
+    what: &str,
+    kinds: &'k [KindInfo],
+    plural: &str,
+) -> Result<&'k KindInfo> {
+    let mut all: Vec<&str> = Vec::new();
+    for f in kinds.iter().flat_map(|k| k.fields.iter().copied()) {
+        if !all.contains(&f) {
+            all.push(f);
+        }
+    }
+    let any = Table::new(node, path, what, &all, &[])?;
+    let names: Vec<(&str, usize)> = kinds.iter().enumerate().map(|(i, k)| (k.name, i)).collect();
+    let k = &kinds[keyword(any.required("type", what)?, &any.path("type"), &names)?];
+    // The fields of the other kinds, each with the kinds it belongs to.
+    let owners: Vec<(&str, String)> = all
+        .iter()
+        .filter(|f| !k.fields.contains(f))
+        .map(|&f| {
+            let with: Vec<&str> = kinds
+                .iter()
+                .filter(|o| o.fields.contains(&f))
+                .map(|o| o.name)
+                .collect();
+            (f, format!("{} {plural}", and_list(&with)))
+        })
+        .collect();
+    let elsewhere: Vec<(&str, &str)> = owners.iter().map(|(f, o)| (*f, o.as_str())).collect();
+    Table::new(node, path, k.what, &k.fields, &elsewhere)?;
+    Ok(k)
+}
 
-fn material(node: &Node, path: &str) -> Result<MaterialDesc> {
-    let (kind, what, t) = tagged(node, path, "a material", MATERIALS)?;
-    Ok(match kind {
-        MaterialKind::Diffuse => MaterialDesc::Diffuse {
-            albedo: t.require("albedo", what, color_or_texture)?,
-            bounce: t
-                .optional("bounce", |n, p| keyword(n, p, BOUNCES))?
-                .unwrap_or_default(),
-            attenuation: t
-                .optional("attenuation", |n, p| keyword(n, p, ATTENUATIONS))?
-                .unwrap_or_default(),
-        },
-        MaterialKind::Metal => MaterialDesc::Metal {
-            albedo: t.require("albedo", what, color_or_texture)?,
-            fuzz: t.optional("fuzz", float)?.unwrap_or(0.0),
-        },
-        MaterialKind::Dielectric => MaterialDesc::Dielectric {
-            ior: t.require("ior", what, float)?,
-            refract_only: t.optional("refract_only", boolean)?.unwrap_or(false),
-        },
-        MaterialKind::Emissive => MaterialDesc::Emissive {
-            radiance: t.require("radiance", what, color_or_texture)?,
-            two_sided: t.optional("two_sided", boolean)?.unwrap_or(false),
-        },
-    })
+/// "a", "a and b", "a, b and c".
+fn and_list(items: &[&str]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
 }
 
 #[derive(Clone, Copy)]

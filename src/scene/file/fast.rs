@@ -17,8 +17,8 @@ use super::plain_toml;
 use super::toml_cut;
 use super::Format;
 use crate::scene::desc::{
-    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, MaterialDesc, ObjectDesc, RenderDesc,
-    ScaleDesc, SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, ObjectDesc, RenderDesc, ScaleDesc,
+    SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
 };
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -87,7 +87,9 @@ struct Batch {
 
 fn toml(text: &str) -> Option<SceneDesc> {
     let split = toml_cut::split(text)?;
-    let mut desc: SceneDesc = ::toml::from_str(&split.rest).ok()?;
+    // Everything but the objects is small: read by the precise reader.
+    let rest = super::tree(&split.rest, Format::Toml).ok()?;
+    let mut desc = super::decode::scene(&rest).ok()?;
     if split.objects.is_empty() {
         return Some(desc);
     }
@@ -135,13 +137,14 @@ fn read_batch(text: &str, tables: &[Range<usize>]) -> Option<Vec<ObjectDesc>> {
 
 /// What the precise reader checks beyond the types serde knows: counts of
 /// at least 1, seeds of at most [`MAX_SEED`], finite numbers (TOML has
-/// `nan` and `inf`).
+/// `nan` and `inf`). Materials need no check: in TOML they are read by the
+/// precise reader with the rest of the file around the objects, and JSON
+/// has no numbers that are not finite.
 fn within_limits(d: &SceneDesc) -> bool {
     render(&d.render)
         && camera(&d.camera)
         && background(&d.background)
         && d.textures.values().all(texture)
-        && d.materials.values().all(material)
         && d.objects.iter().all(object)
 }
 
@@ -192,15 +195,6 @@ fn texture(t: &TextureDesc) -> bool {
         TextureDesc::Checker { scale, even, odd } => finite(&[*scale]) && color(even) && color(odd),
         TextureDesc::Image { .. } => true,
         TextureDesc::Noise { scale, seed, .. } => finite(&[*scale]) && *seed <= MAX_SEED,
-    }
-}
-
-fn material(m: &MaterialDesc) -> bool {
-    match m {
-        MaterialDesc::Diffuse { albedo, .. } => color(albedo),
-        MaterialDesc::Metal { albedo, fuzz } => color(albedo) && finite(&[*fuzz]),
-        MaterialDesc::Dielectric { ior, .. } => finite(&[*ior]),
-        MaterialDesc::Emissive { radiance, .. } => color(radiance),
     }
 }
 

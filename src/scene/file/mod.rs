@@ -23,6 +23,7 @@ mod decode;
 pub mod export;
 mod fast;
 pub mod hint;
+mod node_de;
 mod plain_toml;
 pub mod source;
 mod toml_cut;
@@ -353,7 +354,7 @@ fn drop_bom(text: &mut String) {
 /// The tree of `text`'s values and their positions. Nothing but whitespace
 /// is the empty scene in both formats, as an empty TOML document is (JSON
 /// would call it a syntax error).
-fn tree(text: &str, format: Format) -> Result<Node, source::SyntaxError> {
+pub(super) fn tree(text: &str, format: Format) -> Result<Node, source::SyntaxError> {
     if is_blank(text) {
         return Ok(Node {
             span: 0..0,
