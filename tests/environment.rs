@@ -14,7 +14,7 @@ use common::{
     assert_tiles_agree, compile_file, furnace_desc, pixel_stats, scene_file, scene_file_error,
     scratch_dir, tiles_agree, PixelStats, K,
 };
-use lumen::scene::desc::{DiffuseDesc, EmissiveDesc, MaterialDesc, MetalDesc};
+use lumen::scene::desc::{DiffuseDesc, MaterialDesc};
 use lumen::scene::{Integrator, LightSelection, Overrides, Sampling, Scene};
 use std::path::Path;
 
