@@ -1,7 +1,11 @@
-//! The notes' dielectric: Snell refraction, total internal reflection and
-//! Schlick's approximation of Fresnel reflectance.
+//! Dielectrics: the notes' glass (Snell refraction, total internal
+//! reflection and Schlick's approximation of Fresnel reflectance), and
+//! glass by the exact Fresnel equations, smooth or rough (Walter et al.
+//! 2007; pbrt-v4's `DielectricBxDF`, Mitsuba 3's `roughdielectric`).
 
+use super::fresnel;
 use super::metal::reflect;
+use super::microfacet::Microfacet;
 use super::{Bsdf, BsdfSample, LobeFlags};
 use crate::math::{Color, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -76,6 +80,142 @@ impl SmoothDielectric {
             pdf: 0.0,
             flags: side | LobeFlags::SPECULAR,
         })
+    }
+}
+
+/// A dielectric interface at one point, in the local frame (z on the side
+/// light leaves to along `wo`): the exact Fresnel equations choose between
+/// reflection and transmission.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactDielectric {
+    /// The index of refraction below the surface (−z) over the index above
+    /// it (+z): 1.5 for glass seen from the air, 1/1.5 from inside.
+    pub eta: f32,
+    /// The microfacets; `None` for a smooth interface.
+    pub roughness: Option<Microfacet>,
+}
+
+impl ExactDielectric {
+    /// What kind of scattering it does.
+    pub fn flags(&self) -> LobeFlags {
+        let spread = match self.roughness {
+            Some(_) if self.eta != 1.0 => LobeFlags::GLOSSY,
+            _ => LobeFlags::SPECULAR,
+        };
+        if self.eta == 1.0 {
+            LobeFlags::TRANSMISSION | spread
+        } else {
+            LobeFlags::REFLECTION | LobeFlags::TRANSMISSION | spread
+        }
+    }
+
+    /// A direction for light leaving along `wo`, from `uc` (reflect or
+    /// transmit) and `u` (the microfacet), uniform in [0, 1).
+    #[inline]
+    pub fn sample(&self, wo: Vec3, uc: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let Some(d) = self.roughness.filter(|_| self.eta != 1.0) else {
+            return self.sample_smooth(wo, uc);
+        };
+        // Sampled as seen from the side `wo` is on.
+        let up = if wo.z < 0.0 { -wo } else { wo };
+        let wm = d.sample_wm(up, u);
+        // A microfacet seen from behind (Beckmann's normals are not drawn
+        // as seen) scatters nothing.
+        if !(up.dot(wm) > 0.0) {
+            return None;
+        }
+        let r = fresnel::dielectric(wo.dot(wm), self.eta);
+        let (wi, flags) = if uc < r {
+            (fresnel::reflect(wo, wm), LobeFlags::REFLECTION)
+        } else {
+            (
+                fresnel::refract(wo, wm, self.eta)?.0,
+                LobeFlags::TRANSMISSION,
+            )
+        };
+        let reflected = wi.z * wo.z > 0.0;
+        if reflected != (flags == LobeFlags::REFLECTION) || wi.z == 0.0 {
+            return None;
+        }
+        // Evaluated as `eval_and_pdf` evaluates it, so that a sample's
+        // density is the one light sampling weighs it against.
+        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
+        let value = f_cos / pdf;
+        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
+            value,
+            wi,
+            pdf,
+            flags: flags | LobeFlags::GLOSSY,
+        })
+    }
+
+    /// The smooth interface: mirror reflection or Snell refraction, chosen
+    /// in proportion to the Fresnel reflectance.
+    fn sample_smooth(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
+        let r = fresnel::dielectric(wo.z, self.eta);
+        let t = 1.0 - r;
+        if uc < r {
+            return Some(BsdfSample {
+                value: Color::ONE,
+                wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                pdf: r,
+                flags: LobeFlags::REFLECTION | LobeFlags::SPECULAR,
+            });
+        }
+        let (wi, etap) = fresnel::refract(wo, Vec3::Z, self.eta)?;
+        Some(BsdfSample {
+            // Radiance is compressed into the smaller solid angle of the
+            // denser side (divided by η² going in).
+            value: Color::splat(1.0 / (etap * etap)),
+            wi,
+            pdf: t,
+            flags: LobeFlags::TRANSMISSION | LobeFlags::SPECULAR,
+        })
+    }
+
+    /// f(wo, wi)·|cos θi| and the density of `wi` (zero when smooth).
+    #[inline]
+    pub fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        let Some(d) = self.roughness.filter(|_| self.eta != 1.0) else {
+            return (Color::ZERO, 0.0);
+        };
+        let (cos_o, cos_i) = (wo.z, wi.z);
+        if cos_o == 0.0 || cos_i == 0.0 {
+            return (Color::ZERO, 0.0);
+        }
+        let reflect = cos_o * cos_i > 0.0;
+        let etap = match (reflect, cos_o > 0.0) {
+            (true, _) => 1.0,
+            (false, true) => self.eta,
+            (false, false) => 1.0 / self.eta,
+        };
+        // The generalised half vector, turned to +z.
+        let wm = (wi * etap + wo).normalize_or_zero();
+        if wm == Vec3::ZERO {
+            return (Color::ZERO, 0.0);
+        }
+        let wm = if wm.z < 0.0 { -wm } else { wm };
+        let (dot_o, dot_i) = (wo.dot(wm), wi.dot(wm));
+        // Microfacets seen from behind reflect and transmit nothing.
+        if dot_i * cos_i < 0.0 || dot_o * cos_o < 0.0 {
+            return (Color::ZERO, 0.0);
+        }
+        let up = if cos_o < 0.0 { -wo } else { wo };
+        let r = fresnel::dielectric(dot_o, self.eta);
+        if reflect {
+            let f_cos = d.d(wm) * d.g(wo, wi) * r / (4.0 * cos_o.abs());
+            let pdf = d.pdf(up, wm) / (4.0 * dot_o.abs()) * r;
+            return (Color::splat(f_cos), pdf);
+        }
+        let t = 1.0 - r;
+        let denom = (dot_i + dot_o / etap).powi(2);
+        let f_cos =
+            t * d.d(wm) * d.g(wo, wi) * (dot_i * dot_o / (cos_o * denom)).abs() / (etap * etap);
+        let pdf = d.pdf(up, wm) * dot_i.abs() / denom * t;
+        (Color::splat(f_cos), pdf)
     }
 }
 

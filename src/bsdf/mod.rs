@@ -23,12 +23,17 @@
 //! figures keep their bits; the fuzzy metal and the bounce models other than
 //! the Lambertian have no density written down and are sampled only.
 
+pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod fresnel;
 pub mod metal;
+pub mod microfacet;
+#[cfg(test)]
+mod tests;
 
 use crate::math::{Color, Vec3};
-use crate::sampler::Sampler;
+use crate::sampler::{Dim, Sampler};
 
 /// An orthonormal frame: tangent `t`, bitangent `b` and normal `n`, with
 /// `t × b = n`.
@@ -167,6 +172,58 @@ pub enum Lobe {
     Metal(metal::FuzzyMetal),
     /// The notes' glass: Snell refraction, Schlick reflection.
     Dielectric(dielectric::SmoothDielectric),
+    /// A metal: smooth or rough, by its complex index of refraction.
+    Conductor(conductor::Conductor),
+    /// Glass by the exact Fresnel equations, smooth or rough.
+    ExactDielectric(dielectric::ExactDielectric),
+}
+
+impl Lobe {
+    /// Whether it works in the local frame (every lobe but the notes').
+    #[inline(always)]
+    pub fn is_local(&self) -> bool {
+        !matches!(
+            self,
+            Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_)
+        )
+    }
+
+    /// What kind of scattering it can do.
+    pub fn flags(&self) -> LobeFlags {
+        let book = |f| LobeFlags::REFLECTION | f;
+        match self {
+            Lobe::Diffuse(_) => book(LobeFlags::DIFFUSE),
+            Lobe::Metal(m) if m.fuzz == 0.0 => book(LobeFlags::SPECULAR),
+            Lobe::Metal(_) => book(LobeFlags::GLOSSY),
+            Lobe::Dielectric(_) => {
+                LobeFlags::REFLECTION | LobeFlags::TRANSMISSION | LobeFlags::SPECULAR
+            }
+            Lobe::Conductor(c) => c.flags(),
+            Lobe::ExactDielectric(d) => d.flags(),
+        }
+    }
+
+    /// A direction for light leaving along local `wo`, from `uc` (a
+    /// discrete choice) and `u`, uniform in [0, 1); the local lobes only.
+    #[inline(always)]
+    pub fn sample_local(&self, wo: Vec3, uc: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        match self {
+            Lobe::Conductor(c) => c.sample(wo, u),
+            Lobe::ExactDielectric(d) => d.sample(wo, uc, u),
+            Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => None,
+        }
+    }
+
+    /// f(wo, wi)·|cos θi| and the density of `wi` for local directions;
+    /// the local lobes only.
+    #[inline(always)]
+    pub fn eval_and_pdf_local(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        match self {
+            Lobe::Conductor(c) => c.eval_and_pdf(wo, wi),
+            Lobe::ExactDielectric(d) => d.eval_and_pdf(wo, wi),
+            Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),
+        }
+    }
 }
 
 /// How a surface scatters at one point: its frame and its lobe.
@@ -204,6 +261,7 @@ impl Bsdf {
         match &self.lobe {
             Lobe::Diffuse(d) => d.is_lambertian(),
             Lobe::Metal(_) | Lobe::Dielectric(_) => false,
+            lobe => !lobe.flags().is_specular(),
         }
     }
 
@@ -216,7 +274,25 @@ impl Bsdf {
             Lobe::Diffuse(d) => d.sample(self, sampler),
             Lobe::Metal(m) => m.sample(self, wo, sampler),
             Lobe::Dielectric(d) => d.sample(self, wo, sampler),
+            lobe => {
+                let uc = sampler.get_1d(Dim::BsdfChoice);
+                let u = sampler.get_2d(Dim::Bsdf);
+                let s = lobe.sample_local(self.frame.to_local(wo), uc, u)?;
+                let wi = self.frame.to_world(s.wi);
+                (self.sides_agree(wo, wi, s.flags.is_transmission()) && s.value.is_finite())
+                    .then_some(BsdfSample { wi, ..s })
+            }
         }
+    }
+
+    /// Whether `wi` lies on the side of the true surface that reflection
+    /// (or transmission) from `wo` goes to: a shading normal that differs
+    /// from the geometric one must not let light through a surface, nor
+    /// reflect it from behind.
+    #[inline(always)]
+    fn sides_agree(&self, wo: Vec3, wi: Vec3, transmission: bool) -> bool {
+        let (o, i) = (wo.dot(self.ng), wi.dot(self.ng));
+        o != 0.0 && i != 0.0 && ((o * i < 0.0) == transmission)
     }
 
     /// f(wo, wi)·|cos θi| for unit world directions `wo` and `wi` (both
@@ -235,10 +311,18 @@ impl Bsdf {
 
     /// [`eval`](Self::eval) and [`pdf`](Self::pdf) together.
     #[inline(always)]
-    pub fn eval_and_pdf(&self, _wo: Vec3, wi: Vec3) -> (Color, f32) {
+    pub fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
         match &self.lobe {
             Lobe::Diffuse(d) => d.eval_and_pdf(self, wi),
             Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),
+            lobe => {
+                let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+                let transmission = lo.z * li.z < 0.0;
+                if !self.sides_agree(wo, wi, transmission) {
+                    return (Color::ZERO, 0.0);
+                }
+                lobe.eval_and_pdf_local(lo, li)
+            }
         }
     }
 

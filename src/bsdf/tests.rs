@@ -1,0 +1,634 @@
+//! The harness every lobe plugs into: χ² of its sampling against its pdf,
+//! the consistency of `sample`, `eval` and `pdf`, energy, reciprocity, and
+//! no NaN anywhere (pbrt-v4's `bsdfs_test.cpp` method).
+//!
+//! A lobe is added to the tests by one entry of [`lobes`].
+
+use super::conductor::Conductor;
+use super::dielectric::ExactDielectric;
+use super::microfacet::{Microfacet, Model};
+use super::{BsdfSample, Lobe};
+use crate::math::{Color, Vec3};
+use crate::rng::Rng;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// A lobe under test and what it is called in messages.
+struct Case {
+    name: String,
+    lobe: Lobe,
+}
+
+/// Gold's index of refraction (Mitsuba's RGB).
+const GOLD_ETA: Vec3 = Vec3::new(0.143_036, 0.375_307, 1.442_045);
+const GOLD_K: Vec3 = Vec3::new(3.982_997, 2.385_556, 1.603_359);
+
+/// The roughnesses tested (α = roughness²), and the anisotropic pairs.
+const ROUGHNESSES: [f32; 4] = [0.05, 0.3, 0.7, 1.0];
+
+fn distributions() -> Vec<(String, Microfacet)> {
+    let mut out = Vec::new();
+    for model in [Model::Ggx, Model::Beckmann] {
+        for r in ROUGHNESSES {
+            let a = r * r;
+            out.push((format!("{model:?} r {r}"), Microfacet::new(a, a, model)));
+            // Anisotropic: half as rough along the bitangent.
+            let b = 0.5 * r * (0.5 * r);
+            out.push((
+                format!("{model:?} r {r}/{}", 0.5 * r),
+                Microfacet::new(a, b, model),
+            ));
+        }
+    }
+    out
+}
+
+/// Every lobe with a density, in every configuration the tests cover.
+fn lobes() -> Vec<Case> {
+    let mut cases = Vec::new();
+    for (what, d) in distributions() {
+        cases.push(Case {
+            name: format!("conductor {what}"),
+            lobe: Lobe::Conductor(Conductor {
+                eta: GOLD_ETA,
+                k: GOLD_K,
+                tint: Color::ONE,
+                roughness: Some(d),
+            }),
+        });
+        for (side, eta) in [("outside", 1.5), ("inside", 1.0 / 1.5)] {
+            cases.push(Case {
+                name: format!("dielectric {side} {what}"),
+                lobe: Lobe::ExactDielectric(ExactDielectric {
+                    eta,
+                    roughness: Some(d),
+                }),
+            });
+        }
+    }
+    cases
+}
+
+/// The directions light leaves along in the tests: near the normal,
+/// oblique, grazing, and one with an azimuth (for the anisotropic lobes).
+fn outgoing() -> [Vec3; 3] {
+    let at = |theta: f32, phi: f32| {
+        let (t, p) = (theta.to_radians(), phi.to_radians());
+        Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+    };
+    [at(10.0, 30.0), at(50.0, 100.0), at(80.0, 200.0)]
+}
+
+// ---------------------------------------------------------------- χ² ---
+
+const THETA_RES: usize = 40;
+const PHI_RES: usize = 80;
+const SAMPLES: usize = 1_000_000;
+
+/// A histogram of directions about an axis: θ from the axis warped as
+/// θ = π t² (fine near the axis, where narrow lobes peak), φ uniform.
+struct Histogram {
+    frame: super::Frame,
+}
+
+impl Histogram {
+    fn new(axis: Vec3) -> Self {
+        Histogram {
+            frame: super::Frame::from_normal(axis.normalize()),
+        }
+    }
+
+    fn cell(&self, w: Vec3) -> usize {
+        let l = self.frame.to_local(w);
+        // From the sine, not acos(z): near the axis, where a narrow lobe
+        // peaks, z = cos θ rounds to steps of 10⁻⁸ and θ to steps of 10⁻⁴.
+        let (x, y, z) = (f64::from(l.x), f64::from(l.y), f64::from(l.z));
+        let theta = (x * x + y * y).sqrt().atan2(z);
+        let t = (theta / PI).sqrt();
+        let phi = f64::from(l.y).atan2(f64::from(l.x)).rem_euclid(2.0 * PI);
+        let i = ((t * THETA_RES as f64) as usize).min(THETA_RES - 1);
+        let j = ((phi / (2.0 * PI) * PHI_RES as f64) as usize).min(PHI_RES - 1);
+        i * PHI_RES + j
+    }
+
+    /// The direction at warped coordinates (t, φ).
+    fn direction(&self, t: f64, phi: f64) -> Vec3 {
+        let theta = PI * t * t;
+        let l = Vec3::new(
+            (theta.sin() * phi.cos()) as f32,
+            (theta.sin() * phi.sin()) as f32,
+            theta.cos() as f32,
+        );
+        self.frame.to_world(l)
+    }
+
+    /// ∫ pdf dω over every cell, by adaptive Simpson in t and φ.
+    fn expected(&self, pdf: &(dyn Fn(Vec3) -> f64 + Sync)) -> Vec<f64> {
+        (0..THETA_RES * PHI_RES)
+            .into_par_iter()
+            .map(|c| {
+                let (i, j) = (c / PHI_RES, c % PHI_RES);
+                let (t0, t1) = (
+                    i as f64 / THETA_RES as f64,
+                    (i + 1) as f64 / THETA_RES as f64,
+                );
+                let dp = 2.0 * PI / PHI_RES as f64;
+                let (p0, p1) = (j as f64 * dp, (j + 1) as f64 * dp);
+                let integrand = |t: f64, phi: f64| {
+                    let theta = PI * t * t;
+                    pdf(self.direction(t, phi)) * theta.sin() * 2.0 * PI * t
+                };
+                simpson_2d(&integrand, t0, t1, p0, p1)
+            })
+            .collect()
+    }
+}
+
+/// Adaptive Simpson quadrature of `f` over [a, b] (Lyness's test, with
+/// Richardson's correction), splitting at most `depth` times.
+fn simpson(f: &dyn Fn(f64) -> f64, a: f64, b: f64, eps: f64, depth: u32) -> f64 {
+    /// An interval with f at its ends and middle, and its Simpson estimate.
+    struct Piece {
+        a: f64,
+        b: f64,
+        f: [f64; 3],
+        whole: f64,
+        eps: f64,
+        depth: u32,
+    }
+    let fs = [f(a), f(0.5 * (a + b)), f(b)];
+    let whole = (b - a) / 6.0 * (fs[0] + 4.0 * fs[1] + fs[2]);
+    let mut stack = vec![Piece {
+        a,
+        b,
+        f: fs,
+        whole,
+        eps: eps.max(1e-5 * whole.abs()),
+        depth,
+    }];
+    let mut total = 0.0;
+    while let Some(p) = stack.pop() {
+        let m = 0.5 * (p.a + p.b);
+        let (fl, fr) = (f(0.5 * (p.a + m)), f(0.5 * (m + p.b)));
+        let left = (m - p.a) / 6.0 * (p.f[0] + 4.0 * fl + p.f[1]);
+        let right = (p.b - m) / 6.0 * (p.f[1] + 4.0 * fr + p.f[2]);
+        let both = left + right;
+        if p.depth == 0 || (both - p.whole).abs() <= 15.0 * p.eps {
+            total += both + (both - p.whole) / 15.0;
+            continue;
+        }
+        let (eps, depth) = (0.5 * p.eps, p.depth - 1);
+        stack.push(Piece {
+            a: p.a,
+            b: m,
+            f: [p.f[0], fl, p.f[1]],
+            whole: left,
+            eps,
+            depth,
+        });
+        stack.push(Piece {
+            a: m,
+            b: p.b,
+            f: [p.f[1], fr, p.f[2]],
+            whole: right,
+            eps,
+            depth,
+        });
+    }
+    total
+}
+
+/// Nested adaptive Simpson over a rectangle, each direction split in two
+/// first so that a narrow peak inside a cell is not stepped over.
+fn simpson_2d(f: &dyn Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+    let halves = |a: f64, b: f64| [(a, 0.5 * (a + b)), (0.5 * (a + b), b)];
+    let outer = |x: f64| {
+        let inner = |y: f64| f(x, y);
+        halves(y0, y1)
+            .iter()
+            .map(|&(a, b)| simpson(&inner, a, b, 1e-10, 6))
+            .sum::<f64>()
+    };
+    halves(x0, x1)
+        .iter()
+        .map(|&(a, b)| simpson(&outer, a, b, 1e-10, 6))
+        .sum()
+}
+
+/// The regularised upper incomplete gamma function Q(a, x) (Numerical
+/// Recipes' series and continued fraction): the χ² p-value is
+/// Q(dof/2, χ²/2).
+fn gamma_q(a: f64, x: f64) -> f64 {
+    let ln_gamma = |z: f64| {
+        // Lanczos (g = 7, n = 9).
+        const C: [f64; 9] = [
+            0.999_999_999_999_809_9,
+            676.520_368_121_885_1,
+            -1_259.139_216_722_402_8,
+            771.323_428_777_653_1,
+            -176.615_029_162_140_6,
+            12.507_343_278_686_905,
+            -0.138_571_095_265_720_12,
+            9.984_369_578_019_572e-6,
+            1.505_632_735_149_311_6e-7,
+        ];
+        let z = z - 1.0;
+        let mut s = C[0];
+        for (i, c) in C.iter().enumerate().skip(1) {
+            s += c / (z + i as f64);
+        }
+        let t = z + 7.5;
+        0.5 * (2.0 * PI).ln() + (z + 0.5) * t.ln() - t + s.ln()
+    };
+    if x <= 0.0 {
+        return 1.0;
+    }
+    let front = (-x + a * x.ln() - ln_gamma(a)).exp();
+    if x < a + 1.0 {
+        let (mut sum, mut term, mut n) = (1.0 / a, 1.0 / a, a);
+        for _ in 0..10_000 {
+            n += 1.0;
+            term *= x / n;
+            sum += term;
+            if term.abs() < sum.abs() * 1e-15 {
+                break;
+            }
+        }
+        1.0 - sum * front
+    } else {
+        let tiny = 1e-300;
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / tiny;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = b + an / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            let del = d * c;
+            h *= del;
+            if (del - 1.0).abs() < 1e-15 {
+                break;
+            }
+        }
+        front * h
+    }
+}
+
+/// Pearson's χ² test of `observed` against `expected` (cells expected to
+/// hold fewer than 5 pooled, as pbrt does): the p-value, or why the test
+/// cannot pass.
+fn chi2_p_value(observed: &[u64], expected: &[f64]) -> Result<f64, String> {
+    let mut order: Vec<usize> = (0..observed.len()).collect();
+    order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
+    let (mut chsq, mut dof) = (0.0, 0i64);
+    let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
+    for &c in &order {
+        let (o, e) = (observed[c] as f64, expected[c]);
+        if e <= 0.0 {
+            if o > SAMPLES as f64 * 1e-5 {
+                return Err(format!("{o} samples in a cell of expected frequency 0"));
+            }
+        } else if e < 5.0 || (pooled_exp > 0.0 && pooled_exp < 5.0) {
+            pooled_obs += o;
+            pooled_exp += e;
+        } else {
+            chsq += (o - e).powi(2) / e;
+            dof += 1;
+        }
+    }
+    if pooled_exp > 0.0 {
+        chsq += (pooled_obs - pooled_exp).powi(2) / pooled_exp;
+        dof += 1;
+    }
+    // The counts add up to the samples drawn: one degree of freedom less.
+    // All in one cell (a narrow lobe glass transmits from inside past the
+    // critical angle) leaves none: that cell's count is then tested alone.
+    dof = (dof - 1).max(1);
+    Ok(gamma_q(dof as f64 / 2.0, chsq / 2.0))
+}
+
+/// The direction light from `wo` mirrors to, and the one it refracts to
+/// through a smooth interface of `eta` (if it can).
+fn peaks(lobe: &Lobe, wo: Vec3) -> (Vec3, Option<Vec3>) {
+    let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
+    let refracted = match lobe {
+        Lobe::ExactDielectric(d) => super::fresnel::refract(wo, Vec3::Z, d.eta).map(|(w, _)| w),
+        _ => None,
+    };
+    (mirror, refracted)
+}
+
+/// The χ² test of one lobe from one direction: samples binned in one
+/// histogram about the mirror direction (reflections) and one about the
+/// refracted direction (transmissions); the p-values.
+fn chi2(lobe: &Lobe, wo: Vec3, seed: u64) -> Result<Vec<f64>, String> {
+    let (mirror, refracted) = peaks(lobe, wo);
+    let reflect = Histogram::new(mirror);
+    let transmit = Histogram::new(refracted.unwrap_or(-wo));
+    let mut counts = [
+        vec![0u64; THETA_RES * PHI_RES],
+        vec![0u64; THETA_RES * PHI_RES],
+    ];
+    let mut rng = Rng::new(seed);
+    for _ in 0..SAMPLES {
+        let uc = rng.next_f32();
+        let u = rng.next_2d();
+        let Some(s) = lobe.sample_local(wo, uc, u) else {
+            continue;
+        };
+        if s.flags.is_specular() {
+            continue;
+        }
+        if s.wi.z * wo.z > 0.0 {
+            counts[0][reflect.cell(s.wi)] += 1;
+        } else {
+            counts[1][transmit.cell(s.wi)] += 1;
+        }
+    }
+    let mut p = Vec::new();
+    for (k, h) in [&reflect, &transmit].into_iter().enumerate() {
+        let pdf = |w: Vec3| {
+            let same = w.z * wo.z > 0.0;
+            if same != (k == 0) {
+                return 0.0;
+            }
+            f64::from(lobe.eval_and_pdf_local(wo, w).1)
+        };
+        let expected: Vec<f64> = h
+            .expected(&pdf)
+            .iter()
+            .map(|e| e * SAMPLES as f64)
+            .collect();
+        // Too few samples expected on a side for a χ² test (glass seen
+        // from inside at grazing angles reflects nearly all): their number
+        // is checked instead.
+        let (observed, total) = (
+            counts[k].iter().sum::<u64>() as f64,
+            expected.iter().sum::<f64>(),
+        );
+        if total < 50.0 {
+            if (observed - total).abs() > 4.0 * total.sqrt() + 5.0 {
+                return Err(format!("{observed} samples on side {k}, {total} expected"));
+            }
+            continue;
+        }
+        p.push(chi2_p_value(&counts[k], &expected)?);
+    }
+    Ok(p)
+}
+
+/// Every lobe's directions fall where its pdf says, from several
+/// directions, at every roughness, isotropic and anisotropic, from outside
+/// and inside for dielectrics: p-values above 0.01, Šidák-corrected for
+/// the number of tests.
+#[test]
+fn every_lobe_samples_its_pdf() {
+    let cases = lobes();
+    let runs: Vec<(usize, usize)> = (0..cases.len())
+        .flat_map(|c| (0..outgoing().len()).map(move |w| (c, w)))
+        .collect();
+    let results: Vec<(String, Result<Vec<f64>, String>)> = runs
+        .par_iter()
+        .map(|&(c, w)| {
+            let wo = outgoing()[w];
+            let name = format!("{} from {wo}", cases[c].name);
+            (name, chi2(&cases[c].lobe, wo, (c * 7 + w) as u64))
+        })
+        .collect();
+    let tests: usize = results
+        .iter()
+        .map(|(_, r)| r.as_ref().map_or(1, Vec::len))
+        .sum();
+    let level = 1.0 - (1.0f64 - 0.01).powf(1.0 / tests as f64);
+    let failures: Vec<String> = results
+        .iter()
+        .filter_map(|(name, r)| match r {
+            Err(e) => Some(format!("{name}: {e}")),
+            Ok(ps) if ps.iter().any(|&p| !(p >= level)) => Some(format!("{name}: p = {ps:?}")),
+            Ok(_) => None,
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {tests} χ² tests below p = {level:.2e}:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+// ------------------------------------------------ consistency, energy ---
+
+/// Directions spread over the sphere (and a few grazing ones).
+fn directions(rng: &mut Rng, n: usize) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = (0..n)
+        .map(|_| crate::sampling::unit_vector(rng.next_2d()))
+        .collect();
+    out.extend([
+        Vec3::new(1.0, 0.0, 1e-6).normalize(),
+        Vec3::new(0.0, 1.0, -1e-6).normalize(),
+        Vec3::Z,
+        -Vec3::Z,
+    ]);
+    out
+}
+
+/// The value a sample carries is eval·|cos|/pdf at its direction, its pdf
+/// is `pdf` there, and nothing is NaN or negative, from any direction
+/// (grazing ones too).
+#[test]
+fn samples_agree_with_eval_and_pdf() {
+    let mut rng = Rng::new(11);
+    for case in lobes() {
+        for wo in directions(&mut rng, 40) {
+            for _ in 0..200 {
+                let (uc, u) = (rng.next_f32(), rng.next_2d());
+                let Some(s) = case.lobe.sample_local(wo, uc, u) else {
+                    continue;
+                };
+                let BsdfSample { value, wi, pdf, .. } = s;
+                assert!(
+                    value.is_finite() && value.min_element() >= 0.0 && pdf > 0.0,
+                    "{}: wo {wo}: {s:?}",
+                    case.name
+                );
+                assert!(
+                    (wi.length() - 1.0).abs() < 1e-4,
+                    "{}: |wi| {}",
+                    case.name,
+                    wi.length()
+                );
+                let (f, p) = case.lobe.eval_and_pdf_local(wo, wi);
+                let close = |a: f32, b: f32| (a - b).abs() <= 2e-3 * a.abs().max(b.abs()) + 1e-6;
+                assert!(
+                    close(p, pdf),
+                    "{}: wo {wo} wi {wi}: pdf {p} vs {pdf}",
+                    case.name
+                );
+                let expect = f / p;
+                for c in 0..3 {
+                    assert!(
+                        close(expect[c], value[c]),
+                        "{}: wo {wo} wi {wi}: eval/pdf {expect} vs value {value}",
+                        case.name
+                    );
+                }
+            }
+            // Any direction at all: finite, not negative.
+            for wi in directions(&mut rng, 20) {
+                let (f, p) = case.lobe.eval_and_pdf_local(wo, wi);
+                assert!(
+                    f.is_finite() && f.min_element() >= 0.0 && p.is_finite() && p >= 0.0,
+                    "{}: wo {wo} wi {wi}: {f} {p}",
+                    case.name
+                );
+            }
+        }
+    }
+}
+
+/// The factor that turns radiance carried from `wi` to `wo` back into the
+/// power it is: a transmission compresses radiance by (η_o/η_i)², which
+/// energy does not see.
+fn importance(lobe: &Lobe, wo: Vec3, wi: Vec3) -> f32 {
+    match lobe {
+        Lobe::ExactDielectric(d) if wo.z * wi.z < 0.0 => {
+            let etap = if wo.z > 0.0 { d.eta } else { 1.0 / d.eta };
+            etap * etap
+        }
+        _ => 1.0,
+    }
+}
+
+/// The mean of f·cos/pdf over samples (the directional albedo) is at most
+/// 1, within three standard errors, from random directions (transmitted
+/// radiance counted as power).
+#[test]
+fn no_lobe_reflects_more_than_it_receives() {
+    let mut rng = Rng::new(12);
+    for case in lobes() {
+        for wo in directions(&mut rng, 6).into_iter().filter(|w| w.z > 1e-3) {
+            let n = 20_000;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let v = case
+                    .lobe
+                    .sample_local(wo, rng.next_f32(), rng.next_2d())
+                    .map_or(0.0, |s| {
+                        f64::from(s.value.max_element() * importance(&case.lobe, wo, s.wi))
+                    });
+                sum += v;
+                sum2 += v * v;
+            }
+            let mean = sum / n as f64;
+            let se = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+            assert!(
+                mean <= 1.0 + 3.0 * se + 1e-3,
+                "{}: wo {wo}: albedo {mean} ± {se}",
+                case.name
+            );
+        }
+    }
+}
+
+/// f(wo, wi) = f(wi, wo) for every reflection (eval gives f·|cos θi|).
+#[test]
+fn reflection_is_reciprocal() {
+    let mut rng = Rng::new(13);
+    for case in lobes() {
+        for _ in 0..2000 {
+            let wo = crate::sampling::on_hemisphere(rng.next_2d(), Vec3::Z);
+            let wi = crate::sampling::on_hemisphere(rng.next_2d(), Vec3::Z);
+            if wo.z < 1e-3 || wi.z < 1e-3 {
+                continue;
+            }
+            let a = case.lobe.eval_and_pdf_local(wo, wi).0 / wi.z;
+            let b = case.lobe.eval_and_pdf_local(wi, wo).0 / wo.z;
+            assert!(
+                (a - b).abs().max_element() <= 1e-3 * a.max_element().max(1e-3),
+                "{}: f({wo}, {wi}) = {a} but f({wi}, {wo}) = {b}",
+                case.name
+            );
+        }
+    }
+}
+
+/// Directional albedo by quadrature of eval over the sphere, an estimate
+/// independent of the sampling routine.
+pub(crate) fn albedo_by_quadrature(lobe: &Lobe, wo: Vec3) -> Color {
+    let (mirror, refracted) = peaks(lobe, wo);
+    let mut total = Color::ZERO;
+    let below = refracted.unwrap_or(Vec3::new(wo.x, wo.y, -wo.z));
+    for (k, axis) in [mirror, below].into_iter().enumerate() {
+        let h = Histogram::new(axis);
+        let (nt, np) = (400, 400);
+        for i in 0..nt {
+            let t = (i as f64 + 0.5) / nt as f64;
+            let theta = PI * t * t;
+            let dw = theta.sin() * 2.0 * PI * t / nt as f64 * (2.0 * PI / np as f64);
+            for j in 0..np {
+                let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
+                let wi = h.direction(t, phi);
+                if (wi.z * wo.z > 0.0) == (k == 0) {
+                    total += lobe.eval_and_pdf_local(wo, wi).0 * dw as f32;
+                }
+            }
+        }
+    }
+    total
+}
+
+/// The sampled albedo (the mean value of the samples) agrees with the
+/// albedo by quadrature of eval: the single-scattering loss of each rough
+/// lobe, measured two independent ways.
+#[test]
+fn sampled_albedo_matches_quadrature() {
+    let cases: Vec<Case> = lobes()
+        .into_iter()
+        .filter(|c| !c.name.contains("r 0.05"))
+        .collect();
+    let failures: Vec<String> = cases
+        .par_iter()
+        .flat_map(|case| {
+            let mut out = Vec::new();
+            for wo in [
+                Vec3::new(0.3, 0.1, 0.9).normalize(),
+                Vec3::new(0.9, 0.0, 0.3).normalize(),
+            ] {
+                let quad = albedo_by_quadrature(&case.lobe, wo);
+                let mut rng = Rng::new(case.name.len() as u64);
+                let n = 100_000;
+                let (mut sum, mut sum2) = (Color::ZERO, Color::ZERO);
+                for _ in 0..n {
+                    let v = case
+                        .lobe
+                        .sample_local(wo, rng.next_f32(), rng.next_2d())
+                        .map_or(Color::ZERO, |s| s.value);
+                    sum += v;
+                    sum2 += v * v;
+                }
+                let mean = sum / n as f32;
+                let se = ((sum2 / n as f32 - mean * mean).max(Color::ZERO) / n as f32).powf(0.5);
+                for c in 0..3 {
+                    if (mean[c] - quad[c]).abs() > 4.0 * se[c] + 2e-3 {
+                        out.push(format!(
+                            "{} wo {wo}: sampled {mean} ± {se}, quadrature {quad}",
+                            case.name
+                        ));
+                        break;
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
