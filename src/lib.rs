@@ -61,6 +61,7 @@ pub mod files;
 pub mod film;
 pub mod gallery;
 pub mod geometry;
+pub mod hint;
 pub mod integrator;
 pub mod isa;
 pub mod lanes;

@@ -29,6 +29,10 @@ pub struct HitRecord {
     pub material: u32,
     /// Index of the hit primitive in the scene's tree.
     pub object: u32,
+    /// ∂p/∂u: the surface's tangent along its first texture coordinate
+    /// (not unit; zero where it has none, as at a sphere's poles), which
+    /// anisotropic materials align with.
+    pub dpdu: Vec3,
     /// A bound on how far `point` may lie from the true surface through
     /// `f32` rounding. 0 when the scene's epsilon is 0, so that rays leave
     /// from the point itself (the notes' shadow acne).

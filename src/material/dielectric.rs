@@ -1,9 +1,12 @@
 //! The dielectric material: clear glass, water, diamond.
 
-use super::param::{Invalid, Textures};
+use super::param::{Invalid, RoughnessDesc, Textures};
+use super::roughness::{DistributionDesc, Roughness};
 use super::{Kind, Material};
-use crate::bsdf::dielectric::SmoothDielectric;
+use crate::bsdf::dielectric::{ExactDielectric, SmoothDielectric};
+use crate::bsdf::Lobe;
 use crate::geometry::HitRecord;
+use crate::texture::Texture;
 
 material_desc! {
     /// A clear refracting material.
@@ -13,6 +16,17 @@ material_desc! {
         /// Never reflect partially (no Schlick term).
         #[serde(default)]
         pub refract_only: bool,
+        /// Roughness in [0, 1] (α = roughness²): frosted glass. 0, the
+        /// default, is the notes' smooth glass (Schlick's reflectance); any
+        /// other value reflects and refracts by the exact Fresnel equations.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub roughness: Option<RoughnessDesc>,
+        /// The microfacet width α itself, instead of `roughness`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub alpha: Option<RoughnessDesc>,
+        /// The microfacet distribution: "ggx" (the default) or "beckmann".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub distribution: Option<DistributionDesc>,
     }
 }
 
@@ -25,7 +39,11 @@ impl DielectricDesc {
         }
     }
 
-    pub(super) fn compile(&self, field: &str, _: &mut dyn Textures) -> Result<Material, Invalid> {
+    pub(super) fn compile(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<Material, Invalid> {
         let ior = self.ior;
         if !(ior.abs() <= f64::from(f32::MAX)) {
             return Err(Invalid::new(
@@ -42,9 +60,28 @@ impl DielectricDesc {
                 format!("index of refraction must be greater than 0, got {ior}"),
             ));
         }
+        let roughness = Roughness::compile(
+            field,
+            self.roughness.as_ref(),
+            self.alpha.as_ref(),
+            self.distribution,
+            textures,
+        )?;
+        // Given as zero (or not given): the notes' glass, to the bit.
+        let zero = |r: Option<&RoughnessDesc>| {
+            r.is_none_or(|r| matches!(r, RoughnessDesc::Value(v) if *v == 0.0))
+        };
+        let rough = !(zero(self.roughness.as_ref()) && zero(self.alpha.as_ref()));
+        if rough && self.refract_only {
+            return Err(Invalid::new(
+                format!("{field}.refract_only"),
+                "is the notes' smooth glass: a rough dielectric reflects by the Fresnel equations",
+            ));
+        }
         Ok(Material::new(Kind::Dielectric(Dielectric {
             ior: ior as f32,
             refract_only: self.refract_only,
+            roughness: rough.then_some(roughness),
         })))
     }
 }
@@ -58,19 +95,32 @@ pub struct Dielectric {
     /// Refract whenever Snell's law allows it and never reflect partially
     /// (no Schlick term): the notes' "only refracting" figure.
     pub refract_only: bool,
+    /// The microfacets of frosted glass, reflecting and refracting by the
+    /// exact Fresnel equations; `None` for the notes' glass.
+    pub roughness: Option<Roughness>,
 }
 
 impl Dielectric {
     /// The lobe at `hit`: η/η′ by the side the ray arrives from.
     #[inline(always)]
-    pub fn at(&self, hit: &HitRecord) -> SmoothDielectric {
-        SmoothDielectric {
-            eta_ratio: if hit.front_face {
-                1.0 / self.ior
-            } else {
-                self.ior
-            },
-            refract_only: self.refract_only,
+    pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> Lobe {
+        match &self.roughness {
+            None => Lobe::Dielectric(SmoothDielectric {
+                eta_ratio: if hit.front_face {
+                    1.0 / self.ior
+                } else {
+                    self.ior
+                },
+                refract_only: self.refract_only,
+            }),
+            Some(r) => Lobe::ExactDielectric(ExactDielectric {
+                eta: if hit.front_face {
+                    self.ior
+                } else {
+                    1.0 / self.ior
+                },
+                roughness: r.at(hit, textures),
+            }),
         }
     }
 }

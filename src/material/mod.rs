@@ -113,15 +113,19 @@ macro_rules! material_kinds {
     };
 }
 
+pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod emissive;
 pub mod metal;
+pub mod metals;
 pub mod param;
+pub mod roughness;
 
 pub use crate::bsdf::dielectric::{reflectance, refract};
 pub use crate::bsdf::diffuse::{Attenuation, BounceModel};
 pub use crate::bsdf::metal::reflect;
+pub use conductor::{Conductor, ConductorDesc};
 pub use dielectric::{Dielectric, DielectricDesc};
 pub use diffuse::{AttenuationDesc, BounceDesc, Diffuse, DiffuseDesc};
 pub use emissive::{Emission, Emissive, EmissiveDesc};
@@ -143,6 +147,8 @@ material_kinds! {
     Dielectric(DielectricDesc) = "dielectric", "a dielectric material";
     /// A light: emits `radiance` and scatters nothing.
     Emissive(EmissiveDesc) = "emissive", "an emissive material";
+    /// A metal by its complex index of refraction, smooth or rough.
+    Conductor(ConductorDesc) = "conductor", "a conductor material";
 }
 
 /// A kind of material as the readers know it.
@@ -226,6 +232,8 @@ pub enum Kind {
     Metal(Metal),
     /// Clear refracting material such as glass or water.
     Dielectric(Dielectric),
+    /// A metal by its complex index of refraction.
+    Conductor(Conductor),
 }
 
 /// A surface material.
@@ -266,11 +274,20 @@ impl Material {
                 lobe,
             ))
         };
+        // The others in the frame of the surface's tangent.
+        let local = |lobe| {
+            let frame = Frame::from_normal_tangent(hit.shading_normal, hit.dpdu);
+            Some(Bsdf::new(frame, hit.normal, lobe))
+        };
         match &self.kind {
             Kind::Black => None,
             Kind::Diffuse(d) => notes(Lobe::Diffuse(d.at(hit, textures))),
             Kind::Metal(m) => notes(Lobe::Metal(m.at(hit, textures))),
-            Kind::Dielectric(d) => notes(Lobe::Dielectric(d.at(hit))),
+            Kind::Dielectric(d) => match d.at(hit, textures) {
+                lobe @ Lobe::Dielectric(_) => notes(lobe),
+                lobe => local(lobe),
+            },
+            Kind::Conductor(c) => local(Lobe::Conductor(c.at(hit, textures))),
         }
     }
 
@@ -303,18 +320,20 @@ impl Material {
     /// surface's (u, v) (directly or through a texture it refers to).
     pub fn uses_uv(&self, textures: &[Texture]) -> bool {
         self.textures()
+            .into_iter()
             .any(|t| textures[t as usize].uses_uv(textures))
     }
 
     /// The textures its parameters look up.
-    pub fn textures(&self) -> impl Iterator<Item = u32> {
-        let colour = match &self.kind {
-            Kind::Diffuse(d) => d.albedo.texture(),
-            Kind::Metal(m) => m.albedo.texture(),
-            Kind::Black | Kind::Dielectric(_) => None,
+    pub fn textures(&self) -> Vec<u32> {
+        let mut out: Vec<u32> = match &self.kind {
+            Kind::Diffuse(d) => d.albedo.texture().into_iter().collect(),
+            Kind::Metal(m) => m.albedo.texture().into_iter().collect(),
+            Kind::Dielectric(d) => d.roughness.iter().flat_map(|r| r.textures()).collect(),
+            Kind::Conductor(c) => c.roughness.textures().collect(),
+            Kind::Black => Vec::new(),
         };
-        colour
-            .into_iter()
-            .chain(self.emission.and_then(|e| e.radiance.texture()))
+        out.extend(self.emission.and_then(|e| e.radiance.texture()));
+        out
     }
 }

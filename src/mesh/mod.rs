@@ -212,6 +212,7 @@ impl MeshMaterial {
             Material::new(Kind::Dielectric(Dielectric {
                 ior,
                 refract_only: false,
+                roughness: None,
             }))
         } else if self.metallic >= 0.5 {
             let r = unit(self.roughness);

@@ -257,14 +257,16 @@ fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
         mat("glass"),
         Material::new(Kind::Dielectric(Dielectric {
             ior: 1.45,
-            refract_only: false
+            refract_only: false,
+            roughness: None,
         }))
     );
     assert_eq!(
         mat("water"),
         Material::new(Kind::Dielectric(Dielectric {
             ior: 1.33,
-            refract_only: false
+            refract_only: false,
+            roughness: None,
         }))
     );
     assert_eq!(
@@ -704,7 +706,8 @@ fn gltf_transmission_and_strips_and_fans() {
         m.materials[0].to_material(),
         Material::new(Kind::Dielectric(Dielectric {
             ior: 1.7,
-            refract_only: false
+            refract_only: false,
+            roughness: None,
         }))
     );
 }

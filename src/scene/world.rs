@@ -167,6 +167,8 @@ impl Shapes {
                     front_face,
                     material: surface.material,
                     object: index,
+                    // Along u = φ/2π about +y (see `Sphere::uv`).
+                    dpdu: Vec3::new(outward.z, 0.0, -outward.x),
                     error: (point.abs().max_element() + surface.radius) * error_scale,
                 }
             }
@@ -186,6 +188,7 @@ impl Shapes {
                     front_face,
                     material: *material,
                     object: index,
+                    dpdu: quad.u,
                     error: (point.abs().max_element() + quad.d.abs()) * error_scale,
                 }
             }
@@ -225,15 +228,16 @@ fn triangle_record(
         }
         None => normal,
     };
-    let uv = match &mesh.data.uvs {
+    let (uv, dpdu) = match &mesh.data.uvs {
         Some(uvs) => {
             let [p, q, r] = idx.map(|i| uvs[i]);
-            [
+            let uv = [
                 b_[0] * p[0] + b_[1] * q[0] + b_[2] * r[0],
                 b_[0] * p[1] + b_[1] * q[1] + b_[2] * r[1],
-            ]
+            ];
+            (uv, triangle_dpdu([a, b, c], [p, q, r]))
         }
-        None => [b_[1], b_[2]],
+        None => ([b_[1], b_[2]], b - a),
     };
     let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
     HitRecord {
@@ -245,7 +249,24 @@ fn triangle_record(
         front_face,
         material: mesh.material(k),
         object: index,
+        dpdu,
         error: extent.max_element() * error_scale,
+    }
+}
+
+/// ∂p/∂u of the triangle of corners `p` with texture coordinates `uv`
+/// (from the two edges and their differences of (u, v)); the first edge
+/// where the coordinates are degenerate.
+fn triangle_dpdu(p: [Vec3; 3], uv: [[f32; 2]; 3]) -> Vec3 {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (du1, dv1) = (uv[1][0] - uv[0][0], uv[1][1] - uv[0][1]);
+    let (du2, dv2) = (uv[2][0] - uv[0][0], uv[2][1] - uv[0][1]);
+    let det = du1 * dv2 - dv1 * du2;
+    let dpdu = (e1 * dv2 - e2 * dv1) / det;
+    if det != 0.0 && dpdu.is_finite() {
+        dpdu
+    } else {
+        e1
     }
 }
 
@@ -447,6 +468,7 @@ impl World {
             front_face,
             material: placed.material.unwrap_or(inner.material),
             object: hit.index,
+            dpdu: transform.vector(inner.dpdu),
             error: inner.error * placed.stretch * 4.0
                 + point.abs().max_element() * self.error_scale,
         }

@@ -3,9 +3,9 @@
 //! between textures followed and cycles refused; image files read once and
 //! recorded as sources of the scene.
 
+use crate::hint;
 use crate::math::Color;
 use crate::scene::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
-use crate::scene::file::hint;
 use crate::scene::{invalid, MeshSource, SceneError};
 use crate::texture::{Image, NoisePattern, Perlin, Texture};
 use std::collections::{BTreeMap, HashMap};

@@ -22,7 +22,7 @@
 mod decode;
 pub mod export;
 mod fast;
-pub mod hint;
+pub use crate::hint;
 mod node_de;
 mod plain_toml;
 pub mod source;

@@ -1,0 +1,143 @@
+//! The conductor material: a metal by its complex index of refraction (a
+//! measured one by name, or η and k given), smooth or rough.
+
+use super::metals;
+use super::param::{Invalid, RoughnessDesc, Textures, Triple};
+use super::roughness::{DistributionDesc, Roughness};
+use super::{Kind, Material};
+use crate::bsdf::conductor::Conductor as ConductorLobe;
+use crate::geometry::HitRecord;
+use crate::math::{Color, Vec3};
+use crate::texture::Texture;
+
+material_desc! {
+    /// A metal: Fresnel reflection by a complex index of refraction, off a
+    /// mirror or rough microfacets.
+    pub struct ConductorDesc {
+        /// A measured metal by name ("Au", "Ag", "Cu", "Al", "Cr", "Fe",
+        /// "Ni", "Ti", "Pt", …; see [`metals`]), or none when `eta` and
+        /// `k` are given.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub metal: Option<String>,
+        /// The real part of the index of refraction per channel, ≥ 0.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub eta: Option<Triple>,
+        /// The imaginary part (absorption) per channel, ≥ 0.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub k: Option<Triple>,
+        /// Roughness in [0, 1] (α = roughness²); 0, the default, is a mirror.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub roughness: Option<RoughnessDesc>,
+        /// The microfacet width α itself, instead of `roughness`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub alpha: Option<RoughnessDesc>,
+        /// The microfacet distribution: "ggx" (the default) or "beckmann".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub distribution: Option<DistributionDesc>,
+    }
+}
+
+impl ConductorDesc {
+    /// The named metal `metal` of roughness `roughness`.
+    pub fn named(metal: &str, roughness: f64) -> Self {
+        ConductorDesc {
+            metal: Some(metal.to_string()),
+            roughness: Some(roughness.into()),
+            ..Default::default()
+        }
+    }
+
+    pub(super) fn compile(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<Material, Invalid> {
+        let (eta, k) = match (&self.metal, self.eta, self.k) {
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                return Err(Invalid::new(
+                    format!("{field}.metal"),
+                    "give `metal` or `eta` and `k`, not both",
+                ))
+            }
+            (Some(name), None, None) => {
+                let m = metals::find(name).ok_or_else(|| {
+                    let known: Vec<&str> = metals::names().collect();
+                    let mut message = format!(
+                        "unknown metal \"{name}\"; the known ones are {}",
+                        known.join(", ")
+                    );
+                    if let Some(c) = crate::hint::closest(name, known.iter().copied()) {
+                        message = format!("{message} (did you mean \"{c}\"?)");
+                    }
+                    Invalid::new(format!("{field}.metal"), message)
+                })?;
+                (Color::from_array(m.eta), Color::from_array(m.k))
+            }
+            (None, Some(eta), Some(k)) => (
+                index(&format!("{field}.eta"), eta)?,
+                index(&format!("{field}.k"), k)?,
+            ),
+            (None, Some(_), None) | (None, None, Some(_)) => {
+                return Err(Invalid::new(
+                    format!("{field}.{}", if self.eta.is_some() { "k" } else { "eta" }),
+                    "a conductor's index of refraction needs both `eta` and `k`",
+                ))
+            }
+            (None, None, None) => {
+                return Err(Invalid::new(
+                    field,
+                    "a conductor needs `metal` (a measured metal by name) or `eta` and `k`",
+                ))
+            }
+        };
+        let roughness = Roughness::compile(
+            field,
+            self.roughness.as_ref(),
+            self.alpha.as_ref(),
+            self.distribution,
+            textures,
+        )?;
+        Ok(Material::new(Kind::Conductor(Conductor {
+            eta,
+            k,
+            roughness,
+        })))
+    }
+}
+
+/// An index of refraction given per channel: finite, not negative.
+fn index(field: &str, v: Triple) -> Result<Color, Invalid> {
+    if v.iter()
+        .any(|x| !(x.is_finite() && *x >= 0.0 && *x <= f64::from(f32::MAX)))
+    {
+        return Err(Invalid::new(
+            field,
+            format!("must be finite and not negative, got {v:?}"),
+        ));
+    }
+    Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+}
+
+/// A metal surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conductor {
+    /// The real part of the index of refraction.
+    pub eta: Color,
+    /// The imaginary part.
+    pub k: Color,
+    /// The microfacet width.
+    pub roughness: Roughness,
+}
+
+impl Conductor {
+    /// The lobe at `hit`.
+    #[inline]
+    pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> ConductorLobe {
+        ConductorLobe {
+            eta: self.eta,
+            k: self.k,
+            tint: Color::ONE,
+            roughness: self.roughness.at(hit, textures),
+        }
+    }
+}
