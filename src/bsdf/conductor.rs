@@ -2,8 +2,8 @@
 //! refraction, off a mirror or a rough microfacet surface (pbrt-v4's
 //! `ConductorBxDF`, Mitsuba 3's `roughconductor`). Nothing is transmitted.
 
-use super::fresnel;
 use super::microfacet::Microfacet;
+use super::{albedo, fresnel};
 use super::{BsdfSample, LobeFlags};
 use crate::math::{Color, Vec3};
 
@@ -18,6 +18,8 @@ pub struct Conductor {
     pub tint: Color,
     /// The microfacets; `None` for a mirror.
     pub roughness: Option<Microfacet>,
+    /// Return the energy single scattering loses (see [`super::albedo`]).
+    pub multiscatter: bool,
 }
 
 impl Conductor {
@@ -71,7 +73,12 @@ impl Conductor {
     /// f·cos θi on the rough surface, through microfacet normal `wm`.
     #[inline]
     fn f_cos(&self, d: &Microfacet, wo: Vec3, wi: Vec3, wm: Vec3) -> Color {
-        self.fresnel(wo.dot(wm)) * (d.d(wm) * d.g(wo, wi) / (4.0 * wo.z))
+        let single = self.fresnel(wo.dot(wm)) * (d.d(wm) * d.g(wo, wi) / (4.0 * wo.z));
+        if self.multiscatter {
+            single * albedo::conductor_compensation(d, wo.z, self.fresnel(1.0))
+        } else {
+            single
+        }
     }
 
     /// f(wo, wi)·|cos θi| and the density of `wi`.

@@ -3,9 +3,9 @@
 //! glass by the exact Fresnel equations, smooth or rough (Walter et al.
 //! 2007; pbrt-v4's `DielectricBxDF`, Mitsuba 3's `roughdielectric`).
 
-use super::fresnel;
 use super::metal::reflect;
 use super::microfacet::Microfacet;
+use super::{albedo, fresnel};
 use super::{Bsdf, BsdfSample, LobeFlags};
 use crate::math::{Color, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -93,6 +93,8 @@ pub struct ExactDielectric {
     pub eta: f32,
     /// The microfacets; `None` for a smooth interface.
     pub roughness: Option<Microfacet>,
+    /// Return the energy single scattering loses (see [`super::albedo`]).
+    pub multiscatter: bool,
 }
 
 impl ExactDielectric {
@@ -205,17 +207,47 @@ impl ExactDielectric {
         }
         let up = if cos_o < 0.0 { -wo } else { wo };
         let r = fresnel::dielectric(dot_o, self.eta);
+        let scale = if self.multiscatter {
+            let eta = if cos_o > 0.0 {
+                self.eta
+            } else {
+                1.0 / self.eta
+            };
+            albedo::dielectric_compensation(&d, eta, cos_o)
+        } else {
+            1.0
+        };
+        let (f_cos, pdf) = self.single(&d, wo, wi, wm, up, r, reflect, etap);
+        (Color::splat(f_cos * scale), pdf)
+    }
+
+    /// f·|cos θi| and the density of single scattering through microfacet
+    /// `wm` (`up`: `wo` turned to +z; `r`: the Fresnel reflectance there).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn single(
+        &self,
+        d: &Microfacet,
+        wo: Vec3,
+        wi: Vec3,
+        wm: Vec3,
+        up: Vec3,
+        r: f32,
+        reflect: bool,
+        etap: f32,
+    ) -> (f32, f32) {
+        let (cos_o, dot_o, dot_i) = (wo.z, wo.dot(wm), wi.dot(wm));
         if reflect {
             let f_cos = d.d(wm) * d.g(wo, wi) * r / (4.0 * cos_o.abs());
             let pdf = d.pdf(up, wm) / (4.0 * dot_o.abs()) * r;
-            return (Color::splat(f_cos), pdf);
+            return (f_cos, pdf);
         }
         let t = 1.0 - r;
         let denom = (dot_i + dot_o / etap).powi(2);
         let f_cos =
             t * d.d(wm) * d.g(wo, wi) * (dot_i * dot_o / (cos_o * denom)).abs() / (etap * etap);
         let pdf = d.pdf(up, wm) * dot_i.abs() / denom * t;
-        (Color::splat(f_cos), pdf)
+        (f_cos, pdf)
     }
 }
 

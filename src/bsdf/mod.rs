@@ -23,6 +23,7 @@
 //! figures keep their bits; the fuzzy metal and the bounce models other than
 //! the Lambertian have no density written down and are sampled only.
 
+pub mod albedo;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;

@@ -34,6 +34,9 @@ material_desc! {
         /// The microfacet distribution: "ggx" (the default) or "beckmann".
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub distribution: Option<DistributionDesc>,
+        /// Return the energy single-scattering microfacets lose.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        pub multiscatter: bool,
     }
 }
 
@@ -101,6 +104,7 @@ impl ConductorDesc {
             eta,
             k,
             roughness,
+            multiscatter: self.multiscatter,
         })))
     }
 }
@@ -127,6 +131,8 @@ pub struct Conductor {
     pub k: Color,
     /// The microfacet width.
     pub roughness: Roughness,
+    /// Return the energy single scattering loses.
+    pub multiscatter: bool,
 }
 
 impl Conductor {
@@ -138,6 +144,7 @@ impl Conductor {
             k: self.k,
             tint: Color::ONE,
             roughness: self.roughness.at(hit, textures),
+            multiscatter: self.multiscatter,
         }
     }
 }

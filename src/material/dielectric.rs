@@ -27,6 +27,9 @@ material_desc! {
         /// The microfacet distribution: "ggx" (the default) or "beckmann".
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub distribution: Option<DistributionDesc>,
+        /// Return the energy single-scattering microfacets lose.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        pub multiscatter: bool,
     }
 }
 
@@ -82,6 +85,7 @@ impl DielectricDesc {
             ior: ior as f32,
             refract_only: self.refract_only,
             roughness: rough.then_some(roughness),
+            multiscatter: self.multiscatter,
         })))
     }
 }
@@ -98,6 +102,8 @@ pub struct Dielectric {
     /// The microfacets of frosted glass, reflecting and refracting by the
     /// exact Fresnel equations; `None` for the notes' glass.
     pub roughness: Option<Roughness>,
+    /// Return the energy single scattering loses.
+    pub multiscatter: bool,
 }
 
 impl Dielectric {
@@ -120,6 +126,7 @@ impl Dielectric {
                     1.0 / self.ior
                 },
                 roughness: r.at(hit, textures),
+                multiscatter: self.multiscatter,
             }),
         }
     }

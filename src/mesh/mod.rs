@@ -213,6 +213,7 @@ impl MeshMaterial {
                 ior,
                 refract_only: false,
                 roughness: None,
+                multiscatter: false,
             }))
         } else if self.metallic >= 0.5 {
             let r = unit(self.roughness);

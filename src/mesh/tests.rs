@@ -259,6 +259,7 @@ fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
             ior: 1.45,
             refract_only: false,
             roughness: None,
+            multiscatter: false,
         }))
     );
     assert_eq!(
@@ -267,6 +268,7 @@ fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
             ior: 1.33,
             refract_only: false,
             roughness: None,
+            multiscatter: false,
         }))
     );
     assert_eq!(
@@ -708,6 +710,7 @@ fn gltf_transmission_and_strips_and_fans() {
             ior: 1.7,
             refract_only: false,
             roughness: None,
+            multiscatter: false,
         }))
     );
 }
