@@ -105,6 +105,17 @@ pub fn in_cone(u: [f32; 2], axis: Vec3, one_minus_cos_max: f32) -> Vec3 {
     (tangent * (sin * c) + bitangent * (sin * s) + axis * cos).normalize()
 }
 
+/// A direction of the hemisphere around +z distributed as cos θ/π, from `u`
+/// uniform in [0, 1)²: cos²θ = 1 − `u[0]`, the azimuth `u[1]` turns (the
+/// projection of a uniform point of the unit disk, Malley's method).
+#[inline]
+pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
+    let sin2 = u[0];
+    let r = sin2.sqrt();
+    let (s, c) = sin_cos_turns(u[1]);
+    Vec3::new(r * c, r * s, (1.0 - sin2).max(0.0).sqrt())
+}
+
 /// A uniformly distributed direction in the hemisphere around `normal`,
 /// from `u` uniform in [0, 1)².
 #[inline]

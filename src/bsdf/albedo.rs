@@ -30,11 +30,14 @@ const N_R: usize = 32;
 const N_ETA: usize = 12;
 const ETA_MAX: f32 = 3.0;
 
-/// μ at grid index `i`: from 0.02 (grazing) to 1, closer together near
-/// grazing, where the albedo changes fastest.
+/// The most grazing μ of the tables.
+const MU_MIN: f32 = 0.002;
+
+/// μ at grid index `i`: from [`MU_MIN`] (grazing) to 1, closer together
+/// near grazing, where the albedo changes fastest.
 fn mu_at(i: usize) -> f32 {
     let t = i as f32 / (N_MU - 1) as f32;
-    0.02 + 0.98 * t * t
+    MU_MIN + (1.0 - MU_MIN) * t * t
 }
 
 /// √α at grid index `j`: from 0.02 to 1.
@@ -89,9 +92,9 @@ fn conductor_albedo(d: &Microfacet, wo: Vec3) -> f32 {
 
 /// The albedo, counted as power (without the η² of radiance), of a
 /// single-scattering dielectric interface of relative index `eta` seen
-/// from `wo`: reflection and transmission together.
-fn dielectric_albedo(d: &Microfacet, wo: Vec3, eta: f32) -> f32 {
-    let mut sum = 0.0f64;
+/// from `wo`: what it reflects and what it transmits.
+fn dielectric_albedo(d: &Microfacet, wo: Vec3, eta: f32) -> [f32; 2] {
+    let (mut reflected, mut transmitted) = (0.0f64, 0.0f64);
     for u in grid(DIELECTRIC_GRID) {
         let wm = d.sample_wm(wo, u);
         let dot_o = wo.dot(wm);
@@ -109,15 +112,16 @@ fn dielectric_albedo(d: &Microfacet, wo: Vec3, eta: f32) -> f32 {
         let weight = |wi: Vec3| d.d(wm) * d.g(wo, wi) * dot_o / (wo.z * pdf_m);
         let wr = fresnel::reflect(wo, wm);
         if wr.z > 0.0 {
-            sum += f64::from(r * weight(wr));
+            reflected += f64::from(r * weight(wr));
         }
         if let Some((wt, _)) = fresnel::refract(wo, wm, eta) {
             if wt.z < 0.0 {
-                sum += f64::from((1.0 - r) * weight(wt));
+                transmitted += f64::from((1.0 - r) * weight(wt));
             }
         }
     }
-    (sum / (DIELECTRIC_GRID * DIELECTRIC_GRID) as f64) as f32
+    let n = (DIELECTRIC_GRID * DIELECTRIC_GRID) as f64;
+    [(reflected / n) as f32, (transmitted / n) as f32]
 }
 
 /// A table of albedos over (η, √α, μ).
@@ -133,7 +137,7 @@ impl Table {
     /// Linear interpolation in √α and μ (clamped to the grid) in layer `k`.
     fn lookup(&self, k: usize, r: f32, mu: f32) -> f32 {
         let fj = ((r - 0.02) / 0.98 * (N_R - 1) as f32).clamp(0.0, (N_R - 1) as f32);
-        let t = ((mu - 0.02) / 0.98).max(0.0).sqrt();
+        let t = ((mu - MU_MIN) / (1.0 - MU_MIN)).max(0.0).sqrt();
         let fi = (t * (N_MU - 1) as f32).clamp(0.0, (N_MU - 1) as f32);
         let (j0, i0) = ((fj as usize).min(N_R - 2), (fi as usize).min(N_MU - 2));
         let (tj, ti) = (fj - j0 as f32, fi - i0 as f32);
@@ -142,7 +146,12 @@ impl Table {
     }
 }
 
-fn build(layers: usize, albedo: impl Fn(usize, &Microfacet, Vec3) -> f32 + Sync) -> Table {
+/// Tables of `C` albedos over `layers` layers, entry by entry from
+/// `albedo(layer, microfacets, direction)`.
+fn build<const C: usize>(
+    layers: usize,
+    albedo: impl Fn(usize, &Microfacet, Vec3) -> [f32; C] + Sync,
+) -> [Table; C] {
     let entry = |n: usize| {
         let (k, j, i) = (n / (N_R * N_MU), n / N_MU % N_R, n % N_MU);
         let r = r_at(j);
@@ -152,7 +161,7 @@ fn build(layers: usize, albedo: impl Fn(usize, &Microfacet, Vec3) -> f32 + Sync)
             Model::Beckmann
         };
         let d = Microfacet::new(r * r, r * r, model);
-        albedo(k, &d, direction(mu_at(i))).max(1e-3)
+        albedo(k, &d, direction(mu_at(i)))
     };
     // On threads of its own, not rayon's: a render's workers wait for the
     // table while it is made, and could not make it.
@@ -161,7 +170,7 @@ fn build(layers: usize, albedo: impl Fn(usize, &Microfacet, Vec3) -> f32 + Sync)
         .map_or(1, |t| t.get())
         .min(16);
     let chunk = n.div_ceil(threads);
-    let mut values = vec![0.0f32; n];
+    let mut values = vec![[0.0f32; C]; n];
     std::thread::scope(|s| {
         for (c, part) in values.chunks_mut(chunk).enumerate() {
             let entry = &entry;
@@ -172,25 +181,76 @@ fn build(layers: usize, albedo: impl Fn(usize, &Microfacet, Vec3) -> f32 + Sync)
             });
         }
     });
-    Table { values }
+    std::array::from_fn(|c| Table {
+        values: values.iter().map(|v| v[c]).collect(),
+    })
 }
 
 /// Layers: GGX, Beckmann.
 fn conductor_table() -> &'static Table {
     static TABLE: OnceLock<Table> = OnceLock::new();
-    TABLE.get_or_init(|| build(2, |_, d, wo| conductor_albedo(d, wo)))
+    TABLE.get_or_init(|| {
+        let [t] = build(2, |_, d, wo| [conductor_albedo(d, wo).max(1e-3)]);
+        t
+    })
 }
 
-/// Layers: for each η of the grid, seen from outside (η) and from inside
-/// (1/η), GGX and Beckmann.
-fn dielectric_table() -> &'static Table {
-    static TABLE: OnceLock<Table> = OnceLock::new();
-    TABLE.get_or_init(|| {
+/// The albedos of dielectric interfaces: what they reflect and what they
+/// transmit. Layers: for each η of the grid, seen from outside (η) and
+/// from inside (1/η), GGX and Beckmann.
+fn dielectric_tables() -> &'static [Table; 2] {
+    static TABLES: OnceLock<[Table; 2]> = OnceLock::new();
+    TABLES.get_or_init(|| {
         build(4 * N_ETA, |k, d, wo| {
             let eta = eta_at(k / 4);
             let eta = if (k / 2) % 2 == 0 { eta } else { 1.0 / eta };
             dielectric_albedo(d, wo, eta)
         })
+    })
+}
+
+/// Where a relative index falls in the tables: from inside or outside,
+/// the layer below and the fraction of the way to the next.
+fn eta_place(eta: f32) -> (usize, usize, f32) {
+    let (inside, e) = if eta >= 1.0 { (0, eta) } else { (1, 1.0 / eta) };
+    let fk = ((e - 1.0) / (ETA_MAX - 1.0) * (N_ETA - 1) as f32).clamp(0.0, (N_ETA - 1) as f32);
+    let k0 = (fk as usize).min(N_ETA - 2);
+    (inside, k0, fk - k0 as f32)
+}
+
+/// Interpolates between the tabulated indices: `at(layer)` looked up in
+/// the two layers around `eta`.
+fn across_eta(d: &Microfacet, eta: f32, at: impl Fn(usize, f32) -> f32) -> f32 {
+    let (model, r) = layer(d);
+    let (inside, k0, t) = eta_place(eta);
+    let of = |k: usize| at(k * 4 + inside * 2 + model, r);
+    of(k0) * (1.0 - t) + of(k0 + 1) * t
+}
+
+/// Points of the quadrature of a coat's internal reflectance over μ.
+const RI_POINTS: usize = 64;
+
+/// The fraction of light diffused from below that a rough coat reflects
+/// back, ∫₀¹ 2μ R(μ) dμ seen from inside, over (η, model, √α).
+fn internal_reflectance_table() -> &'static Vec<f32> {
+    static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let [reflected, _] = dielectric_tables();
+        let mut out = Vec::with_capacity(N_ETA * 2 * N_R);
+        for k in 0..N_ETA {
+            for model in 0..2 {
+                for j in 0..N_R {
+                    let mut sum = 0.0f64;
+                    for p in 0..RI_POINTS {
+                        let mu = (p as f32 + 0.5) / RI_POINTS as f32;
+                        sum +=
+                            f64::from(2.0 * mu * reflected.lookup(k * 4 + 2 + model, r_at(j), mu));
+                    }
+                    out.push((sum / RI_POINTS as f64) as f32);
+                }
+            }
+        }
+        out
     })
 }
 
@@ -213,26 +273,44 @@ pub fn conductor(d: &Microfacet, mu: f32) -> f32 {
 /// microfacets `d` and relative index `eta` (from the side seen) at
 /// incidence cosine `mu`, interpolated between the tabulated indices.
 pub fn dielectric(d: &Microfacet, eta: f32, mu: f32) -> f32 {
-    let (model, r) = layer(d);
-    let (inside, e) = if eta >= 1.0 { (0, eta) } else { (1, 1.0 / eta) };
-    let fk = ((e - 1.0) / (ETA_MAX - 1.0) * (N_ETA - 1) as f32).clamp(0.0, (N_ETA - 1) as f32);
-    let k0 = (fk as usize).min(N_ETA - 2);
-    let t = fk - k0 as f32;
-    let table = dielectric_table();
-    let at = |k: usize| table.lookup(k * 4 + inside * 2 + model, r, mu);
-    at(k0) * (1.0 - t) + at(k0 + 1) * t
+    let [reflected, transmitted] = dielectric_tables();
+    across_eta(d, eta, |k, r| {
+        (reflected.lookup(k, r, mu) + transmitted.lookup(k, r, mu)).max(1e-3)
+    })
 }
 
-/// The factor returning a conductor's lost energy (Turquin 2019), for
-/// reflectance `f0` at normal incidence: 1 + f₀(1 − E)/E.
-pub fn conductor_compensation(d: &Microfacet, mu: f32, f0: Vec3) -> Vec3 {
-    let e = conductor(d, mu.abs());
+/// The fraction of light arriving at incidence cosine `mu` that a rough
+/// coat of microfacets `d` and index `eta` (> 1) lets through to what it
+/// covers, counted as power.
+pub fn coat_transmittance(d: &Microfacet, eta: f32, mu: f32) -> f32 {
+    let [_, transmitted] = dielectric_tables();
+    across_eta(d, eta.max(1.0), |k, r| transmitted.lookup(k, r, mu)).clamp(0.0, 1.0)
+}
+
+/// The fraction of light diffused from below that a rough coat of
+/// microfacets `d` and index `eta` (> 1) reflects back down.
+pub fn coat_internal_reflectance(d: &Microfacet, eta: f32) -> f32 {
+    let table = internal_reflectance_table();
+    let (model, r) = layer(d);
+    let (_, k0, t) = eta_place(eta.max(1.0));
+    let fj = ((r - 0.02) / 0.98 * (N_R - 1) as f32).clamp(0.0, (N_R - 1) as f32);
+    let j0 = (fj as usize).min(N_R - 2);
+    let tj = fj - j0 as f32;
+    let at = |k: usize, j: usize| table[(k * 2 + model) * N_R + j];
+    let row = |k: usize| at(k, j0) * (1.0 - tj) + at(k, j0 + 1) * tj;
+    (row(k0) * (1.0 - t) + row(k0 + 1) * t).clamp(0.0, 1.0)
+}
+
+/// The factor returning a conductor's lost energy (Turquin 2019) seen
+/// along `wo`, for reflectance `f0` at normal incidence: 1 + f₀(1 − E)/E.
+pub fn conductor_compensation(d: &Microfacet, wo: Vec3, f0: Vec3) -> Vec3 {
+    let e = conductor(d, wo.z.abs());
     Vec3::ONE + f0 * ((1.0 - e) / e)
 }
 
-/// The factor returning a dielectric's lost energy: 1/E.
-pub fn dielectric_compensation(d: &Microfacet, eta: f32, mu: f32) -> f32 {
-    1.0 / dielectric(d, eta, mu.abs())
+/// The factor returning a dielectric's lost energy seen along `wo`: 1/E.
+pub fn dielectric_compensation(d: &Microfacet, eta: f32, wo: Vec3) -> f32 {
+    1.0 / dielectric(d, eta, wo.z.abs())
 }
 
 #[cfg(test)]

@@ -75,7 +75,7 @@ impl Conductor {
     fn f_cos(&self, d: &Microfacet, wo: Vec3, wi: Vec3, wm: Vec3) -> Color {
         let single = self.fresnel(wo.dot(wm)) * (d.d(wm) * d.g(wo, wi) / (4.0 * wo.z));
         if self.multiscatter {
-            single * albedo::conductor_compensation(d, wo.z, self.fresnel(1.0))
+            single * albedo::conductor_compensation(d, wo, self.fresnel(1.0))
         } else {
             single
         }

@@ -213,7 +213,7 @@ impl ExactDielectric {
             } else {
                 1.0 / self.eta
             };
-            albedo::dielectric_compensation(&d, eta, cos_o)
+            albedo::dielectric_compensation(&d, eta, wo)
         } else {
             1.0
         };

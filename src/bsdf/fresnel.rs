@@ -96,6 +96,21 @@ pub fn refract(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
     Some((-w / eta + (cos_i / eta - cos_t) * n, eta))
 }
 
+/// The fraction of light diffused uniformly over the hemisphere that a
+/// smooth interface of relative index `eta` reflects, ∫ 2μ F(μ) dμ, by the
+/// fits Mitsuba 3 uses: Egan & Hilgeman's for η < 1, d'Eon & Irving's
+/// polynomial in 1/η otherwise.
+#[inline]
+pub fn diffuse_reflectance(eta: f32) -> f32 {
+    if eta < 1.0 {
+        0.0636 / eta + eta * (-1.4399 * eta + 0.7099) + 0.6681
+    } else {
+        let x = 1.0 / eta;
+        0.919_317
+            + x * (-3.479_3 + x * (6.753_35 + x * (-7.809_89 + x * (4.985_54 + x * -1.368_81))))
+    }
+}
+
 /// `w` mirrored about unit `n`: 2(w·n)n − w (both pointing away).
 #[inline]
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
@@ -170,5 +185,28 @@ mod tests {
         assert_eq!(schlick(1.0, f0, Vec3::ONE), f0);
         assert_eq!(schlick(0.0, f0, Vec3::ONE), Vec3::ONE);
         assert!((f0_of_ior(1.5) - 0.04).abs() < 1e-7);
+    }
+
+    /// Mitsuba 3's values of its fits (`fresnel_diffuse_reflectance`), and
+    /// a midpoint quadrature of ∫ 2μ F(μ) dμ that they approximate.
+    #[test]
+    fn diffuse_reflectance_matches_its_fits_and_the_integral() {
+        assert!((diffuse_reflectance(1.5) - 0.091_774_3).abs() < 2e-6);
+        assert!((diffuse_reflectance(1.0 / 1.5) - 0.596_811_1).abs() < 2e-6);
+        for eta in [1.3f32, 1.5, 2.0, 1.0 / 1.5] {
+            let n = 20_000;
+            let integral: f32 = (0..n)
+                .map(|i| {
+                    let mu = (i as f32 + 0.5) / n as f32;
+                    2.0 * mu * dielectric(mu, eta)
+                })
+                .sum::<f32>()
+                / n as f32;
+            assert!(
+                (integral - diffuse_reflectance(eta)).abs() < 0.01,
+                "η {eta}: {integral} against {}",
+                diffuse_reflectance(eta)
+            );
+        }
     }
 }

@@ -30,6 +30,9 @@ pub mod diffuse;
 pub mod fresnel;
 pub mod metal;
 pub mod microfacet;
+pub mod plastic;
+pub mod principled;
+pub mod sheen;
 #[cfg(test)]
 mod tests;
 
@@ -139,6 +142,13 @@ impl LobeFlags {
     pub const fn is_transmission(self) -> bool {
         self.contains(LobeFlags::TRANSMISSION)
     }
+
+    /// Whether some of it is spread out (diffuse or glossy), which a light
+    /// sample can find.
+    #[inline(always)]
+    pub const fn is_spread(self) -> bool {
+        self.0 & (LobeFlags::DIFFUSE.0 | LobeFlags::GLOSSY.0) != 0
+    }
 }
 
 impl std::ops::BitOr for LobeFlags {
@@ -177,6 +187,10 @@ pub enum Lobe {
     Conductor(conductor::Conductor),
     /// Glass by the exact Fresnel equations, smooth or rough.
     ExactDielectric(dielectric::ExactDielectric),
+    /// A diffuse base under a clear coat.
+    Plastic(plastic::Plastic),
+    /// The glTF metallic-roughness material and its layers.
+    Principled(principled::Principled),
 }
 
 impl Lobe {
@@ -201,6 +215,8 @@ impl Lobe {
             }
             Lobe::Conductor(c) => c.flags(),
             Lobe::ExactDielectric(d) => d.flags(),
+            Lobe::Plastic(p) => p.flags(),
+            Lobe::Principled(p) => p.flags(),
         }
     }
 
@@ -211,6 +227,8 @@ impl Lobe {
         match self {
             Lobe::Conductor(c) => c.sample(wo, u),
             Lobe::ExactDielectric(d) => d.sample(wo, uc, u),
+            Lobe::Plastic(p) => p.sample(wo, uc, u),
+            Lobe::Principled(p) => p.sample(wo, uc, u),
             Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => None,
         }
     }
@@ -222,6 +240,8 @@ impl Lobe {
         match self {
             Lobe::Conductor(c) => c.eval_and_pdf(wo, wi),
             Lobe::ExactDielectric(d) => d.eval_and_pdf(wo, wi),
+            Lobe::Plastic(p) => p.eval_and_pdf(wo, wi),
+            Lobe::Principled(p) => p.eval_and_pdf(wo, wi),
             Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),
         }
     }
@@ -262,7 +282,7 @@ impl Bsdf {
         match &self.lobe {
             Lobe::Diffuse(d) => d.is_lambertian(),
             Lobe::Metal(_) | Lobe::Dielectric(_) => false,
-            lobe => !lobe.flags().is_specular(),
+            lobe => lobe.flags().is_spread(),
         }
     }
 

@@ -1,0 +1,155 @@
+//! Plastic: a diffuse base under a clear dielectric coat, smooth or rough
+//! (the model of Mitsuba 3's `plastic` and `roughplastic`, after Weidlich
+//! & Wilkie 2007).
+//!
+//! The coat reflects specularly by the exact Fresnel equations (off
+//! microfacets when rough). What it lets through, a fraction T(μ) of the
+//! light arriving at cosine μ, is diffused by the base of albedo ρ; of the
+//! diffused light the coat sends a fraction Ri back down, where it is
+//! diffused again, and so on: the base under its coat reflects
+//!
+//! f_d = ρ / (1 − ρ Ri) · T(μo) T(μi) / (π η²),
+//!
+//! the geometric series of those inner bounces (Mitsuba's `nonlinear =
+//! true`: a darker base is more saturated under a coat, as real paint is).
+//! The 1/η² is the radiance leaving the denser coat into a wider solid
+//! angle. For a smooth coat T = 1 − F and Ri is the fit of d'Eon & Irving
+//! to the hemispherical Fresnel reflectance, as Mitsuba's; for a rough one
+//! both are tabulated from the rough interface (see [`super::albedo`]),
+//! where Mitsuba tabulates them per material. The coat's specular term uses
+//! the height-correlated Smith shadowing of every lobe here (Mitsuba's is
+//! separable).
+//!
+//! Nothing is absorbed by the coat, so the lobe reflects at most what
+//! arrives: R(μo) + T(μo) ρ (1 − Ri)/(1 − ρ Ri) ≤ R + T ≤ 1.
+
+use super::microfacet::Microfacet;
+use super::{albedo, fresnel};
+use super::{BsdfSample, LobeFlags};
+use crate::math::{Color, Vec3};
+use crate::sampling::cosine_hemisphere;
+use std::f32::consts::FRAC_1_PI;
+
+/// A coated diffuse surface at one point, in the local frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plastic {
+    /// The base's albedo, each channel in [0, 1].
+    pub albedo: Color,
+    /// The coat's index of refraction over the outside's (> 0).
+    pub eta: f32,
+    /// The coat's microfacets; `None` for a smooth coat.
+    pub roughness: Option<Microfacet>,
+    /// Return the energy the coat's single scattering loses.
+    pub multiscatter: bool,
+}
+
+impl Plastic {
+    /// What kind of scattering it does.
+    pub fn flags(&self) -> LobeFlags {
+        let coat = match self.roughness {
+            None => LobeFlags::SPECULAR,
+            Some(_) => LobeFlags::GLOSSY,
+        };
+        LobeFlags::REFLECTION | LobeFlags::DIFFUSE | coat
+    }
+
+    /// The fraction of light arriving at cosine `mu` the coat lets through.
+    #[inline]
+    fn transmittance(&self, mu: f32) -> f32 {
+        match &self.roughness {
+            None => 1.0 - fresnel::dielectric(mu, self.eta),
+            Some(d) => albedo::coat_transmittance(d, self.eta, mu),
+        }
+    }
+
+    /// The fraction of the base's diffuse light the coat reflects back.
+    #[inline]
+    fn internal_reflectance(&self) -> f32 {
+        match &self.roughness {
+            None => fresnel::diffuse_reflectance(1.0 / self.eta),
+            Some(d) => albedo::coat_internal_reflectance(d, self.eta),
+        }
+    }
+
+    /// The probability of sampling the coat rather than the base, seen at
+    /// coat transmittance `t_o`: Mitsuba's, the coat's reflectance against
+    /// the base's weighted by 1 and the base's mean albedo.
+    #[inline]
+    fn coat_probability(&self, t_o: f32) -> f32 {
+        let base = (self.albedo.x + self.albedo.y + self.albedo.z) / 3.0;
+        let ws = 1.0 / (1.0 + base);
+        let r = 1.0 - t_o;
+        let p = r * ws / (r * ws + t_o * (1.0 - ws));
+        if p.is_finite() {
+            p
+        } else {
+            1.0
+        }
+    }
+
+    /// A direction for light leaving along `wo`, from `uc` (coat or base)
+    /// and `u`, uniform in [0, 1).
+    #[inline]
+    pub fn sample(&self, wo: Vec3, uc: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let p_coat = self.coat_probability(self.transmittance(wo.z));
+        let (wi, part) = if uc < p_coat {
+            match &self.roughness {
+                None => {
+                    let f = fresnel::dielectric(wo.z, self.eta);
+                    return Some(BsdfSample {
+                        value: Color::splat(f / p_coat),
+                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                        pdf: p_coat,
+                        flags: LobeFlags::REFLECTION | LobeFlags::SPECULAR,
+                    });
+                }
+                Some(d) => (fresnel::reflect(wo, d.sample_wm(wo, u)), LobeFlags::GLOSSY),
+            }
+        } else {
+            (cosine_hemisphere(u), LobeFlags::DIFFUSE)
+        };
+        if !(wi.z > 0.0) {
+            return None;
+        }
+        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
+        let value = f_cos / pdf;
+        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
+            value,
+            wi,
+            pdf,
+            flags: LobeFlags::REFLECTION | part,
+        })
+    }
+
+    /// f(wo, wi)·|cos θi| and the density of `wi` (the coat's mirror
+    /// reflection, a delta, left out).
+    #[inline]
+    pub fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return (Color::ZERO, 0.0);
+        }
+        let t_o = self.transmittance(wo.z);
+        let p_coat = self.coat_probability(t_o);
+        let ri = self.internal_reflectance();
+        let through = t_o * self.transmittance(wi.z) * wi.z * FRAC_1_PI / (self.eta * self.eta);
+        let base = self.albedo / (Color::ONE - self.albedo * ri) * through;
+        let mut f_cos = base;
+        let mut pdf = (1.0 - p_coat) * wi.z * FRAC_1_PI;
+        if let Some(d) = &self.roughness {
+            let wm = (wo + wi).normalize_or_zero();
+            if wm != Vec3::ZERO && wo.dot(wm) > 0.0 {
+                let f = fresnel::dielectric(wo.dot(wm), self.eta);
+                let mut coat = f * d.d(wm) * d.g(wo, wi) / (4.0 * wo.z);
+                if self.multiscatter {
+                    coat *= albedo::dielectric_compensation(d, self.eta, wo);
+                }
+                f_cos += Color::splat(coat);
+                pdf += p_coat * d.pdf(wo, wm) / (4.0 * wo.dot(wm));
+            }
+        }
+        (f_cos, pdf)
+    }
+}
