@@ -121,6 +121,12 @@ fn step(
     };
     let record = scene.record(ray, hit);
     let material = scene.material(&record);
+    if !record.front_face {
+        if let Some(sigma) = material.absorption() {
+            // The segment ran inside an absorbing volume (Beer–Lambert).
+            path.throughput *= (-sigma * hit.t).exp();
+        }
+    }
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }

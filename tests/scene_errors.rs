@@ -561,7 +561,7 @@ fn emissive_materials_are_checked_like_the_others() {
         &[
             "materials.lamp.albedo",
             "unknown field `albedo` in an emissive material",
-            "`albedo` belongs to diffuse and metal materials",
+            "`albedo` belongs to diffuse, metal and plastic materials",
         ],
     );
     let m = refused(&lamp("radiance = [1, 1, 1]\ntwo_sided = 2"));

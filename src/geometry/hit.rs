@@ -2,6 +2,7 @@
 
 use crate::math::{Point3, Vec3};
 use crate::ray::Ray;
+use crate::texture::TexCoords;
 
 /// The nearest intersection of a ray with the scene.
 #[derive(Clone, Copy, Debug)]
@@ -29,10 +30,21 @@ pub struct HitRecord {
     pub material: u32,
     /// Index of the hit primitive in the scene's tree.
     pub object: u32,
+    /// The second set of texture coordinates (a mesh's `TEXCOORD_1`; `uv`
+    /// elsewhere).
+    pub uv1: [f32; 2],
     /// ∂p/∂u: the surface's tangent along its first texture coordinate
     /// (not unit; zero where it has none, as at a sphere's poles), which
-    /// anisotropic materials align with.
+    /// anisotropic materials align with. Where a mesh gives tangents, its
+    /// tangent, at the length of ∂p/∂u.
     pub dpdu: Vec3,
+    /// ∂p/∂v, along the second coordinate (v up the image); where a mesh
+    /// gives tangents, its bitangent at the length of ∂p/∂v. With `dpdu`,
+    /// the tangent space of normal and bump maps.
+    pub dpdv: Vec3,
+    /// The mesh's vertex colour and alpha there (glTF `COLOR_0`); white
+    /// and opaque elsewhere.
+    pub color: glam::Vec4,
     /// A bound on how far `point` may lie from the true surface through
     /// `f32` rounding. 0 when the scene's epsilon is 0, so that rays leave
     /// from the point itself (the notes' shadow acne).
@@ -40,6 +52,16 @@ pub struct HitRecord {
 }
 
 impl HitRecord {
+    /// Where textures are looked up at this hit.
+    #[inline(always)]
+    pub fn tex_coords(&self) -> TexCoords {
+        TexCoords {
+            uv: self.uv,
+            uv1: self.uv1,
+            point: self.point,
+        }
+    }
+
     /// Where a ray leaving the surface along `direction` starts: the hit
     /// point moved off the surface, to the side `direction` goes, by the
     /// rounding bound `error`. Started at the rounded point itself, a ray

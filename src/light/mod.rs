@@ -144,7 +144,7 @@ impl Light {
         };
         // Emitted light is not clamped as an albedo is, but never negative.
         textures[t.texture as usize]
-            .value(textures, uv, point)
+            .value(textures, &crate::texture::TexCoords::new(uv, point))
             .max(Color::ZERO)
     }
 }

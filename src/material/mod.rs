@@ -35,6 +35,32 @@ macro_rules! material_desc {
             /// outward normal points to.
             #[serde(default, skip_serializing_if = "std::ops::Not::not")]
             pub two_sided: bool,
+            /// A tangent-space normal map: the name of a colour texture,
+            /// read as linear data (x, y, z = 2·(r, g, b) − 1).
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub normal_map: Option<String>,
+            /// How far the normal map tilts the normal (its x and y are
+            /// multiplied by it), ≥ 0; 1 when absent.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub normal_scale: Option<f64>,
+            /// A height map: the name of a scalar texture whose value lifts
+            /// the surface along its normal, tilting the shading normal.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub bump_map: Option<String>,
+            /// The height, in scene units, of a bump map's value 1; 1 when
+            /// absent.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub bump_scale: Option<f64>,
+            /// How much of the surface is there, in [0, 1]: a number or a
+            /// scalar texture (cut-outs: leaves, fences). Rays pass through
+            /// what is not.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub opacity: Option<$crate::material::param::ScalarDesc>,
+            /// With `opacity`: the surface is there where the opacity is at
+            /// least this, and nowhere else (glTF's `MASK`); without it, a
+            /// ray passes through with probability 1 − opacity (`BLEND`).
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_cutoff: Option<f64>,
         }
 
         impl $name {
@@ -44,6 +70,12 @@ macro_rules! material_desc {
                     emission: self.emission.as_ref(),
                     emission_strength: self.emission_strength,
                     two_sided: self.two_sided,
+                    normal_map: self.normal_map.as_deref(),
+                    normal_scale: self.normal_scale,
+                    bump_map: self.bump_map.as_deref(),
+                    bump_scale: self.bump_scale,
+                    opacity: self.opacity.as_ref(),
+                    alpha_cutoff: self.alpha_cutoff,
                 }
             }
         }
@@ -59,6 +91,8 @@ macro_rules! material_kinds {
         /// fields).
         #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
         #[serde(tag = "type", rename_all = "kebab-case")]
+        // Descriptions are read once and compiled: their size does not matter.
+        #[allow(clippy::large_enum_variant)]
         pub enum MaterialDesc {
             $( $(#[$meta])* $variant($desc), )*
         }
@@ -120,6 +154,8 @@ pub mod emissive;
 pub mod metal;
 pub mod metals;
 pub mod param;
+pub mod plastic;
+pub mod principled;
 pub mod roughness;
 
 pub use crate::bsdf::dielectric::{reflectance, refract};
@@ -131,10 +167,12 @@ pub use diffuse::{AttenuationDesc, BounceDesc, Diffuse, DiffuseDesc};
 pub use emissive::{Emission, Emissive, EmissiveDesc};
 pub use metal::{Metal, MetalDesc};
 pub use param::{ColorDesc, ColorParam, Invalid, ScalarDesc, ScalarParam, Textures};
+pub use plastic::{Plastic, PlasticDesc};
+pub use principled::{Principled, PrincipledDesc};
 
 use crate::bsdf::{Bsdf, Frame, Lobe};
 use crate::geometry::HitRecord;
-use crate::math::Color;
+use crate::math::{Color, Vec3};
 use crate::texture::Texture;
 use param::ColorRange;
 
@@ -149,6 +187,10 @@ material_kinds! {
     Emissive(EmissiveDesc) = "emissive", "an emissive material";
     /// A metal by its complex index of refraction, smooth or rough.
     Conductor(ConductorDesc) = "conductor", "a conductor material";
+    /// A diffuse base under a smooth or rough clear coat.
+    Plastic(PlasticDesc) = "plastic", "a plastic material";
+    /// The glTF metallic-roughness material and its layers.
+    Principled(PrincipledDesc) = "principled", "a principled material";
 }
 
 /// A kind of material as the readers know it.
@@ -171,6 +213,18 @@ pub struct SurfaceDesc<'a> {
     pub emission_strength: Option<f64>,
     /// Emit from both sides.
     pub two_sided: bool,
+    /// A normal map's texture.
+    pub normal_map: Option<&'a str>,
+    /// Its strength.
+    pub normal_scale: Option<f64>,
+    /// A bump map's texture.
+    pub bump_map: Option<&'a str>,
+    /// Its height.
+    pub bump_scale: Option<f64>,
+    /// How much of the surface is there.
+    pub opacity: Option<&'a ScalarDesc>,
+    /// Where it is cut off.
+    pub alpha_cutoff: Option<f64>,
 }
 
 impl SurfaceDesc<'_> {
@@ -216,7 +270,221 @@ impl SurfaceDesc<'_> {
         } else if let Some(e) = &mut material.emission {
             e.two_sided = self.two_sided;
         }
+        material.shape = self.shape(field, textures)?;
+        material.opacity = self.opacity(field, textures)?;
         Ok(material)
+    }
+
+    /// The normal or bump map, if any.
+    fn shape(&self, field: &str, textures: &mut dyn Textures) -> Result<Option<Shape>, Invalid> {
+        let factor = |name: &str, v: Option<f64>| match v {
+            Some(v) => param::number(&format!("{field}.{name}"), v, param::Range::NonNegative),
+            None => Ok(1.0),
+        };
+        match (self.normal_map, self.bump_map) {
+            (Some(_), Some(_)) => Err(Invalid::new(
+                format!("{field}.bump_map"),
+                "give `normal_map` or `bump_map`, not both",
+            )),
+            (Some(name), None) => {
+                if self.bump_scale.is_some() {
+                    return Err(Invalid::new(
+                        format!("{field}.bump_scale"),
+                        "scales `bump_map`, which the material does not have",
+                    ));
+                }
+                let texture = textures.normal_map(&format!("{field}.normal_map"), name)?;
+                Ok(Some(Shape::Normal {
+                    texture,
+                    scale: factor("normal_scale", self.normal_scale)?,
+                }))
+            }
+            (None, Some(name)) => {
+                if self.normal_scale.is_some() {
+                    return Err(Invalid::new(
+                        format!("{field}.normal_scale"),
+                        "scales `normal_map`, which the material does not have",
+                    ));
+                }
+                let at = format!("{field}.bump_map");
+                let texture = match textures.scalar(
+                    &at,
+                    &ScalarDesc::Texture(name.to_string()),
+                    param::Range::Any,
+                )? {
+                    ScalarParam::Texture(t) => t,
+                    ScalarParam::Const(_) => unreachable!("a name is a texture"),
+                };
+                let scale = match self.bump_scale {
+                    Some(v) => param::number(&format!("{field}.bump_scale"), v, param::Range::Any)?,
+                    None => 1.0,
+                };
+                Ok(Some(Shape::Bump { texture, scale }))
+            }
+            (None, None) => {
+                for (name, v) in [
+                    ("normal_scale", self.normal_scale),
+                    ("bump_scale", self.bump_scale),
+                ] {
+                    if v.is_some() {
+                        let map = name.replace("_scale", "_map");
+                        return Err(Invalid::new(
+                            format!("{field}.{name}"),
+                            format!("scales `{map}`, which the material does not have"),
+                        ));
+                    }
+                }
+                Ok(None)
+            }
+        }
+    }
+
+    /// The opacity, if any.
+    fn opacity(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<Option<Opacity>, Invalid> {
+        let cutoff = self
+            .alpha_cutoff
+            .map(|c| param::number(&format!("{field}.alpha_cutoff"), c, param::Range::Unit))
+            .transpose()?;
+        let Some(o) = self.opacity else {
+            if cutoff.is_some() {
+                return Err(Invalid::new(
+                    format!("{field}.alpha_cutoff"),
+                    "cuts `opacity` off, which the material does not have",
+                ));
+            }
+            return Ok(None);
+        };
+        let value = textures.scalar(&format!("{field}.opacity"), o, param::Range::Unit)?;
+        Ok(Some(Opacity {
+            value,
+            cutoff,
+            vertex: false,
+        }))
+    }
+}
+
+/// What tilts a material's shading normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A tangent-space normal map: texture (linear RGB) and how far it
+    /// tilts.
+    Normal {
+        /// The texture.
+        texture: u32,
+        /// The factor on its x and y.
+        scale: f32,
+    },
+    /// A height map: scalar texture and the height of its value 1.
+    Bump {
+        /// The texture.
+        texture: u32,
+        /// Scene units per unit of the texture.
+        scale: f32,
+    },
+}
+
+/// The step in texture coordinates of a bump map's differences.
+const BUMP_STEP: f32 = 5e-4;
+
+impl Shape {
+    /// The shading normal at `hit` tilted by the map: unit, on the side the
+    /// ray came from.
+    #[inline(never)]
+    pub fn normal(&self, hit: &HitRecord, textures: &[Texture]) -> Vec3 {
+        // Maps are made for the outside of the surface.
+        let side = if hit.front_face { 1.0 } else { -1.0 };
+        let n = hit.shading_normal * side;
+        let tilted = match *self {
+            Shape::Normal { texture, scale } => {
+                let c = textures[texture as usize].value(textures, &hit.tex_coords());
+                let m = Vec3::new(
+                    (2.0 * c.x - 1.0) * scale,
+                    (2.0 * c.y - 1.0) * scale,
+                    2.0 * c.z - 1.0,
+                );
+                let (t, b) = tangents(n, hit.dpdu, hit.dpdv);
+                t * m.x + b * m.y + n * m.z
+            }
+            Shape::Bump { texture, scale } => {
+                let height = |du: f32, dv: f32| {
+                    let mut at = hit.tex_coords();
+                    at.uv = [at.uv[0] + du, at.uv[1] + dv];
+                    at.uv1 = [at.uv1[0] + du, at.uv1[1] + dv];
+                    at.point += hit.dpdu * du + hit.dpdv * dv;
+                    textures[texture as usize].value(textures, &at).x * scale
+                };
+                let h = height(0.0, 0.0);
+                let dhdu = (height(BUMP_STEP, 0.0) - h) / BUMP_STEP;
+                let dhdv = (height(0.0, BUMP_STEP) - h) / BUMP_STEP;
+                let pu = hit.dpdu + n * dhdu;
+                let pv = hit.dpdv + n * dhdv;
+                let m = pu.cross(pv);
+                // ∂p/∂u × ∂p/∂v may point inwards (a mirrored mapping).
+                if m.dot(n) < 0.0 {
+                    -m
+                } else {
+                    m
+                }
+            }
+        };
+        let tilted = tilted.normalize_or_zero();
+        if tilted == Vec3::ZERO || !tilted.is_finite() {
+            hit.shading_normal
+        } else {
+            tilted * side
+        }
+    }
+}
+
+/// The unit tangent and bitangent about unit normal `n` from the surface's
+/// derivatives: ∂p/∂u made perpendicular to `n`, and ∂p/∂v made
+/// perpendicular to both (n × tangent, turned to ∂p/∂v's side, where it
+/// has none).
+#[inline]
+fn tangents(n: Vec3, dpdu: Vec3, dpdv: Vec3) -> (Vec3, Vec3) {
+    let t = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
+    let t = if t == Vec3::ZERO {
+        n.any_orthonormal_vector()
+    } else {
+        t
+    };
+    let b = n.cross(t);
+    if b.dot(dpdv) < 0.0 {
+        (t, -b)
+    } else {
+        (t, b)
+    }
+}
+
+/// How much of a surface is there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Opacity {
+    /// The opacity in [0, 1].
+    pub value: ScalarParam,
+    /// Present where the opacity is at least this (a mask); `None`: a ray
+    /// passes with probability 1 − opacity.
+    pub cutoff: Option<f32>,
+    /// Multiplied by the mesh's vertex alpha (glTF `COLOR_0`).
+    pub vertex: bool,
+}
+
+impl Opacity {
+    /// Whether the surface at `hit` stops a ray, `u` uniform in [0, 1)
+    /// (used only where the opacity is partial and not cut off).
+    #[inline]
+    pub fn stops(&self, hit: &HitRecord, textures: &[Texture], u: f32) -> bool {
+        let mut a = self.value.at(hit, textures);
+        if self.vertex {
+            a *= hit.color.w;
+        }
+        match self.cutoff {
+            Some(c) => a >= c,
+            None => u < a,
+        }
     }
 }
 
@@ -234,6 +502,10 @@ pub enum Kind {
     Dielectric(Dielectric),
     /// A metal by its complex index of refraction.
     Conductor(Conductor),
+    /// A diffuse base under a clear coat.
+    Plastic(Plastic),
+    /// The glTF metallic-roughness material.
+    Principled(Principled),
 }
 
 /// A surface material.
@@ -243,6 +515,10 @@ pub struct Material {
     pub kind: Kind,
     /// The light it gives off, if any.
     pub emission: Option<Emission>,
+    /// A normal or bump map tilting its shading normal, if any.
+    pub shape: Option<Shape>,
+    /// How much of the surface is there, where it is not all there.
+    pub opacity: Option<Opacity>,
 }
 
 impl Material {
@@ -251,6 +527,8 @@ impl Material {
         Material {
             kind,
             emission: None,
+            shape: None,
+            opacity: None,
         }
     }
 
@@ -259,6 +537,8 @@ impl Material {
         Material {
             kind: Kind::Black,
             emission: Some(emission),
+            shape: None,
+            opacity: None,
         }
     }
 
@@ -266,17 +546,15 @@ impl Material {
     /// `None` where it scatters nothing.
     #[inline(always)]
     pub fn bsdf(&self, hit: &HitRecord, textures: &[Texture]) -> Option<Bsdf> {
-        // The notes' lobes scatter about the normal alone.
-        let notes = |lobe| {
-            Some(Bsdf::new(
-                Frame::normal_only(hit.shading_normal),
-                hit.normal,
-                lobe,
-            ))
+        let n = match &self.shape {
+            None => hit.shading_normal,
+            Some(shape) => shape.normal(hit, textures),
         };
+        // The notes' lobes scatter about the normal alone.
+        let notes = |lobe| Some(Bsdf::new(Frame::normal_only(n), hit.normal, lobe));
         // The others in the frame of the surface's tangent.
         let local = |lobe| {
-            let frame = Frame::from_normal_tangent(hit.shading_normal, hit.dpdu);
+            let frame = Frame::from_normal_tangent(n, hit.dpdu);
             Some(Bsdf::new(frame, hit.normal, lobe))
         };
         match &self.kind {
@@ -288,6 +566,12 @@ impl Material {
                 lobe => local(lobe),
             },
             Kind::Conductor(c) => local(Lobe::Conductor(c.at(hit, textures))),
+            Kind::Plastic(p) => local(Lobe::Plastic(p.at(hit, textures))),
+            Kind::Principled(p) => {
+                let frame = Frame::from_normal_tangent(n, hit.dpdu);
+                let lobe = p.at(hit, textures, &frame);
+                Some(Bsdf::new(frame, hit.normal, Lobe::Principled(lobe)))
+            }
         }
     }
 
@@ -298,6 +582,16 @@ impl Material {
         match &self.emission {
             Some(e) => e.emitted(hit, textures),
             None => Color::ZERO,
+        }
+    }
+
+    /// How much the volume it encloses absorbs per unit length (glTF's
+    /// `KHR_materials_volume` attenuation), if it absorbs.
+    #[inline(always)]
+    pub fn absorption(&self) -> Option<Color> {
+        match &self.kind {
+            Kind::Principled(p) if p.thickness != ScalarParam::Const(0.0) => p.absorption,
+            _ => None,
         }
     }
 
@@ -331,9 +625,15 @@ impl Material {
             Kind::Metal(m) => m.albedo.texture().into_iter().collect(),
             Kind::Dielectric(d) => d.roughness.iter().flat_map(|r| r.textures()).collect(),
             Kind::Conductor(c) => c.roughness.textures().collect(),
+            Kind::Plastic(p) => p.textures(),
+            Kind::Principled(p) => p.textures(),
             Kind::Black => Vec::new(),
         };
         out.extend(self.emission.and_then(|e| e.radiance.texture()));
+        out.extend(self.shape.map(|s| match s {
+            Shape::Normal { texture, .. } | Shape::Bump { texture, .. } => texture,
+        }));
+        out.extend(self.opacity.and_then(|o| o.value.texture()));
         out
     }
 }

@@ -198,7 +198,7 @@ impl ColorParam {
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> Color {
         match *self {
             ColorParam::Const(c) => c,
-            ColorParam::Texture(t) => textures[t as usize].value(textures, hit.uv, hit.point),
+            ColorParam::Texture(t) => textures[t as usize].value(textures, &hit.tex_coords()),
         }
     }
 
@@ -239,7 +239,7 @@ impl ScalarParam {
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> f32 {
         match *self {
             ScalarParam::Const(v) => v,
-            ScalarParam::Texture(t) => textures[t as usize].value(textures, hit.uv, hit.point).x,
+            ScalarParam::Texture(t) => textures[t as usize].value(textures, &hit.tex_coords()).x,
         }
     }
 
@@ -339,6 +339,10 @@ pub trait Textures {
 
     /// A texture that is texture `t` times `factor`.
     fn scaled(&mut self, t: u32, factor: Color) -> u32;
+
+    /// The colour texture `name` of field `field` read as a tangent-space
+    /// normal map (linear data, not sRGB-decoded colour).
+    fn normal_map(&mut self, field: &str, name: &str) -> Result<u32, Invalid>;
 }
 
 /// `v` checked by `range` for field `field`.

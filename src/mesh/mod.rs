@@ -50,6 +50,16 @@ pub struct TriangleMesh {
     /// Per-vertex texture coordinates, indexed like `positions`; `None` unless
     /// every vertex of the mesh has them.
     pub uvs: Option<Vec<[f32; 2]>>,
+    /// A second set of texture coordinates (glTF `TEXCOORD_1`), indexed
+    /// like `positions`; `None` unless every vertex has them.
+    pub uvs1: Option<Vec<[f32; 2]>>,
+    /// Per-vertex colours and alpha (glTF `COLOR_0`, linear), indexed like
+    /// `positions`; `None` unless every vertex has one.
+    pub colors: Option<Vec<[f32; 4]>>,
+    /// Per-vertex tangents (glTF `TANGENT`: xyz along +u, w ±1 the
+    /// bitangent's side, the bitangent being w · normal × tangent), indexed
+    /// like `positions`; `None` unless every vertex has one.
+    pub tangents: Option<Vec<[f32; 4]>>,
     /// Vertex indices of each triangle, counter-clockwise seen from the front
     /// as in the file. No triangle has zero area.
     pub triangles: Vec<[u32; 3]>,
@@ -70,6 +80,18 @@ impl TriangleMesh {
                 .uvs
                 .as_ref()
                 .map_or(0, |t| t.capacity() * size_of::<[f32; 2]>())
+            + self
+                .uvs1
+                .as_ref()
+                .map_or(0, |t| t.capacity() * size_of::<[f32; 2]>())
+            + self
+                .colors
+                .as_ref()
+                .map_or(0, |t| t.capacity() * size_of::<[f32; 4]>())
+            + self
+                .tangents
+                .as_ref()
+                .map_or(0, |t| t.capacity() * size_of::<[f32; 4]>())
             + self.triangles.capacity() * size_of::<[u32; 3]>()
             + self.material.capacity() * size_of::<u32>()
     }
@@ -107,6 +129,15 @@ impl TriangleMesh {
             n.shrink_to_fit();
         }
         if let Some(t) = &mut self.uvs {
+            t.shrink_to_fit();
+        }
+        if let Some(t) = &mut self.uvs1 {
+            t.shrink_to_fit();
+        }
+        if let Some(t) = &mut self.colors {
+            t.shrink_to_fit();
+        }
+        if let Some(t) = &mut self.tangents {
             t.shrink_to_fit();
         }
         self.triangles.shrink_to_fit();

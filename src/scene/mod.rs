@@ -181,7 +181,29 @@ pub struct Scene {
     light_ids: LightIds,
     /// The fog and smoke of the scene.
     pub media: Vec<Medium>,
+    /// Whether some material is not all there (has an opacity), so that
+    /// rays must look past the hits they find.
+    cutouts: bool,
     world: World,
+}
+
+/// The most surfaces with an opacity a ray passes through before it
+/// stops at the next, whatever that one's opacity (a bound on the work
+/// of a ray through foliage).
+const MAX_CUTOUTS: u32 = 64;
+
+/// A number in [0, 1) made from the ray and the distance of a hit on it:
+/// whether a partly present surface stops the ray is decided by it, the
+/// same for the same ray whatever the thread or the order of the work.
+#[inline]
+fn cutout_random(ray: &Ray, t: f32) -> f32 {
+    let (o, d) = (ray.origin(), ray.direction);
+    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    for x in [o.x, o.y, o.z, d.x, d.y, d.z, t] {
+        h = (h ^ u64::from(x.to_bits())).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h ^= h >> 31;
+    }
+    (h >> 40) as f32 / (1u64 << 24) as f32
 }
 
 /// A mesh file a scene reads.
@@ -224,7 +246,36 @@ impl Scene {
     /// does); the ray's direction must have unit length.
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
+        if self.cutouts {
+            return self.intersect_solid(ray, interval);
+        }
         self.world.bvh.hit(ray, interval)
+    }
+
+    /// [`Scene::intersect`] where surfaces may be partly there: a hit where
+    /// the surface is not is passed through.
+    #[inline(never)]
+    fn intersect_solid(&self, ray: &Ray, mut interval: Interval) -> Option<Hit> {
+        for _ in 0..MAX_CUTOUTS {
+            let hit = self.world.bvh.hit(ray, interval)?;
+            if self.stops(ray, hit) {
+                return Some(hit);
+            }
+            // Past it, by a little more than the rounding of its distance
+            // (an instance's hit is found again in its own space).
+            interval.min = hit.t + hit.t.abs() * 4.0 * f32::EPSILON + f32::MIN_POSITIVE;
+        }
+        self.world.bvh.hit(ray, interval)
+    }
+
+    /// Whether the surface `ray` meets at `hit` is there.
+    #[inline]
+    fn stops(&self, ray: &Ray, hit: Hit) -> bool {
+        let record = self.record(ray, hit);
+        let Some(opacity) = self.material(&record).opacity else {
+            return true;
+        };
+        opacity.stops(&record, &self.textures, cutout_random(ray, hit.t))
     }
 
     /// The surface where `ray` meets `hit` (found by [`Scene::intersect`] or
@@ -251,6 +302,9 @@ impl Scene {
     /// question: any hit, not the nearest).
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
+        if self.cutouts {
+            return self.intersect_solid(ray, interval).is_some();
+        }
         self.world.bvh.occluded(ray, interval)
     }
 
@@ -311,7 +365,7 @@ impl Scene {
     /// in scenes of spheres only (see [`Bvh::spheres_only`](crate::geometry::Bvh::spheres_only)).
     #[inline(always)]
     pub fn bundles_pay_off(&self) -> bool {
-        self.world.bvh.spheres_only()
+        self.world.bvh.spheres_only() && !self.cutouts
     }
 
     /// The radius of the sphere a hit record's `object` names, if it is a

@@ -152,23 +152,29 @@ impl Shapes {
                 let point = ray.at(t);
                 let outward = (point - surface.center) * surface.inverse_radius;
                 let (normal, front_face) = face_normal(ray, outward);
+                // Along u = φ/2π about +y (see `Sphere::uv`).
+                let along_u = Vec3::new(outward.z, 0.0, -outward.x);
+                // Only for textures that use them: the inverse
+                // trigonometry cost a fifth of the cover's render.
+                let (uv, dpdu, dpdv) = if surface.uv {
+                    let (du, dv) = sphere_derivatives(outward, surface.radius);
+                    (Sphere::uv(outward), du, dv)
+                } else {
+                    ([0.0, 0.0], along_u, Vec3::ZERO)
+                };
                 HitRecord {
                     point,
                     normal,
                     shading_normal: normal,
-                    // Only for textures that use them: the inverse
-                    // trigonometry cost a fifth of the cover's render.
-                    uv: if surface.uv {
-                        Sphere::uv(outward)
-                    } else {
-                        [0.0, 0.0]
-                    },
+                    uv,
                     t,
                     front_face,
                     material: surface.material,
                     object: index,
-                    // Along u = φ/2π about +y (see `Sphere::uv`).
-                    dpdu: Vec3::new(outward.z, 0.0, -outward.x),
+                    uv1: uv,
+                    dpdu,
+                    dpdv,
+                    color: glam::Vec4::ONE,
                     error: (point.abs().max_element() + surface.radius) * error_scale,
                 }
             }
@@ -188,7 +194,10 @@ impl Shapes {
                     front_face,
                     material: *material,
                     object: index,
+                    uv1: [alpha, beta],
                     dpdu: quad.u,
+                    dpdv: quad.v,
+                    color: glam::Vec4::ONE,
                     error: (point.abs().max_element() + quad.d.abs()) * error_scale,
                 }
             }
@@ -198,6 +207,20 @@ impl Shapes {
             }
         }
     }
+}
+
+/// ∂p/∂u and ∂p/∂v of a sphere of radius `r` at unit outward normal `n`
+/// (u = φ/2π, v = θ/π, see [`Sphere::uv`]); ∂p/∂v is zero at the poles.
+fn sphere_derivatives(n: Vec3, r: f32) -> (Vec3, Vec3) {
+    use std::f32::consts::PI;
+    let dpdu = 2.0 * PI * r * Vec3::new(n.z, 0.0, -n.x);
+    let s2 = 1.0 - n.y * n.y;
+    let dpdv = if s2 > 1e-12 {
+        PI * r / s2.sqrt() * Vec3::new(-n.x * n.y, s2, -n.z * n.y)
+    } else {
+        Vec3::ZERO
+    };
+    (dpdu, dpdv)
 }
 
 /// The record of a hit on triangle `k` of `mesh`. The point is rebuilt
@@ -228,17 +251,47 @@ fn triangle_record(
         }
         None => normal,
     };
-    let (uv, dpdu) = match &mesh.data.uvs {
-        Some(uvs) => {
-            let [p, q, r] = idx.map(|i| uvs[i]);
-            let uv = [
-                b_[0] * p[0] + b_[1] * q[0] + b_[2] * r[0],
-                b_[0] * p[1] + b_[1] * q[1] + b_[2] * r[1],
-            ];
-            (uv, triangle_dpdu([a, b, c], [p, q, r]))
-        }
-        None => ([b_[1], b_[2]], b - a),
+    let interpolate2 = |v: &[[f32; 2]]| {
+        let [p, q, r] = idx.map(|i| v[i]);
+        [
+            b_[0] * p[0] + b_[1] * q[0] + b_[2] * r[0],
+            b_[0] * p[1] + b_[1] * q[1] + b_[2] * r[1],
+        ]
     };
+    let (uv, (mut dpdu, mut dpdv)) = match &mesh.data.uvs {
+        Some(uvs) => (
+            interpolate2(uvs),
+            triangle_derivatives([a, b, c], idx.map(|i| uvs[i])),
+        ),
+        None => ([b_[1], b_[2]], (b - a, c - a)),
+    };
+    let uv1 = mesh.data.uvs1.as_deref().map_or(uv, interpolate2);
+    let interpolate4 = |v: &[[f32; 4]]| {
+        let [p, q, r] = idx.map(|i| glam::Vec4::from(v[i]));
+        b_[0] * p + b_[1] * q + b_[2] * r
+    };
+    let color = mesh
+        .data
+        .colors
+        .as_deref()
+        .map_or(glam::Vec4::ONE, interpolate4);
+    if let Some(tangents) = &mesh.data.tangents {
+        // The file's tangent frame, at the lengths of the surface's own
+        // derivatives (which bump maps need).
+        let t = interpolate4(tangents);
+        let n = if front_face {
+            shading_normal
+        } else {
+            -shading_normal
+        };
+        let tangent = Vec3::from_vec4(t).normalize_or_zero();
+        let sign = if tangents[idx[0]][3] < 0.0 { -1.0 } else { 1.0 };
+        let bitangent = sign * n.cross(tangent).normalize_or_zero();
+        if tangent != Vec3::ZERO && bitangent != Vec3::ZERO {
+            dpdu = tangent * dpdu.length();
+            dpdv = bitangent * dpdv.length();
+        }
+    }
     let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
     HitRecord {
         point,
@@ -249,24 +302,28 @@ fn triangle_record(
         front_face,
         material: mesh.material(k),
         object: index,
+        uv1,
         dpdu,
+        dpdv,
+        color,
         error: extent.max_element() * error_scale,
     }
 }
 
-/// ∂p/∂u of the triangle of corners `p` with texture coordinates `uv`
-/// (from the two edges and their differences of (u, v)); the first edge
-/// where the coordinates are degenerate.
-fn triangle_dpdu(p: [Vec3; 3], uv: [[f32; 2]; 3]) -> Vec3 {
+/// ∂p/∂u and ∂p/∂v of the triangle of corners `p` with texture
+/// coordinates `uv` (from the two edges and their differences of (u, v));
+/// the two edges where the coordinates are degenerate.
+fn triangle_derivatives(p: [Vec3; 3], uv: [[f32; 2]; 3]) -> (Vec3, Vec3) {
     let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
     let (du1, dv1) = (uv[1][0] - uv[0][0], uv[1][1] - uv[0][1]);
     let (du2, dv2) = (uv[2][0] - uv[0][0], uv[2][1] - uv[0][1]);
     let det = du1 * dv2 - dv1 * du2;
     let dpdu = (e1 * dv2 - e2 * dv1) / det;
-    if det != 0.0 && dpdu.is_finite() {
-        dpdu
+    let dpdv = (e2 * du1 - e1 * du2) / det;
+    if det != 0.0 && dpdu.is_finite() && dpdv.is_finite() {
+        (dpdu, dpdv)
     } else {
-        e1
+        (e1, e2)
     }
 }
 
@@ -468,7 +525,10 @@ impl World {
             front_face,
             material: placed.material.unwrap_or(inner.material),
             object: hit.index,
+            uv1: inner.uv1,
             dpdu: transform.vector(inner.dpdu),
+            dpdv: transform.vector(inner.dpdv),
+            color: inner.color,
             error: inner.error * placed.stretch * 4.0
                 + point.abs().max_element() * self.error_scale,
         }

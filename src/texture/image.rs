@@ -1,15 +1,29 @@
-//! Images read from files, as linear RGB: OpenEXR and Radiance HDR as they
-//! are stored, PNG and JPEG decoded from sRGB.
+//! Images read from files: OpenEXR and Radiance HDR as linear RGB, PNG
+//! and JPEG as the file stores them (8 or 16 bits a channel, with alpha),
+//! decoded from sRGB, or read as linear data, at each lookup.
 
 use crate::math::Color;
 use std::path::Path;
 
-/// An image of linear RGB texels, row by row from the top.
+/// An image, row by row from the top: 8- and 16-bit images as they are
+/// stored (RGBA, sRGB-encoded or linear data as the use says, decoded at
+/// each lookup), floating-point ones as linear RGB.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     width: usize,
     height: usize,
-    texels: Vec<Color>,
+    texels: Texels,
+}
+
+/// An image's texels as stored.
+#[derive(Clone, Debug, PartialEq)]
+enum Texels {
+    /// 8 bits a channel, RGBA (grey and grey-alpha images expanded).
+    Rgba8(Vec<[u8; 4]>),
+    /// 16 bits a channel, RGBA.
+    Rgba16(Vec<[u16; 4]>),
+    /// Linear floating-point RGB (OpenEXR, Radiance HDR), opaque.
+    Rgb32F(Vec<Color>),
 }
 
 /// Why an image file could not be read.
@@ -41,7 +55,8 @@ pub enum ImageError {
 pub const IMAGE_EXTENSIONS: &[&str] = &["exr", "hdr", "png", "jpg", "jpeg"];
 
 impl Image {
-    /// An image of `width × height` texels, row by row from the top.
+    /// A floating-point image of `width × height` linear texels, row by
+    /// row from the top.
     ///
     /// # Panics
     /// If `texels` does not hold `width × height` texels or the image is
@@ -51,7 +66,22 @@ impl Image {
         Image {
             width,
             height,
-            texels,
+            texels: Texels::Rgb32F(texels),
+        }
+    }
+
+    /// An 8-bit RGBA image of `width × height` texels, row by row from the
+    /// top.
+    ///
+    /// # Panics
+    /// If `texels` does not hold `width × height` texels or the image is
+    /// empty.
+    pub fn from_rgba8(width: usize, height: usize, texels: Vec<[u8; 4]>) -> Self {
+        assert!(width > 0 && height > 0 && texels.len() == width * height);
+        Image {
+            width,
+            height,
+            texels: Texels::Rgba8(texels),
         }
     }
 
@@ -66,10 +96,11 @@ impl Image {
     }
 
     /// Decodes the bytes of an image file named `shown` (for messages).
-    /// Floating-point images are taken as linear, 8- and 16-bit ones as
-    /// sRGB-encoded; alpha is ignored. Texels must be finite and not
-    /// negative.
+    /// Floating-point images are kept as linear RGB (texels must be finite
+    /// and not negative); 8- and 16-bit ones as they are stored, with their
+    /// alpha (opaque where the file has none).
     pub fn decode(bytes: &[u8], shown: &str) -> Result<Image, ImageError> {
+        use ::image::DynamicImage as D;
         let shown = shown.to_string();
         let fail = |message: String| ImageError::Read {
             path: shown.clone(),
@@ -80,39 +111,40 @@ impl Image {
             .map_err(|e| fail(e.to_string()))?
             .decode()
             .map_err(|e| fail(e.to_string()))?;
-        let linear = matches!(
-            decoded,
-            ::image::DynamicImage::ImageRgb32F(_) | ::image::DynamicImage::ImageRgba32F(_)
-        );
-        let rgb = decoded.into_rgb32f();
-        let (width, height) = (rgb.width() as usize, rgb.height() as usize);
+        let (width, height) = (decoded.width() as usize, decoded.height() as usize);
         if width == 0 || height == 0 {
             return Err(fail("the image is empty".into()));
         }
-        let mut texels = Vec::with_capacity(width * height);
-        for (i, p) in rgb.pixels().enumerate() {
-            let value = p.0;
-            if value.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(ImageError::BadTexel {
-                    path: shown,
-                    x: i % width,
-                    y: i / width,
-                    value,
-                });
+        let texels = match decoded {
+            D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
+                Texels::Rgba8(decoded.into_rgba8().pixels().map(|p| p.0).collect())
             }
-            let c = Color::from_array(value);
-            texels.push(if linear { c } else { c.map(srgb_to_linear) });
-        }
-        Ok(Image::new(width, height, texels))
-    }
-
-    /// The image with every texel multiplied by `c`.
-    pub fn scaled(&self, c: Color) -> Image {
-        Image::new(
-            self.width,
-            self.height,
-            self.texels.iter().map(|t| *t * c).collect(),
-        )
+            D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
+                Texels::Rgba16(decoded.into_rgba16().pixels().map(|p| p.0).collect())
+            }
+            _ => {
+                let rgb = decoded.into_rgb32f();
+                let mut texels = Vec::with_capacity(width * height);
+                for (i, p) in rgb.pixels().enumerate() {
+                    let value = p.0;
+                    if value.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+                        return Err(ImageError::BadTexel {
+                            path: shown,
+                            x: i % width,
+                            y: i / width,
+                            value,
+                        });
+                    }
+                    texels.push(Color::from_array(value));
+                }
+                Texels::Rgb32F(texels)
+            }
+        };
+        Ok(Image {
+            width,
+            height,
+            texels,
+        })
     }
 
     /// Width in texels.
@@ -125,10 +157,79 @@ impl Image {
         self.height
     }
 
-    /// The texel in column `x`, row `y` (from the top).
+    /// Whether the file stored floating-point (linear) values.
+    pub fn is_float(&self) -> bool {
+        matches!(self.texels, Texels::Rgb32F(_))
+    }
+
+    /// Whether some texel is not opaque.
+    pub fn has_alpha(&self) -> bool {
+        match &self.texels {
+            Texels::Rgba8(t) => t.iter().any(|p| p[3] != u8::MAX),
+            Texels::Rgba16(t) => t.iter().any(|p| p[3] != u16::MAX),
+            Texels::Rgb32F(_) => false,
+        }
+    }
+
+    /// Bytes held by the texels.
+    pub fn heap_bytes(&self) -> usize {
+        let n = self.width * self.height;
+        n * match &self.texels {
+            Texels::Rgba8(_) => 4,
+            Texels::Rgba16(_) => 8,
+            Texels::Rgb32F(_) => 12,
+        }
+    }
+
+    /// The linear colour of the texel in column `x`, row `y` (from the
+    /// top): integer images decoded from sRGB.
     #[inline]
     pub fn texel(&self, x: usize, y: usize) -> Color {
-        self.texels[y * self.width + x]
+        let i = y * self.width + x;
+        match &self.texels {
+            Texels::Rgba8(t) => {
+                let lut = srgb8();
+                let [r, g, b, _] = t[i];
+                Color::new(lut[r as usize], lut[g as usize], lut[b as usize])
+            }
+            Texels::Rgba16(t) => {
+                let [r, g, b, _] = t[i];
+                Color::new(r.into(), g.into(), b.into()).map(|c| srgb_to_linear(c / 65535.0))
+            }
+            Texels::Rgb32F(t) => t[i],
+        }
+    }
+
+    /// The texel in column `x`, row `y` as RGBA: integer images' colour
+    /// channels decoded from sRGB when `srgb`, else scaled to [0, 1] (data
+    /// such as roughness and normals); alpha always linear.
+    #[inline]
+    pub fn texel_rgba(&self, x: usize, y: usize, srgb: bool) -> [f32; 4] {
+        let i = y * self.width + x;
+        match &self.texels {
+            Texels::Rgba8(t) => {
+                let [r, g, b, a] = t[i];
+                let alpha = f32::from(a) / 255.0;
+                if srgb {
+                    let lut = srgb8();
+                    [lut[r as usize], lut[g as usize], lut[b as usize], alpha]
+                } else {
+                    [r, g, b, a].map(|c| f32::from(c) / 255.0)
+                }
+            }
+            Texels::Rgba16(t) => {
+                let [r, g, b, a] = t[i].map(|c| f32::from(c) / 65535.0);
+                if srgb {
+                    [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), a]
+                } else {
+                    [r, g, b, a]
+                }
+            }
+            Texels::Rgb32F(t) => {
+                let c = t[i];
+                [c.x, c.y, c.z, 1.0]
+            }
+        }
     }
 
     /// The colour at `(u, v)` of [0, 1]² (u rightwards, v downwards),
@@ -165,9 +266,16 @@ impl Image {
     }
 }
 
+/// The linear value of each 8-bit sRGB code, as `srgb_to_linear` of the
+/// code over 255 (the same bits as decoding the whole image to floats).
+fn srgb8() -> &'static [f32; 256] {
+    static LUT: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    LUT.get_or_init(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)))
+}
+
 /// The sRGB transfer function, inverted: an encoded value in [0, 1] to
 /// linear light.
-fn srgb_to_linear(c: f32) -> f32 {
+pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
     } else {

@@ -5,13 +5,35 @@
 //! made of.
 
 pub mod image;
+pub mod map;
 pub mod noise;
 
 pub use image::{Image, ImageError};
+pub use map::{Channels, Filter, ImageMap, UvTransform, Wrap};
 pub use noise::Perlin;
 
 use crate::math::{Color, Point3};
 use std::sync::Arc;
+
+/// Where a texture is looked up: the surface's two sets of texture
+/// coordinates and the point in space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexCoords {
+    /// The first texture coordinates (v up the image).
+    pub uv: [f32; 2],
+    /// The second set (a mesh's `TEXCOORD_1`; the first elsewhere).
+    pub uv1: [f32; 2],
+    /// The point.
+    pub point: Point3,
+}
+
+impl TexCoords {
+    /// Coordinates `uv` (both sets) at `point`.
+    #[inline(always)]
+    pub fn new(uv: [f32; 2], point: Point3) -> TexCoords {
+        TexCoords { uv, uv1: uv, point }
+    }
+}
 
 /// Octaves summed by turbulence, as in the book.
 const OCTAVES: u32 = 7;
@@ -34,9 +56,9 @@ pub enum Texture {
         odd: u32,
     },
     /// An image, by the surface's (u, v): u rightwards, v upwards (the
-    /// image's bottom row at v = 0), repeating outside [0, 1]², blended
-    /// bilinearly.
-    Image(Arc<Image>),
+    /// image's bottom row at v = 0), wrapped and filtered as the map says
+    /// (by default repeating outside [0, 1]² and blended bilinearly).
+    Map(Arc<ImageMap>),
     /// Another texture of the table times a colour.
     Scaled {
         /// The texture scaled.
@@ -67,9 +89,11 @@ pub enum NoisePattern {
 }
 
 impl Texture {
-    /// The colour at surface coordinates `uv` and point `p`; textures that
-    /// refer to others find them in `table`.
-    pub fn value(&self, table: &[Texture], uv: [f32; 2], p: Point3) -> Color {
+    /// The colour at `at`; textures that refer to others find them in
+    /// `table`. A scalar texture (one channel of an image) gives its value
+    /// in all three channels.
+    pub fn value(&self, table: &[Texture], at: &TexCoords) -> Color {
+        let p = at.point;
         match self {
             Texture::Solid(c) => *c,
             Texture::Checker {
@@ -80,11 +104,17 @@ impl Texture {
                 let cell = (*inverse_scale * p).floor();
                 let sum = cell.x as i64 + cell.y as i64 + cell.z as i64;
                 let which = if sum.rem_euclid(2) == 0 { even } else { odd };
-                table[*which as usize].value(table, uv, p)
+                table[*which as usize].value(table, at)
             }
-            Texture::Image(image) => image.bilinear_repeat(uv[0], 1.0 - uv[1]),
+            Texture::Map(map) => {
+                let [r, g, b, a] = map.rgba(at);
+                match map.channels {
+                    Channels::Rgb => Color::new(r, g, b),
+                    Channels::One(c) => Color::splat([r, g, b, a][c as usize]),
+                }
+            }
             Texture::Scaled { texture, factor } => {
-                table[*texture as usize].value(table, uv, p) * *factor
+                table[*texture as usize].value(table, at) * *factor
             }
             Texture::Noise {
                 perlin,
@@ -105,7 +135,7 @@ impl Texture {
     /// through a texture it refers to).
     pub fn uses_uv(&self, table: &[Texture]) -> bool {
         match self {
-            Texture::Image(_) => true,
+            Texture::Map(_) => true,
             Texture::Checker { even, odd, .. } => {
                 table[*even as usize].uses_uv(table) || table[*odd as usize].uses_uv(table)
             }
@@ -131,7 +161,9 @@ mod tests {
                 odd: 1,
             },
         ];
-        let at = |x: f32, y: f32, z: f32| table[2].value(&table, [0.0, 0.0], Vec3::new(x, y, z));
+        let at = |x: f32, y: f32, z: f32| {
+            table[2].value(&table, &TexCoords::new([0.0, 0.0], Vec3::new(x, y, z)))
+        };
         // Cubes of side 0.5: (0.1, 0.1, 0.1) is in cube (0, 0, 0), even.
         assert_eq!(at(0.1, 0.1, 0.1), Color::X);
         assert_eq!(at(0.6, 0.1, 0.1), Color::Y);
@@ -146,8 +178,8 @@ mod tests {
     fn an_image_is_looked_up_with_v_upwards_and_repeats() {
         // Bottom row red, top row blue.
         let image = Image::new(1, 2, vec![Color::Z, Color::X]);
-        let t = Texture::Image(Arc::new(image));
-        let at = |u: f32, v: f32| t.value(&[], [u, v], Vec3::ZERO);
+        let t = Texture::Map(Arc::new(ImageMap::color(Arc::new(image))));
+        let at = |u: f32, v: f32| t.value(&[], &TexCoords::new([u, v], Vec3::ZERO));
         assert_eq!(at(0.5, 0.25), Color::X);
         assert_eq!(at(0.5, 0.75), Color::Z);
         assert_eq!(at(3.5, 1.25), Color::X);
@@ -169,7 +201,7 @@ mod tests {
             };
             for i in 0..500 {
                 let p = Vec3::new(i as f32 * 0.37, (i % 7) as f32 * 0.9, i as f32 * -0.11);
-                let c = t.value(&[], [0.0, 0.0], p);
+                let c = t.value(&[], &TexCoords::new([0.0, 0.0], p));
                 assert!(c.x == c.y && c.y == c.z, "{pattern:?}: grey");
                 assert!((0.0..=2.0).contains(&c.x), "{pattern:?}: {c:?}");
             }

@@ -671,12 +671,7 @@ const EARTH_MAP: &str = "lumen:earth.png";
 /// A globe of radius 2 wrapped in the planet map, seen from the front.
 fn earth() -> SceneDesc {
     Builder::new(next_week(400, 100, 16.0 / 9.0))
-        .texture(
-            "earth",
-            TextureDesc::Image {
-                file: EARTH_MAP.to_string(),
-            },
-        )
+        .texture("earth", TextureDesc::image(EARTH_MAP))
         .material("earth", textured("earth"))
         .sphere([0.0; 3], 2.0, "earth")
         .background(NEXT_WEEK_SKY)
@@ -901,12 +896,7 @@ fn next_week_final() -> SceneDesc {
         .sphere([360.0, 150.0, 145.0], 70.0, "glass")
         .fog_ball([360.0, 150.0, 145.0], 70.0, 0.2, [0.2, 0.4, 0.9])
         .fog_ball([0.0; 3], 5000.0, 0.0001, [1.0; 3])
-        .texture(
-            "earth",
-            TextureDesc::Image {
-                file: EARTH_MAP.to_string(),
-            },
-        )
+        .texture("earth", TextureDesc::image(EARTH_MAP))
         .material("earth", textured("earth"))
         .sphere([400.0, 200.0, 400.0], 100.0, "earth")
         .texture(

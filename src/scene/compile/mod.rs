@@ -20,11 +20,11 @@ use crate::material::{ColorParam, Invalid, Kind, Material, ScalarParam, Textures
 use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
 use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
-use crate::texture::Texture;
+use crate::texture::{Channels, ImageMap, Texture};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use textures::{read_image, ColorRef, TextureTable};
+use textures::{read_image, ColorRef, TextureKind, TextureTable};
 
 mod textures;
 
@@ -163,10 +163,12 @@ impl Scene {
             world.bounding_radius(),
             settings.light_selection,
         );
+        let cutouts = materials.iter().any(|m| m.opacity.is_some());
         Ok(Scene {
             settings,
             camera,
             background,
+            cutouts,
             materials,
             textures,
             spheres,
@@ -597,7 +599,12 @@ impl<'a> Objects<'a> {
             if let Some(albedo) = albedo {
                 let factor = Color::from_array(mesh_material.base_color);
                 self.textures
-                    .push(Texture::Image(Arc::new(image.scaled(factor))));
+                    .push(Texture::Map(Arc::new(ImageMap::color(image.clone()))));
+                let map = self.textures.len() as u32 - 1;
+                self.textures.push(Texture::Scaled {
+                    texture: map,
+                    factor,
+                });
                 *albedo = ColorParam::Texture(self.textures.len() as u32 - 1);
             }
         }
@@ -676,6 +683,13 @@ impl<'a> Objects<'a> {
             positions: source.positions.clone(),
             normals: if smooth { source.normals.clone() } else { None },
             uvs: source.uvs.clone(),
+            uvs1: source.uvs1.clone(),
+            colors: source.colors.clone(),
+            tangents: if smooth {
+                source.tangents.clone()
+            } else {
+                None
+            },
             triangles: source.triangles.clone(),
             material: Vec::new(),
         };
@@ -780,6 +794,15 @@ fn place_mesh(mut mesh: Mesh, transform: &Transform, object: usize) -> Result<Me
         if let Some(normals) = &mut mesh.data.normals {
             for n in normals {
                 *n = transform.normal(Vec3::from(*n)).to_array();
+            }
+        }
+        if let Some(tangents) = &mut mesh.data.tangents {
+            // A mirroring transform turns the bitangent (w · n × t) over.
+            let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
+            let side = if x.cross(y).dot(z) < 0.0 { -1.0 } else { 1.0 };
+            for t in tangents {
+                let v = transform.vector(Vec3::new(t[0], t[1], t[2]));
+                *t = [v.x, v.y, v.z, t[3] * side];
             }
         }
     }
@@ -969,7 +992,21 @@ impl Textures for MaterialTextures<'_, '_> {
         };
         match self.textures.color(field, c, check, self.sources) {
             Ok(ColorRef::Rgb(c)) => Ok(ColorParam::Const(c)),
-            Ok(ColorRef::Texture(t)) => Ok(ColorParam::Texture(t)),
+            Ok(ColorRef::Texture(t)) => {
+                if self.textures.kind(t) == TextureKind::Scalar {
+                    let ColorDesc::Texture(name) = c else {
+                        unreachable!("a texture has a name")
+                    };
+                    return Err(Invalid::new(
+                        field,
+                        format!(
+                            "texture \"{name}\" is one channel of an image (a scalar); a colour \
+                             is expected here: leave out its `channel`"
+                        ),
+                    ));
+                }
+                Ok(ColorParam::Texture(t))
+            }
             Err(e) => Err(Invalid::new(e.field(), e.message())),
         }
     }
@@ -983,17 +1020,62 @@ impl Textures for MaterialTextures<'_, '_> {
         match s {
             ScalarDesc::Value(v) => Ok(ScalarParam::Const(param::number(field, *v, range)?)),
             ScalarDesc::Texture(name) => {
-                let c = ColorDesc::Texture(name.clone());
-                match self.color(field, &c, ColorRange::NonNegative)? {
-                    ColorParam::Texture(t) => Ok(ScalarParam::Texture(t)),
-                    ColorParam::Const(_) => unreachable!("a name is a texture"),
+                let t = self.named(field, name)?;
+                if self.textures.kind(t) == TextureKind::Color {
+                    return Err(Invalid::new(
+                        field,
+                        format!(
+                            "texture \"{name}\" is a colour; a scalar is expected here: \
+                             give the image texture a `channel` (\"r\", \"g\", \"b\" or \"a\")"
+                        ),
+                    ));
                 }
+                Ok(ScalarParam::Texture(t))
             }
         }
     }
 
     fn scaled(&mut self, t: u32, factor: Color) -> u32 {
         self.textures.push(Texture::Scaled { texture: t, factor })
+    }
+
+    fn normal_map(&mut self, field: &str, name: &str) -> Result<u32, Invalid> {
+        let t = self.named(field, name)?;
+        let map = match &self.textures.textures[t as usize] {
+            Texture::Map(map) if map.channels == Channels::Rgb => map.clone(),
+            _ => {
+                return Err(Invalid::new(
+                    field,
+                    format!(
+                        "texture \"{name}\" is not a normal map: a normal map is an image \
+                         texture of all three channels"
+                    ),
+                ))
+            }
+        };
+        if map.image.is_float() || !map.srgb {
+            return Ok(t);
+        }
+        // The same image, read as data rather than colour.
+        Ok(self.textures.push(Texture::Map(Arc::new(ImageMap {
+            srgb: false,
+            ..(*map).clone()
+        }))))
+    }
+}
+
+impl MaterialTextures<'_, '_> {
+    /// The texture `name` of field `field`, compiled.
+    fn named(&mut self, field: &str, name: &str) -> Result<u32, Invalid> {
+        let c = ColorDesc::Texture(name.to_string());
+        match self
+            .textures
+            .color(field, &c, albedo, self.sources)
+            .map_err(|e| Invalid::new(e.field(), e.message()))?
+        {
+            ColorRef::Texture(t) => Ok(t),
+            ColorRef::Rgb(_) => unreachable!("a name is a texture"),
+        }
     }
 }
 

@@ -5,9 +5,13 @@
 
 use crate::hint;
 use crate::math::Color;
-use crate::scene::desc::{ColorDesc, NoisePatternDesc, TextureDesc};
+use crate::scene::desc::{
+    ChannelDesc, ColorDesc, EncodingDesc, FilterDesc, NoisePatternDesc, TextureDesc, WrapDesc,
+};
 use crate::scene::{invalid, MeshSource, SceneError};
-use crate::texture::{Image, NoisePattern, Perlin, Texture};
+use crate::texture::{
+    Channels, Filter, Image, ImageMap, NoisePattern, Perlin, Texture, UvTransform, Wrap,
+};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 use std::sync::Arc;
@@ -28,6 +32,8 @@ pub(crate) struct TextureTable<'a> {
     /// The compiled textures; materials refer to them by index.
     pub(crate) textures: Vec<Texture>,
     index: HashMap<&'a str, u32>,
+    /// The images read, by file name.
+    images: HashMap<String, Arc<Image>>,
 }
 
 impl<'a> TextureTable<'a> {
@@ -39,6 +45,7 @@ impl<'a> TextureTable<'a> {
             base,
             textures: Vec::new(),
             index: HashMap::new(),
+            images: HashMap::new(),
         }
     }
 
@@ -127,12 +134,59 @@ impl<'a> TextureTable<'a> {
                 even: self.texture_of(&format!("{here}.even"), even, chain, sources)?,
                 odd: self.texture_of(&format!("{here}.odd"), odd, chain, sources)?,
             },
-            TextureDesc::Image { file } => Texture::Image(Arc::new(read_image(
-                &format!("{here}.file"),
-                self.base,
+            TextureDesc::Image {
                 file,
-                sources,
-            )?)),
+                channel,
+                encoding,
+                wrap,
+                filter,
+                uv_set,
+                uv_offset,
+                uv_rotation,
+                uv_scale,
+            } => {
+                let image = self.image(&format!("{here}.file"), file, sources)?;
+                let channels = match channel {
+                    None => Channels::Rgb,
+                    Some(ChannelDesc::R) => Channels::One(0),
+                    Some(ChannelDesc::G) => Channels::One(1),
+                    Some(ChannelDesc::B) => Channels::One(2),
+                    Some(ChannelDesc::A) => Channels::One(3),
+                };
+                let srgb = match encoding {
+                    Some(EncodingDesc::Srgb) => true,
+                    Some(EncodingDesc::Linear) => false,
+                    None => channel.is_none(),
+                };
+                let wrap = match wrap.unwrap_or(WrapDesc::Repeat) {
+                    WrapDesc::Repeat => Wrap::Repeat,
+                    WrapDesc::Clamp => Wrap::Clamp,
+                    WrapDesc::Mirror => Wrap::Mirror,
+                };
+                let number = |name: &str, v: &[f64]| {
+                    super::finite(format!("{here}.{name}"), v)
+                        .map(|_| v.iter().map(|x| *x as f32).collect::<Vec<f32>>())
+                };
+                let offset = number("uv_offset", &uv_offset.unwrap_or([0.0; 2]))?;
+                let scale = number("uv_scale", &uv_scale.unwrap_or([1.0; 2]))?;
+                let rotation = number("uv_rotation", &[uv_rotation.unwrap_or(0.0)])?[0];
+                Texture::Map(Arc::new(ImageMap {
+                    image,
+                    srgb,
+                    channels,
+                    wrap: [wrap; 2],
+                    filter: match filter.unwrap_or(FilterDesc::Bilinear) {
+                        FilterDesc::Bilinear => Filter::Bilinear,
+                        FilterDesc::Nearest => Filter::Nearest,
+                    },
+                    transform: UvTransform::offset_rotation_scale(
+                        [offset[0], offset[1]],
+                        rotation.to_radians(),
+                        [scale[0], scale[1]],
+                    ),
+                    uv_set: uv_set.unwrap_or(0) as u8,
+                }))
+            }
             TextureDesc::Noise {
                 scale,
                 pattern,
@@ -156,6 +210,56 @@ impl<'a> TextureTable<'a> {
         self.index.insert(key, i);
         Ok(i)
     }
+}
+
+impl TextureTable<'_> {
+    /// The image file `file` of field `field`, read once however many
+    /// textures name it.
+    fn image(
+        &mut self,
+        field: &str,
+        file: &str,
+        sources: &mut Vec<MeshSource>,
+    ) -> Result<Arc<Image>, SceneError> {
+        if let Some(image) = self.images.get(file) {
+            return Ok(image.clone());
+        }
+        let image = Arc::new(read_image(field, self.base, file, sources)?);
+        self.images.insert(file.to_string(), image.clone());
+        Ok(image)
+    }
+
+    /// Whether texture `t` gives a colour, a scalar (one channel of an
+    /// image), or either (grey noise, one colour).
+    pub(crate) fn kind(&self, t: u32) -> TextureKind {
+        let mut t = t;
+        // Scaled textures are what they scale (a chain: no recursion).
+        loop {
+            return match &self.textures[t as usize] {
+                Texture::Map(map) => match map.channels {
+                    Channels::Rgb => TextureKind::Color,
+                    Channels::One(_) => TextureKind::Scalar,
+                },
+                Texture::Scaled { texture, .. } => {
+                    t = *texture;
+                    continue;
+                }
+                Texture::Checker { .. } => TextureKind::Color,
+                Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
+            };
+        }
+    }
+}
+
+/// What a texture gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TextureKind {
+    /// A colour.
+    Color,
+    /// A scalar.
+    Scalar,
+    /// A grey that is either.
+    Either,
 }
 
 /// A scale of field `field`: finite and above 0 in `f32`.

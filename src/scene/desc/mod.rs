@@ -358,6 +358,37 @@ pub enum TextureDesc {
     Image {
         /// The image file, relative to the scene file.
         file: String,
+        /// One channel of the image ("r", "g", "b" or "a"), making it a
+        /// scalar texture (a roughness, an opacity); all three colour
+        /// channels when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        channel: Option<ChannelDesc>,
+        /// How 8- and 16-bit values are read: "srgb" (colours, the default
+        /// without `channel`) or "linear" (data, the default with it).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        encoding: Option<EncodingDesc>,
+        /// What coordinates outside [0, 1] read: "repeat" (the default),
+        /// "clamp" or "mirror".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        wrap: Option<WrapDesc>,
+        /// "bilinear" (the default) or "nearest".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        filter: Option<FilterDesc>,
+        /// Which texture coordinates: 0 (the default) or 1 (a mesh's
+        /// second set).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_set: Option<u32>,
+        /// Added to the texture coordinates (after rotating and scaling
+        /// them), in image widths, u rightwards and v down the image.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_offset: Option<[f64; 2]>,
+        /// Rotation of the texture coordinates in degrees.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_rotation: Option<f64>,
+        /// Factors on the texture coordinates: [2, 2] repeats the image
+        /// twice each way.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_scale: Option<[f64; 2]>,
     },
     /// Perlin noise.
     Noise {
@@ -375,6 +406,69 @@ pub enum TextureDesc {
 
 fn is_zero_u64(x: &u64) -> bool {
     *x == 0
+}
+
+impl TextureDesc {
+    /// The image in `file`, as a colour, with every option at its default.
+    pub fn image(file: impl Into<String>) -> TextureDesc {
+        TextureDesc::Image {
+            file: file.into(),
+            channel: None,
+            encoding: None,
+            wrap: None,
+            filter: None,
+            uv_set: None,
+            uv_offset: None,
+            uv_rotation: None,
+            uv_scale: None,
+        }
+    }
+}
+
+/// A channel of an image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ChannelDesc {
+    /// Red.
+    R,
+    /// Green.
+    G,
+    /// Blue.
+    B,
+    /// Alpha.
+    A,
+}
+
+/// How an image's integer values are read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EncodingDesc {
+    /// Decoded from sRGB (colours).
+    Srgb,
+    /// As they are, scaled to [0, 1] (data).
+    Linear,
+}
+
+/// What texture coordinates outside [0, 1] read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WrapDesc {
+    /// The image again.
+    Repeat,
+    /// The edge.
+    Clamp,
+    /// The image mirrored every other time.
+    Mirror,
+}
+
+/// How an image is blended between texels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FilterDesc {
+    /// The four nearest texels, weighted.
+    Bilinear,
+    /// The nearest texel.
+    Nearest,
 }
 
 /// How noise becomes a grey level (see [`crate::texture::NoisePattern`]).

@@ -14,9 +14,9 @@ use super::source::{Entry, Node, Value};
 use crate::light::LightSelection;
 use crate::material::KindInfo;
 use crate::scene::desc::{
-    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, IntegratorDesc, MaterialDesc,
-    NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc,
-    TextureDesc, TransformDesc, Triple, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc, FilterDesc,
+    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
+    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -692,6 +692,14 @@ const TEXTURES: &[Kind<TextureKind>] = &[
         fields: &["type", "scale", "even", "odd"],
         elsewhere: &[
             ("file", "image textures"),
+            ("channel", "image textures"),
+            ("encoding", "image textures"),
+            ("wrap", "image textures"),
+            ("filter", "image textures"),
+            ("uv_set", "image textures"),
+            ("uv_offset", "image textures"),
+            ("uv_rotation", "image textures"),
+            ("uv_scale", "image textures"),
             ("pattern", "noise textures"),
             ("seed", "noise textures"),
         ],
@@ -700,7 +708,18 @@ const TEXTURES: &[Kind<TextureKind>] = &[
         name: "image",
         kind: TextureKind::Image,
         what: "an image texture",
-        fields: &["type", "file"],
+        fields: &[
+            "type",
+            "file",
+            "channel",
+            "encoding",
+            "wrap",
+            "filter",
+            "uv_set",
+            "uv_offset",
+            "uv_rotation",
+            "uv_scale",
+        ],
         elsewhere: &[
             ("scale", "checker and noise textures"),
             ("even", "checker textures"),
@@ -716,11 +735,47 @@ const TEXTURES: &[Kind<TextureKind>] = &[
         fields: &["type", "scale", "pattern", "seed"],
         elsewhere: &[
             ("file", "image textures"),
+            ("channel", "image textures"),
+            ("encoding", "image textures"),
+            ("wrap", "image textures"),
+            ("filter", "image textures"),
+            ("uv_set", "image textures"),
+            ("uv_offset", "image textures"),
+            ("uv_rotation", "image textures"),
+            ("uv_scale", "image textures"),
             ("even", "checker textures"),
             ("odd", "checker textures"),
         ],
     },
 ];
+
+const CHANNELS: &[(&str, ChannelDesc)] = &[
+    ("r", ChannelDesc::R),
+    ("g", ChannelDesc::G),
+    ("b", ChannelDesc::B),
+    ("a", ChannelDesc::A),
+];
+
+const ENCODINGS: &[(&str, EncodingDesc)] = &[
+    ("srgb", EncodingDesc::Srgb),
+    ("linear", EncodingDesc::Linear),
+];
+
+const WRAPS: &[(&str, WrapDesc)] = &[
+    ("repeat", WrapDesc::Repeat),
+    ("clamp", WrapDesc::Clamp),
+    ("mirror", WrapDesc::Mirror),
+];
+
+const FILTERS: &[(&str, FilterDesc)] = &[
+    ("bilinear", FilterDesc::Bilinear),
+    ("nearest", FilterDesc::Nearest),
+];
+
+/// A set of texture coordinates: 0 or 1.
+fn uv_set(node: &Node, path: &str) -> Result<u32> {
+    integer(node, path, 0, 1).map(|n| n as u32)
+}
 
 const NOISE_PATTERNS: &[(&str, NoisePatternDesc)] = &[
     ("smooth", NoisePatternDesc::Smooth),
@@ -738,6 +793,14 @@ fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
         },
         TextureKind::Image => TextureDesc::Image {
             file: t.require("file", what, string)?.to_string(),
+            channel: t.optional("channel", |n, p| keyword(n, p, CHANNELS))?,
+            encoding: t.optional("encoding", |n, p| keyword(n, p, ENCODINGS))?,
+            wrap: t.optional("wrap", |n, p| keyword(n, p, WRAPS))?,
+            filter: t.optional("filter", |n, p| keyword(n, p, FILTERS))?,
+            uv_set: t.optional("uv_set", uv_set)?,
+            uv_offset: t.optional("uv_offset", pair)?,
+            uv_rotation: t.optional("uv_rotation", float)?,
+            uv_scale: t.optional("uv_scale", pair)?,
         },
         TextureKind::Noise => TextureDesc::Noise {
             scale: t.optional("scale", float)?.unwrap_or(1.0),

@@ -1,0 +1,113 @@
+//! The plastic material: a diffuse base under a clear dielectric coat,
+//! smooth or rough (see [`crate::bsdf::plastic`] for the model).
+
+use super::param::{self, ColorDesc, ColorParam, ColorRange, Invalid, RoughnessDesc, Textures};
+use super::roughness::{DistributionDesc, Roughness};
+use super::{Kind, Material};
+use crate::bsdf::plastic::Plastic as PlasticLobe;
+use crate::geometry::HitRecord;
+use crate::texture::Texture;
+
+material_desc! {
+    /// A coated diffuse surface: paint, plastic, varnished wood.
+    pub struct PlasticDesc {
+        /// The base's albedo, each channel in [0, 1], or a texture; 0.5
+        /// grey when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub albedo: Option<ColorDesc>,
+        /// The coat's index of refraction, > 0; 1.5 when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub ior: Option<f64>,
+        /// The coat's roughness in [0, 1] (α = roughness²); 0, the default,
+        /// is a smooth coat.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub roughness: Option<RoughnessDesc>,
+        /// The coat's microfacet width α itself, instead of `roughness`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub alpha: Option<RoughnessDesc>,
+        /// The microfacet distribution: "ggx" (the default) or "beckmann".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub distribution: Option<DistributionDesc>,
+        /// Return the energy the coat's single-scattering microfacets lose.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        pub multiscatter: bool,
+    }
+}
+
+/// The coat's index when none is given.
+const DEFAULT_IOR: f64 = 1.5;
+
+impl PlasticDesc {
+    /// Plastic of albedo `albedo` under a coat of roughness `roughness`.
+    pub fn new(albedo: impl Into<ColorDesc>, roughness: f64) -> Self {
+        PlasticDesc {
+            albedo: Some(albedo.into()),
+            roughness: Some(roughness.into()),
+            ..Default::default()
+        }
+    }
+
+    pub(super) fn compile(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<Material, Invalid> {
+        let albedo = match &self.albedo {
+            Some(a) => textures.color(&format!("{field}.albedo"), a, ColorRange::Unit)?,
+            None => ColorParam::Const(crate::math::Color::splat(0.5)),
+        };
+        let ior = param::number(
+            &format!("{field}.ior"),
+            self.ior.unwrap_or(DEFAULT_IOR),
+            param::Range::Positive,
+        )?;
+        let roughness = Roughness::compile(
+            field,
+            self.roughness.as_ref(),
+            self.alpha.as_ref(),
+            self.distribution,
+            textures,
+        )?;
+        Ok(Material::new(Kind::Plastic(Plastic {
+            albedo,
+            ior,
+            roughness,
+            multiscatter: self.multiscatter,
+        })))
+    }
+}
+
+/// A coated diffuse surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plastic {
+    /// The base's albedo.
+    pub albedo: ColorParam,
+    /// The coat's index of refraction.
+    pub ior: f32,
+    /// The coat's microfacets.
+    pub roughness: Roughness,
+    /// Return the energy the coat's single scattering loses.
+    pub multiscatter: bool,
+}
+
+impl Plastic {
+    /// The lobe at `hit` (the same from either side: the base is opaque).
+    #[inline]
+    pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> PlasticLobe {
+        PlasticLobe {
+            albedo: self.albedo.albedo_at(hit, textures),
+            eta: self.ior,
+            roughness: self.roughness.at(hit, textures),
+            multiscatter: self.multiscatter,
+        }
+    }
+
+    /// The textures it looks up.
+    pub fn textures(&self) -> Vec<u32> {
+        self.albedo
+            .texture()
+            .into_iter()
+            .chain(self.roughness.textures())
+            .collect()
+    }
+}
