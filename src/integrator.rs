@@ -130,11 +130,11 @@ fn step(
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }
-    let Some(bsdf) = material.bsdf(&record, &scene.textures) else {
+    let wo = -ray.direction;
+    let Some(bsdf) = material.bsdf(&record, wo, &scene.textures) else {
         return Step::Done(path.radiance);
     };
     sampler.start_bounce(depth);
-    let wo = -ray.direction;
     let nee = samples_lights(scene, depth) && bsdf.has_density();
     if nee {
         let (light, traced) = light_at_surface(scene, &record, &bsdf, wo, ray.time(), sampler);

@@ -21,9 +21,13 @@ fn colour_at(scene: &Scene, from: Vec3, towards: Vec3) -> Color {
     if material.emits() {
         return material.emitted(&record, &scene.textures);
     }
-    match material.bsdf(&record, &scene.textures).map(|b| b.lobe) {
+    match material
+        .bsdf(&record, -ray.direction, &scene.textures)
+        .map(|b| b.lobe)
+    {
         Some(Lobe::Diffuse(d)) => d.albedo,
         Some(Lobe::Metal(m)) => m.albedo,
+        Some(Lobe::Principled(p)) => p.base_color,
         other => panic!("no colour: {other:?}"),
     }
 }

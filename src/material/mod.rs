@@ -440,6 +440,30 @@ impl Shape {
     }
 }
 
+/// Unit shading normal `n` (from a normal or bump map) bent towards the
+/// geometric normal `ng` as far as needed for the mirror reflection of `wo`
+/// about it to leave the surface, as Cycles does: a map tilting the normal
+/// away from the view would make the surface black there.
+#[inline]
+fn visible(n: Vec3, wo: Vec3, ng: Vec3) -> Vec3 {
+    let least = (0.9 * wo.dot(ng)).min(0.01);
+    let reflects = |n: Vec3| (2.0 * wo.dot(n) * n - wo).dot(ng) >= least;
+    if reflects(n) || !reflects(ng) {
+        return n;
+    }
+    // Along the arc from `n` (fails) to `ng` (passes), by bisection.
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..12 {
+        let mid = 0.5 * (lo + hi);
+        if reflects(n.lerp(ng, mid).normalize()) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    n.lerp(ng, hi).normalize()
+}
+
 /// The unit tangent and bitangent about unit normal `n` from the surface's
 /// derivatives: ∂p/∂u made perpendicular to `n`, and ∂p/∂v made
 /// perpendicular to both (n × tangent, turned to ∂p/∂v's side, where it
@@ -542,13 +566,14 @@ impl Material {
         }
     }
 
-    /// The scattering at `hit` (textures looked up in `textures`), or
-    /// `None` where it scatters nothing.
+    /// The scattering at `hit`, seen from unit direction `wo` (back along
+    /// the ray; textures looked up in `textures`), or `None` where it
+    /// scatters nothing.
     #[inline(always)]
-    pub fn bsdf(&self, hit: &HitRecord, textures: &[Texture]) -> Option<Bsdf> {
+    pub fn bsdf(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Option<Bsdf> {
         let n = match &self.shape {
             None => hit.shading_normal,
-            Some(shape) => shape.normal(hit, textures),
+            Some(shape) => visible(shape.normal(hit, textures), wo, hit.normal),
         };
         // The notes' lobes scatter about the normal alone.
         let notes = |lobe| Some(Bsdf::new(Frame::normal_only(n), hit.normal, lobe));

@@ -21,16 +21,16 @@
 //! ```
 
 mod gltf;
+pub mod material;
 mod obj;
 mod ply;
+mod tangents;
 
-use crate::material::{ColorParam, Dielectric, Diffuse, Emission, Kind, Material, Metal};
-use crate::math::Color;
-use crate::texture::Image;
+pub use material::{AlphaMode, Mapped, MeshMaterial};
+
 use glam::Mat4;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Material index of a triangle whose file gives it no material.
 pub const NO_MATERIAL: u32 = u32::MAX;
@@ -156,108 +156,6 @@ fn fan(polygon: &[u32]) -> impl Iterator<Item = [u32; 3]> + '_ {
         .map(|w| [polygon[0], w[0], w[1]])
 }
 
-/// A material as a file describes it, in the terms of glTF's
-/// metallic-roughness model; [`MeshMaterial::to_material`] maps it onto one of
-/// lumen's materials.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MeshMaterial {
-    /// The material's name in the file (glTF materials without one are named
-    /// `material N`).
-    pub name: String,
-    /// Linear RGB base colour (MTL `Kd`, or `Ks` for a metal; glTF
-    /// `baseColorFactor`).
-    pub base_color: [f32; 3],
-    /// An image the base colour is multiplied by, looked up by the mesh's
-    /// texture coordinates (MTL `map_Kd`; glTF `baseColorTexture`).
-    pub base_color_texture: Option<Arc<Image>>,
-    /// 0 for a dielectric surface, 1 for a metal.
-    pub metallic: f32,
-    /// Perceptual roughness in [0, 1] as in glTF; the microfacet width is
-    /// α = roughness². For MTL, roughness = (2 / (Ns + 2))^¼, the usual
-    /// Blinn–Phong-to-Beckmann match α² = 2 / (Ns + 2).
-    pub roughness: f32,
-    /// Index of refraction (MTL `Ni`, glTF `KHR_materials_ior`; default 1.5).
-    pub ior: f32,
-    /// Fraction of light transmitted through the surface: MTL 1 − `d` or
-    /// `Tr` (1 for illumination models 4, 6 and 7), glTF
-    /// `KHR_materials_transmission`.
-    pub transmission: f32,
-    /// Emitted radiance (MTL `Ke`; glTF `emissiveFactor` times
-    /// `KHR_materials_emissive_strength`).
-    pub emission: [f32; 3],
-    /// Whether the surface is seen, and emits, from both sides (glTF
-    /// `doubleSided`; false for MTL, which has no such notion: its lights
-    /// emit towards the side from which the triangles' corners run
-    /// counter-clockwise).
-    pub double_sided: bool,
-}
-
-impl Default for MeshMaterial {
-    fn default() -> Self {
-        Self {
-            name: String::new(),
-            base_color: [0.8; 3],
-            base_color_texture: None,
-            metallic: 0.0,
-            roughness: 1.0,
-            ior: DEFAULT_IOR,
-            transmission: 0.0,
-            emission: [0.0; 3],
-            double_sided: false,
-        }
-    }
-}
-
-impl MeshMaterial {
-    /// The nearest of lumen's materials:
-    ///
-    /// - any emission (a channel > 0) → an emitter with that radiance
-    ///   (negative, infinite and NaN channels taken as 0), two-sided when the
-    ///   material is double-sided; such a surface emits and reflects
-    ///   nothing;
-    /// - else any transmission (> 0) → [`Dielectric`] with `ior` (1.5 when it is
-    ///   not a positive finite number);
-    /// - else `metallic` ≥ 0.5 → [`Metal`] with the base colour as albedo and
-    ///   fuzz = α = roughness² (for MTL: √(2 / (Ns + 2)), so Ns = 1000 gives
-    ///   0.045 and Ns = 0 gives 1);
-    /// - else a Lambertian [`Diffuse`] with the base colour as albedo.
-    ///
-    /// Colours are clamped to [0, 1] (NaN to 0).
-    pub fn to_material(&self) -> Material {
-        let unit = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-        let albedo = Color::from_array(self.base_color.map(unit));
-        let radiance = self
-            .emission
-            .map(|x| if x > 0.0 && x.is_finite() { x } else { 0.0 });
-        if radiance.iter().any(|&x| x > 0.0) {
-            Material::emitter(Emission {
-                radiance: ColorParam::Const(Color::from_array(radiance)),
-                two_sided: self.double_sided,
-            })
-        } else if self.transmission > 0.0 {
-            let ior = if self.ior.is_finite() && self.ior > 0.0 {
-                self.ior
-            } else {
-                DEFAULT_IOR
-            };
-            Material::new(Kind::Dielectric(Dielectric {
-                ior,
-                refract_only: false,
-                roughness: None,
-                multiscatter: false,
-            }))
-        } else if self.metallic >= 0.5 {
-            let r = unit(self.roughness);
-            Material::new(Kind::Metal(Metal {
-                albedo: ColorParam::Const(albedo),
-                fuzz: r * r,
-            }))
-        } else {
-            Material::new(Kind::Diffuse(Diffuse::lambertian(albedo)))
-        }
-    }
-}
-
 /// Meshes, their materials and where they are placed.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Model {
@@ -280,6 +178,8 @@ pub struct Model {
     pub file_crc: u32,
     /// The file's length in bytes, as read.
     pub file_len: u64,
+    /// What the file holds that lumen does not render, one line each.
+    pub warnings: Vec<String>,
 }
 
 impl Model {
@@ -306,6 +206,25 @@ impl Model {
             }
         }
         (lo.x <= hi.x).then(|| (lo.to_array(), hi.to_array()))
+    }
+
+    /// Gives tangents (MikkTSpace) to the meshes that a normal-mapped
+    /// material covers and whose file gives none, in parallel.
+    fn generate_tangents(&mut self) {
+        use rayon::prelude::*;
+        let materials = &self.materials;
+        let needs = |m: &TriangleMesh| {
+            m.material.iter().any(|&i| {
+                materials
+                    .get(i as usize)
+                    .is_some_and(MeshMaterial::needs_tangents)
+            })
+        };
+        self.meshes.par_iter_mut().for_each(|m| {
+            if needs(m) {
+                tangents::generate(m);
+            }
+        });
     }
 
     /// Refuses a model without triangles and trims the arrays.
@@ -401,11 +320,13 @@ pub fn load(path: &Path) -> Result<Model, MeshError> {
     };
     let bytes = read_file(path)?;
     let (file_crc, file_len) = (crc32fast::hash(&bytes), bytes.len() as u64);
-    Ok(Model {
+    let mut model = Model {
         file_crc,
         file_len,
         ..format(path, bytes)?
-    })
+    };
+    model.generate_tangents();
+    Ok(model)
 }
 
 /// Reads a whole file, with a clear error for a missing file or a directory.

@@ -12,11 +12,12 @@
 //! identity instance; `usemtl` switches only the per-triangle material.
 //! Line (`l`) and point (`p`) elements have no surface and are ignored.
 
-use super::{MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
-use crate::texture::Image;
+use super::{AlphaMode, Mapped, MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use crate::texture::{Channels, Filter, Image, ImageMap, UvTransform, Wrap};
 use glam::Mat4;
 use std::borrow::Cow;
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -51,10 +52,12 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let (models, materials) = result.map_err(|e| obj_error(path, &text, e))?;
     // A missing MTL file leaves the materials empty (or an error that only
     // says so); the triangles then have no material.
+    let mtl = mtl_path.borrow().clone();
+    let mut images = Images::default();
     let materials: Vec<MeshMaterial> = materials
         .unwrap_or_default()
         .iter()
-        .map(|m| convert_material(m, mtl_path.borrow().as_deref().unwrap_or(path)))
+        .map(|m| convert_material(m, mtl.as_deref().unwrap_or(path), &mut images))
         .collect::<Result<_, _>>()?;
 
     let mut model = Model {
@@ -446,54 +449,271 @@ fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
     }
 }
 
-/// Maps an MTL material onto [`MeshMaterial`]:
-///
-/// - base colour = `Kd` (0.8 grey when absent);
-/// - a metal when `Kd` is black (every channel < 0.01) and `Ks` is strong
-///   (some channel ≥ 0.25): metallic = 1, base colour = `Ks`;
-/// - roughness = (2 / (Ns + 2))^¼ (`Ns` 0 when absent), so a metal's fuzz
-///   roughness² is √(2 / (Ns + 2));
-/// - ior = `Ni` (1.5 when absent); transmission = the larger of 1 − `d` and
-///   `Tr`, and 1 for illumination models 4, 6 and 7 (glass, refraction);
-/// - emission = `Ke`;
-/// - `map_Kd`: an image (relative to the MTL file `mtl`) the base colour is
-///   multiplied by.
-fn convert_material(m: &tobj::Material, mtl: &Path) -> Result<MeshMaterial, MeshError> {
-    let base_color_texture = match &m.diffuse_texture {
-        Some(file) => {
-            let dir = mtl.parent().unwrap_or(Path::new(""));
-            let image = Image::read(&dir.join(file)).map_err(|e| {
-                MeshError::new(mtl, None, format!("material `{}`: map_Kd: {e}", m.name))
-            })?;
-            Some(Arc::new(image))
+/// The images an MTL file's materials name, each read once.
+#[derive(Default)]
+struct Images {
+    read: HashMap<PathBuf, Arc<Image>>,
+}
+
+impl Images {
+    /// The image `file` (relative to `dir`).
+    fn get(&mut self, dir: &Path, file: &str) -> Result<Arc<Image>, String> {
+        let path = dir.join(file);
+        if let Some(image) = self.read.get(&path) {
+            return Ok(image.clone());
         }
-        None => None,
+        let image = Arc::new(Image::read(&path).map_err(|e| e.to_string())?);
+        self.read.insert(path, image.clone());
+        Ok(image)
+    }
+}
+
+/// A texture statement's options and file: `-bm 0.5 -s 2 2 file.png`
+/// gives the bump multiplier, the uv scale and offset, whether it clamps,
+/// and the file.
+struct MapStatement {
+    file: String,
+    bump: f32,
+    scale: [f32; 2],
+    offset: [f32; 2],
+    clamp: bool,
+}
+
+impl MapStatement {
+    fn parse(text: &str) -> Result<MapStatement, String> {
+        let words: Vec<&str> = text.split_whitespace().collect();
+        let mut out = MapStatement {
+            file: String::new(),
+            bump: 1.0,
+            scale: [1.0; 2],
+            offset: [0.0; 2],
+            clamp: false,
+        };
+        let mut i = 0;
+        // The numbers after an option (up to `max`).
+        let numbers = |i: &mut usize, max: usize| -> Vec<f32> {
+            let mut v = Vec::new();
+            while v.len() < max {
+                match words.get(*i).and_then(|w| w.parse::<f32>().ok()) {
+                    Some(x) if x.is_finite() => {
+                        v.push(x);
+                        *i += 1;
+                    }
+                    _ => break,
+                }
+            }
+            v
+        };
+        while i < words.len() && words[i].starts_with('-') && words[i].len() > 1 {
+            let option = words[i];
+            i += 1;
+            match option {
+                "-bm" => {
+                    out.bump = numbers(&mut i, 1)
+                        .first()
+                        .copied()
+                        .ok_or("-bm needs a number")?
+                }
+                "-s" => {
+                    let v = numbers(&mut i, 3);
+                    out.scale = [
+                        *v.first().ok_or("-s needs numbers")?,
+                        *v.get(1).unwrap_or(&1.0),
+                    ];
+                }
+                "-o" => {
+                    let v = numbers(&mut i, 3);
+                    out.offset = [
+                        *v.first().ok_or("-o needs numbers")?,
+                        *v.get(1).unwrap_or(&0.0),
+                    ];
+                }
+                "-clamp" => {
+                    out.clamp = words.get(i) == Some(&"on");
+                    i += 1;
+                }
+                "-blendu" | "-blendv" | "-cc" | "-imfchan" | "-type" => i += 1,
+                "-mm" => {
+                    numbers(&mut i, 2);
+                }
+                "-t" => {
+                    numbers(&mut i, 3);
+                }
+                "-texres" | "-boost" => {
+                    numbers(&mut i, 1);
+                }
+                other => return Err(format!("unknown texture option {other}")),
+            }
+        }
+        out.file = words[i.min(words.len())..].join(" ");
+        if out.file.is_empty() {
+            return Err("no file name".to_string());
+        }
+        Ok(out)
+    }
+}
+
+/// Maps an MTL material onto [`MeshMaterial`] (documented in
+/// `docs/materials.md`):
+///
+/// - base colour = `Kd` (0.8 grey when absent) × `map_Kd`;
+/// - the PBR extension where given: roughness `Pr` / `map_Pr`, metallic
+///   `Pm` / `map_Pm`, sheen `Ps`, clear coat `Pc` and its roughness `Pcr`;
+/// - else a metal when `Kd` is black (every channel < 0.01) and `Ks` is
+///   strong (some channel ≥ 0.25), base colour `Ks`; roughness =
+///   (2 / (Ns + 2))^¼ (`Ns` 0 when absent), or 1 − `map_Ns`;
+/// - illumination models 0 and 1 have no specular reflection (and a `Ks`
+///   of zero turns it off); 4, 6, 7 and 9 are glass (transmission 1,
+///   index `Ni`); otherwise transmission is `Tr` (or 1 − `d` for glass);
+/// - `d` < 1 or `map_d` elsewhere is opacity (cut-outs);
+/// - emission `Ke` × `map_Ke`; `bump`/`map_Bump` a height map (`-bm` its
+///   height), `norm` a tangent-space normal map; `-s`, `-o` and `-clamp on`
+///   move and wrap any map.
+fn convert_material(
+    m: &tobj::Material,
+    mtl: &Path,
+    images: &mut Images,
+) -> Result<MeshMaterial, MeshError> {
+    let dir = mtl.parent().unwrap_or(Path::new(""));
+    let fail = |what: &str, e: String| {
+        MeshError::new(mtl, None, format!("material `{}`: {what}: {e}", m.name))
+    };
+    let param = |key: &str| -> Option<&str> { m.unknown_param.get(key).map(|s| s.trim()) };
+    let number = |key: &str| -> Result<Option<f32>, MeshError> {
+        match param(key) {
+            None => Ok(None),
+            Some(v) => v
+                .split_whitespace()
+                .next()
+                .and_then(|w| w.parse::<f32>().ok())
+                .filter(|x| x.is_finite())
+                .map(Some)
+                .ok_or_else(|| fail(key, format!("needs a number, got `{v}`"))),
+        }
+    };
+    // An image map of statement `text` (keyword `what`).
+    let mut map = |what: &str, text: Option<&str>, channels: Channels, srgb: bool| {
+        let Some(text) = text else {
+            return Ok(None);
+        };
+        let statement = MapStatement::parse(text).map_err(|e| fail(what, e))?;
+        let image = images
+            .get(dir, &statement.file)
+            .map_err(|e| fail(what, e))?;
+        let channels = match channels {
+            // A scalar map of a grey image is its grey; of an image with
+            // alpha, its alpha.
+            Channels::One(0) if image.has_alpha() && what == "map_d" => Channels::One(3),
+            c => c,
+        };
+        let wrap = if statement.clamp {
+            Wrap::Clamp
+        } else {
+            Wrap::Repeat
+        };
+        Ok(Some((
+            ImageMap {
+                image,
+                srgb,
+                channels,
+                wrap: [wrap; 2],
+                filter: Filter::Bilinear,
+                transform: UvTransform::offset_rotation_scale(
+                    statement.offset,
+                    0.0,
+                    statement.scale,
+                ),
+                uv_set: 0,
+            },
+            statement.bump,
+        )))
     };
     let defaults = MeshMaterial::default();
-    let kd = m.diffuse.unwrap_or(defaults.base_color);
+    let kd = m.diffuse.unwrap_or(defaults.base_color.value);
     let ks = m.specular.unwrap_or([0.0; 3]);
     let max = |c: [f32; 3]| c[0].max(c[1]).max(c[2]);
-    let metal = max(kd) < 0.01 && max(ks) >= 0.25;
+    let pbr = param("Pr").is_some() || param("Pm").is_some() || param("map_Pr").is_some();
+    let metal = !pbr && max(kd) < 0.01 && max(ks) >= 0.25;
     let ns = m.shininess.unwrap_or(0.0).max(0.0);
-    let tr = m
-        .unknown_param
-        .get("Tr")
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse::<f32>().ok())
-        .unwrap_or(0.0);
-    let mut transmission = (1.0 - m.dissolve.unwrap_or(1.0)).max(tr).clamp(0.0, 1.0);
-    if matches!(m.illumination_model, Some(4 | 6 | 7)) {
-        transmission = 1.0;
-    }
-    Ok(MeshMaterial {
+    let illum = m.illumination_model.unwrap_or(2);
+    let glass = matches!(illum, 4 | 6 | 7 | 9);
+    let tr = number("Tr")?.unwrap_or(0.0);
+    let dissolve = m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0);
+    let first = |m: Option<(ImageMap, f32)>| m.map(|(map, _)| map);
+    let mut out = MeshMaterial {
         name: m.name.clone(),
-        base_color: if metal { ks } else { kd },
-        base_color_texture,
-        metallic: if metal { 1.0 } else { 0.0 },
-        roughness: (2.0 / (ns + 2.0)).sqrt().sqrt(),
-        ior: m.optical_density.unwrap_or(defaults.ior),
-        transmission,
-        emission: m.emissive.unwrap_or([0.0; 3]),
-        double_sided: false,
-    })
+        base_color: Mapped {
+            value: if metal { ks } else { kd },
+            map: first(map(
+                "map_Kd",
+                m.diffuse_texture.as_deref(),
+                Channels::Rgb,
+                true,
+            )?),
+        },
+        metallic: Mapped::value(if metal { 1.0 } else { 0.0 }),
+        roughness: Mapped::value((2.0 / (ns + 2.0)).sqrt().sqrt()),
+        ior: m.optical_density.unwrap_or(defaults.ior).max(1.0),
+        emission: Mapped {
+            value: m
+                .emissive
+                .unwrap_or([0.0; 3])
+                .map(|e| if e > 0.0 { e } else { 0.0 }),
+            map: first(map("map_Ke", param("map_Ke"), Channels::Rgb, true)?),
+        },
+        ..defaults
+    };
+    if let Some(gloss) = first(map(
+        "map_Ns",
+        m.shininess_texture.as_deref(),
+        Channels::One(0),
+        false,
+    )?) {
+        out.roughness = Mapped {
+            value: 1.0,
+            map: Some(gloss),
+        };
+        out.roughness_from_gloss = true;
+    }
+    if pbr {
+        out.roughness = Mapped {
+            value: number("Pr")?.unwrap_or(1.0).clamp(0.0, 1.0),
+            map: first(map("map_Pr", param("map_Pr"), Channels::One(0), false)?),
+        };
+        out.roughness_from_gloss = false;
+        out.metallic = Mapped {
+            value: number("Pm")?.unwrap_or(0.0).clamp(0.0, 1.0),
+            map: first(map("map_Pm", param("map_Pm"), Channels::One(0), false)?),
+        };
+        if let Some(ps) = number("Ps")? {
+            out.sheen_color = Mapped::value([ps.clamp(0.0, 1.0); 3]);
+            out.sheen_roughness = Mapped::value(0.5);
+        }
+        out.clearcoat = Mapped::value(number("Pc")?.unwrap_or(0.0).clamp(0.0, 1.0));
+        out.clearcoat_roughness = Mapped::value(number("Pcr")?.unwrap_or(0.0).clamp(0.0, 1.0));
+    }
+    if matches!(illum, 0 | 1) || (m.specular.is_some() && max(ks) == 0.0 && !pbr) {
+        out.specular = Mapped::value(0.0);
+    }
+    if glass {
+        out.transmission = Mapped::value(1.0);
+    } else {
+        out.transmission = Mapped::value(tr.clamp(0.0, 1.0));
+        let alpha = first(map(
+            "map_d",
+            m.dissolve_texture.as_deref(),
+            Channels::One(0),
+            false,
+        )?);
+        if dissolve < 1.0 || alpha.is_some() {
+            out.alpha = Mapped {
+                value: dissolve,
+                map: alpha,
+            };
+            out.alpha_mode = AlphaMode::Blend;
+        }
+    }
+    out.bump_map = map("bump", m.normal_texture.as_deref(), Channels::One(0), false)?;
+    out.normal_map = map("norm", param("norm"), Channels::Rgb, false)?.map(|(n, _)| (n, 1.0));
+    Ok(out)
 }

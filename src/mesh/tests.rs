@@ -229,63 +229,38 @@ fn mtl_materials_map_to_lights_diffuse_metal_and_glass() {
     assert_eq!(m.meshes.len(), 1, "usemtl does not split the object");
     let mesh = &m.meshes[0];
     assert_eq!(mesh.material, vec![0, 1, 2, 3, 4, NO_MATERIAL, 5]);
-    let mat = |name: &str| {
-        m.materials
-            .iter()
-            .find(|x| x.name == name)
-            .unwrap()
-            .to_material()
-    };
+    let mat = |name: &str| m.materials.iter().find(|x| x.name == name).unwrap();
 
-    // `Ke` makes a light, one-sided (MTL has no two-sided materials).
-    assert_eq!(
-        mat("red"),
-        Material::emitter(Emission {
-            radiance: ColorParam::Const(Color::new(0.0, 0.0, 4.0)),
-            two_sided: false
-        })
-    );
-    assert_eq!(m.materials[0].emission, [0.0, 0.0, 4.0]);
-    match mat("chrome").kind {
-        Kind::Metal(Metal { albedo, fuzz }) => {
-            assert_eq!(albedo, ColorParam::Const(Color::new(0.9, 0.8, 0.7)));
-            assert!((fuzz - (2.0f32 / 1002.0).sqrt()).abs() < 1e-5, "{fuzz}");
-        }
-        other => panic!("chrome is {other:?}"),
-    }
-    assert_eq!(
-        mat("glass"),
-        Material::new(Kind::Dielectric(Dielectric {
-            ior: 1.45,
-            refract_only: false,
-            roughness: None,
-            multiscatter: false,
-        }))
-    );
-    assert_eq!(
-        mat("water"),
-        Material::new(Kind::Dielectric(Dielectric {
-            ior: 1.33,
-            refract_only: false,
-            roughness: None,
-            multiscatter: false,
-        }))
-    );
-    assert_eq!(
-        mat("grey"),
-        Material::new(Kind::Diffuse(Diffuse::lambertian(Color::splat(0.5))))
-    );
-    assert_eq!(
-        mat("hot"),
-        Material::new(Kind::Diffuse(Diffuse::lambertian(Color::new(
-            1.0, 0.0, 0.5
-        ))))
-    );
+    // `Ke` glows, one-sided (MTL has no two-sided materials), on top of
+    // what the surface reflects.
+    let red = mat("red");
+    assert_eq!(red.emission.value, [0.0, 0.0, 4.0]);
+    assert_eq!(red.base_color.value, [1.0, 0.2, 0.0]);
+    assert!(!red.double_sided);
+    // Black diffuse and strong specular: a metal of the specular colour.
+    let chrome = mat("chrome");
+    assert_eq!(chrome.metallic.value, 1.0);
+    assert_eq!(chrome.base_color.value, [0.9, 0.8, 0.7]);
+    let r = (2.0f32 / 1002.0).sqrt().sqrt();
+    assert!((chrome.roughness.value - r).abs() < 1e-6);
+    // `d` is opacity (as Blender reads it); glass is an illumination model.
+    let glass = mat("glass");
+    assert_eq!(glass.ior, 1.45);
+    assert_eq!(glass.alpha.value, 0.1);
+    assert_eq!(glass.alpha_mode, AlphaMode::Blend);
+    assert_eq!(glass.transmission.value, 0.0);
+    let water = mat("water");
+    assert_eq!((water.transmission.value, water.ior), (1.0, 1.33));
+    assert_eq!(water.alpha_mode, AlphaMode::Opaque);
+    assert_eq!(mat("grey").base_color.value, [0.5; 3]);
+    assert_eq!(mat("grey").metallic.value, 0.0);
+    // Out of range as written; the scene clamps it.
+    assert_eq!(mat("hot").base_color.value, [3.0, -1.0, 0.5]);
 }
 
 #[test]
-fn metal_fuzz_falls_as_the_phong_exponent_rises() {
-    let fuzz = |ns: f32| {
+fn mtl_roughness_falls_as_the_phong_exponent_rises() {
+    let roughness = |ns: f32| {
         let text = format!("newmtl m\nKd 0 0 0\nKs 1 1 1\nNs {ns}\n");
         let dir = TempDir::new();
         dir.write("m.mtl", text);
@@ -293,15 +268,12 @@ fn metal_fuzz_falls_as_the_phong_exponent_rises() {
             "m.obj",
             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
         );
-        match load(&p).unwrap().materials[0].to_material().kind {
-            Kind::Metal(m) => m.fuzz,
-            other => panic!("{other:?}"),
-        }
+        load(&p).unwrap().materials[0].roughness.value
     };
-    let f: Vec<f32> = [0.0, 10.0, 100.0, 10000.0].map(fuzz).to_vec();
-    assert!((f[0] - 1.0).abs() < 1e-6);
-    assert!(f.windows(2).all(|w| w[1] < w[0]), "{f:?}");
-    assert!(f[3] < 0.02);
+    let r: Vec<f32> = [0.0, 10.0, 100.0, 10000.0].map(roughness).to_vec();
+    assert!((r[0] - 1.0).abs() < 1e-6);
+    assert!(r.windows(2).all(|w| w[1] < w[0]), "{r:?}");
+    assert!(r[3] < 0.12);
 }
 
 #[test]
@@ -576,26 +548,13 @@ fn gltf_hierarchy_composes_transforms_and_shares_the_mesh() {
 
     let steel = &m.materials[0];
     assert_eq!(steel.name, "steel");
-    assert_eq!(steel.emission, [0.1, 0.2, 0.3]);
     assert!(steel.double_sided);
-    // It glows, from both sides; without its glow it is a metal.
-    assert_eq!(
-        steel.to_material(),
-        Material::emitter(Emission {
-            radiance: ColorParam::Const(Color::new(0.1, 0.2, 0.3)),
-            two_sided: true
-        })
-    );
-    let dark = MeshMaterial {
-        emission: [0.0; 3],
-        ..steel.clone()
-    };
-    assert_eq!(
-        dark.to_material(),
-        Material::new(Kind::Metal(Metal {
-            albedo: ColorParam::Const(Color::new(0.5, 0.6, 0.7)),
-            fuzz: 0.25
-        }))
+    assert_eq!(steel.emission.value, [0.1, 0.2, 0.3]);
+    assert_eq!(steel.base_color.value, [0.5, 0.6, 0.7]);
+    assert_eq!((steel.metallic.value, steel.roughness.value), (1.0, 0.5));
+    assert!(
+        steel.vertex_color,
+        "glTF colours by COLOR_0 where a mesh has it"
     );
 }
 
@@ -704,15 +663,8 @@ fn gltf_transmission_and_strips_and_fans() {
     );
     assert_eq!(mesh.material, vec![0, 0, NO_MATERIAL, NO_MATERIAL]);
     assert_eq!(m.materials[0].name, "material 0");
-    assert_eq!(
-        m.materials[0].to_material(),
-        Material::new(Kind::Dielectric(Dielectric {
-            ior: 1.7,
-            refract_only: false,
-            roughness: None,
-            multiscatter: false,
-        }))
-    );
+    assert_eq!(m.materials[0].transmission.value, 1.0);
+    assert_eq!(m.materials[0].ior, 1.7);
 }
 
 // ------------------------------------------------------------ bad glTF input

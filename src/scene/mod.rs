@@ -181,6 +181,9 @@ pub struct Scene {
     light_ids: LightIds,
     /// The fog and smoke of the scene.
     pub media: Vec<Medium>,
+    /// What each mesh file loaded holds, and what of it lumen does not
+    /// render.
+    pub reports: Vec<FileReport>,
     /// Whether some material is not all there (has an opacity), so that
     /// rays must look past the hits they find.
     cutouts: bool,
@@ -215,6 +218,59 @@ pub struct MeshSource {
     pub crc: u32,
     /// Its length in bytes.
     pub len: u64,
+}
+
+/// What a mesh file loaded for a scene holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileReport {
+    /// The file, as the scene names it.
+    pub file: String,
+    /// Triangles in it (a mesh placed several times counts once).
+    pub triangles: usize,
+    /// Its materials.
+    pub materials: usize,
+    /// The images its materials map, and the bytes their texels take.
+    pub images: usize,
+    /// Bytes of the images' texels.
+    pub image_bytes: usize,
+    /// What the file holds that lumen does not render.
+    pub warnings: Vec<String>,
+}
+
+impl FileReport {
+    /// The report of `model`, read from `file`.
+    pub fn of(file: &str, model: &crate::mesh::Model) -> FileReport {
+        let mut images: Vec<&std::sync::Arc<crate::texture::Image>> = Vec::new();
+        for map in model.materials.iter().flat_map(|m| m.maps()) {
+            if !images.iter().any(|i| std::sync::Arc::ptr_eq(i, &map.image)) {
+                images.push(&map.image);
+            }
+        }
+        let image_bytes = images.iter().map(|i| i.heap_bytes()).sum();
+        FileReport {
+            file: file.to_string(),
+            triangles: model.triangle_count(),
+            materials: model.materials.len(),
+            images: images.len(),
+            image_bytes,
+            warnings: model.warnings.clone(),
+        }
+    }
+}
+
+impl std::fmt::Display for FileReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+        write!(
+            f,
+            "{}: {}, {}, {} ({:.1} MB)",
+            self.file,
+            plural(self.triangles, "triangle"),
+            plural(self.materials, "material"),
+            plural(self.images, "texture image"),
+            self.image_bytes as f64 / 1e6
+        )
+    }
 }
 
 /// Counts of what a compiled scene holds.

@@ -66,6 +66,12 @@ pub enum Texture {
         /// The factor.
         factor: Color,
     },
+    /// One minus another texture of the table (a gloss map read as a
+    /// roughness).
+    Inverted {
+        /// The texture inverted.
+        texture: u32,
+    },
     /// Perlin noise, grey, over the point in space scaled by `scale`.
     Noise {
         /// The noise function.
@@ -116,6 +122,7 @@ impl Texture {
             Texture::Scaled { texture, factor } => {
                 table[*texture as usize].value(table, at) * *factor
             }
+            Texture::Inverted { texture } => Color::ONE - table[*texture as usize].value(table, at),
             Texture::Noise {
                 perlin,
                 scale,
@@ -139,7 +146,9 @@ impl Texture {
             Texture::Checker { even, odd, .. } => {
                 table[*even as usize].uses_uv(table) || table[*odd as usize].uses_uv(table)
             }
-            Texture::Scaled { texture, .. } => table[*texture as usize].uses_uv(table),
+            Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
+                table[*texture as usize].uses_uv(table)
+            }
             Texture::Solid(_) | Texture::Noise { .. } => false,
         }
     }

@@ -70,6 +70,12 @@ pub(crate) fn render_command(
     prog: &ProgressiveArgs,
 ) -> Result<ExitCode> {
     let (desc, scene) = load_scene(name)?.resolve(name, &args.overrides())?;
+    for report in &scene.reports {
+        errln!("{report}");
+        for warning in &report.warnings {
+            errln!("lumen: warning: {}: {warning}", report.file);
+        }
+    }
     let is_part_file = out.extension().is_some_and(|e| e == part::EXTENSION);
     let share = Share {
         part: prog.part,

@@ -17,15 +17,15 @@
 //! (it can slice out of bounds or misread on a bad file), so every accessor is
 //! checked against its buffer view and buffer before it is read.
 
-use super::{fan, MeshError, MeshMaterial, Model, TriangleMesh, DEFAULT_IOR, NO_MATERIAL};
-use crate::texture::Image;
+use super::{fan, MeshError, Model, TriangleMesh, NO_MATERIAL};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use std::borrow::Cow;
 use std::path::Path;
-use std::sync::Arc;
+
+mod material;
 
 /// Loads a `.gltf` or `.glb` file.
 /// `bytes` are the file's content.
@@ -33,20 +33,39 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let err = |msg: String| MeshError::new(path, None, msg);
     check_glb_header(&bytes).map_err(err)?;
     let invalid = |e: gltf::Error| err(format!("invalid glTF: {e}"));
+    // The JSON as written, for what the crate does not read (material
+    // extensions) and for the extensions the file needs, checked first.
+    let raw = raw_json(&bytes).map_err(err)?;
+    let mut warnings = check_extensions(&raw).map_err(err)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
     drop(bytes);
-    let json = document.into_json();
+    let mut json = document.into_json();
     check_attribute_indices(&json).map_err(err)?;
+    // Checked above; the crate would refuse those it was not built for.
+    json.extensions_required.clear();
     let document = gltf::Document::from_json(json).map_err(invalid)?;
     let buffers = load_buffers(path, &document, blob)?;
 
-    let materials = document
-        .materials()
-        .map(|m| convert_material(m, path, &buffers))
-        .collect::<Result<_, _>>()?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let views: Vec<gltf::buffer::View> = document.views().collect();
+    let view_bytes = |i: usize| -> Option<&[u8]> {
+        let view = views.get(i)?;
+        let data = buffers.get(view.buffer().index())?;
+        data.get(view.offset()..view.offset().checked_add(view.length())?)
+    };
+    let uri_bytes = |uri: &str| read_uri(dir, uri);
+    let materials = material::materials(
+        path,
+        &material::Json { root: &raw },
+        &view_bytes,
+        &uri_bytes,
+        &mut warnings,
+    )?;
+    warnings.extend(unrendered(&raw));
     let mut model = Model {
         materials,
+        warnings,
         ..Model::default()
     };
     // glTF mesh index → index in model.meshes, for meshes already converted.
@@ -338,6 +357,9 @@ fn convert_mesh(
     let mut out = TriangleMesh::default();
     let (mut all_normals, mut all_uvs) = (true, true);
     let (mut normals, mut uvs) = (Vec::new(), Vec::new());
+    // Kept only when every primitive has them.
+    let (mut all_uvs1, mut all_colors, mut all_tangents) = (true, true, true);
+    let (mut uvs1, mut colors, mut tangents) = (Vec::new(), Vec::new(), Vec::new());
     for primitive in mesh.primitives() {
         let p = primitive.index();
         let in_primitive = |m: String| format!("primitive {p}: {m}");
@@ -371,7 +393,34 @@ fn convert_mesh(
             check_accessor(a, "TEXCOORD_0", &types, Dimensions::Vec2, buffers)
                 .map_err(in_primitive)?;
         }
-        for (a, name) in [(&normal, "NORMAL"), (&uv, "TEXCOORD_0")] {
+        let uv1 = primitive.get(&Semantic::TexCoords(1));
+        if let Some(a) = &uv1 {
+            let types = [DataType::F32, DataType::U8, DataType::U16];
+            check_accessor(a, "TEXCOORD_1", &types, Dimensions::Vec2, buffers)
+                .map_err(in_primitive)?;
+        }
+        let color = primitive.get(&Semantic::Colors(0));
+        if let Some(a) = &color {
+            let types = [DataType::F32, DataType::U8, DataType::U16];
+            let dims = if a.dimensions() == Dimensions::Vec3 {
+                Dimensions::Vec3
+            } else {
+                Dimensions::Vec4
+            };
+            check_accessor(a, "COLOR_0", &types, dims, buffers).map_err(in_primitive)?;
+        }
+        let tangent = primitive.get(&Semantic::Tangents);
+        if let Some(a) = &tangent {
+            check_accessor(a, "TANGENT", &[DataType::F32], Dimensions::Vec4, buffers)
+                .map_err(in_primitive)?;
+        }
+        for (a, name) in [
+            (&normal, "NORMAL"),
+            (&uv, "TEXCOORD_0"),
+            (&uv1, "TEXCOORD_1"),
+            (&color, "COLOR_0"),
+            (&tangent, "TANGENT"),
+        ] {
             if let Some(a) = a {
                 if a.count() != vertex_count {
                     return Err(in_primitive(format!(
@@ -416,6 +465,18 @@ fn convert_mesh(
             // glTF's v runs down the image; lumen's up.
             Some(t) if all_uvs => uvs.extend(t.into_f32().map(|[u, v]| [u, 1.0 - v])),
             _ => all_uvs = false,
+        }
+        match reader.read_tex_coords(1) {
+            Some(t) if all_uvs1 => uvs1.extend(t.into_f32().map(|[u, v]| [u, 1.0 - v])),
+            _ => all_uvs1 = false,
+        }
+        match reader.read_colors(0) {
+            Some(c) if all_colors => colors.extend(c.into_rgba_f32()),
+            _ => all_colors = false,
+        }
+        match reader.read_tangents() {
+            Some(t) if all_tangents => tangents.extend(t),
+            _ => all_tangents = false,
         }
 
         let indices: Vec<u32> = match reader.read_indices() {
@@ -468,58 +529,106 @@ fn convert_mesh(
     if all_uvs && uvs.len() == out.positions.len() {
         out.uvs = Some(uvs);
     }
+    let n = out.positions.len();
+    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+    if all_uvs1 && uvs1.len() == n && uvs1.iter().all(|t| finite(t)) {
+        out.uvs1 = Some(uvs1);
+    }
+    if all_colors && colors.len() == n && colors.iter().all(|c| finite(c)) {
+        out.colors = Some(colors);
+    }
+    if all_tangents && tangents.len() == n && tangents.iter().all(|t| finite(t)) {
+        out.tangents = Some(tangents);
+    }
     Ok(out)
 }
 
-/// Maps a glTF material: base colour (RGB of `baseColorFactor`), metallic,
-/// roughness, `KHR_materials_ior`, `KHR_materials_transmission`, and
-/// `emissiveFactor` times `KHR_materials_emissive_strength`, and
-/// `doubleSided`; of the textures, `baseColorTexture` (read by texture
-/// coordinates 0; others are ignored).
-fn convert_material(
-    m: gltf::Material,
-    path: &Path,
-    buffers: &[Vec<u8>],
-) -> Result<MeshMaterial, MeshError> {
-    let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
-    let strength = m.emissive_strength().unwrap_or(1.0);
-    let base_color_texture = match pbr.base_color_texture() {
-        Some(info) if info.tex_coord() == 0 => {
-            let image = info.texture().source();
-            let err =
-                |msg: String| MeshError::new(path, None, format!("image {}: {msg}", image.index()));
-            let bytes: Cow<[u8]> = match image.source() {
-                gltf::image::Source::View { view, .. } => {
-                    let data = buffers.get(view.buffer().index());
-                    let range = view.offset()..view.offset() + view.length();
-                    Cow::Borrowed(
-                        data.and_then(|d| d.get(range))
-                            .ok_or_else(|| err("its buffer view lies outside its buffer".into()))?,
-                    )
-                }
-                gltf::image::Source::Uri { uri, .. } => {
-                    Cow::Owned(read_uri(path.parent().unwrap_or(Path::new("")), uri).map_err(err)?)
-                }
-            };
-            let shown = format!("{} image {}", path.display(), image.index());
-            let decoded = Image::decode(&bytes, &shown).map_err(|e| err(e.to_string()))?;
-            Some(Arc::new(decoded))
-        }
-        _ => None,
+/// The file's JSON as a value: a `.gltf` file itself, a GLB's JSON chunk.
+fn raw_json(bytes: &[u8]) -> Result<serde_json::Value, String> {
+    let json: Cow<[u8]> = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(bytes)
+            .map_err(|e| format!("invalid glTF: {e}"))?
+            .json
+    } else {
+        Cow::Borrowed(bytes)
     };
-    Ok(MeshMaterial {
-        base_color_texture,
-        name: m
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
-        base_color: [r, g, b],
-        metallic: pbr.metallic_factor(),
-        roughness: pbr.roughness_factor(),
-        ior: m.ior().unwrap_or(DEFAULT_IOR),
-        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
-        emission: m.emissive_factor().map(|e| e * strength),
-        double_sided: m.double_sided(),
-    })
+    serde_json::from_slice(&json).map_err(|e| format!("invalid glTF JSON: {e}"))
+}
+
+/// Refuses a file that requires an extension lumen lacks, naming it (and
+/// nothing else: what else is wrong with such a file is beside the point);
+/// one warning for each extension the file uses and lumen does not render.
+fn check_extensions(raw: &serde_json::Value) -> Result<Vec<String>, String> {
+    let known = |e: &str| material::SUPPORTED.contains(&e) || material::HARMLESS.contains(&e);
+    let names = |key: &str| -> Vec<String> {
+        raw[key]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|e| e.as_str().map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let required: Vec<String> = names("extensionsRequired")
+        .into_iter()
+        .filter(|e| !known(e))
+        .collect();
+    if !required.is_empty() {
+        return Err(format!(
+            "requires {} {}, which lumen does not support (it reads {})",
+            if required.len() == 1 {
+                "extension"
+            } else {
+                "extensions"
+            },
+            required.join(", "),
+            material::SUPPORTED.join(", ")
+        ));
+    }
+    Ok(names("extensionsUsed")
+        .into_iter()
+        .filter(|e| !known(e))
+        .map(|e| format!("extension {e} is not rendered"))
+        .collect())
+}
+
+/// One warning for each kind of thing in the file that lumen does not
+/// render.
+fn unrendered(raw: &serde_json::Value) -> Vec<String> {
+    let count = |key: &str| raw[key].as_array().map_or(0, Vec::len);
+    let mut out = Vec::new();
+    for (key, what) in [
+        ("animations", "animations (the rest pose is rendered)"),
+        ("skins", "skins (the rest pose is rendered)"),
+        ("cameras", "cameras (unless the scene's camera names one)"),
+    ] {
+        let n = count(key);
+        if n > 0 {
+            out.push(format!("{n} {what} not used"));
+        }
+    }
+    let occlusion = raw["materials"].as_array().map_or(0, |m| {
+        m.iter()
+            .filter(|m| !m["occlusionTexture"].is_null())
+            .count()
+    });
+    if occlusion > 0 {
+        out.push(format!(
+            "{occlusion} occlusion textures not used (a path tracer works occlusion out itself)"
+        ));
+    }
+    let morphs = raw["meshes"].as_array().map_or(0, |m| {
+        m.iter()
+            .filter(|m| {
+                m["primitives"]
+                    .as_array()
+                    .is_some_and(|p| p.iter().any(|p| !p["targets"].is_null()))
+            })
+            .count()
+    });
+    if morphs > 0 {
+        out.push(format!("{morphs} meshes' morph targets not used"));
+    }
+    out
 }

@@ -8,24 +8,25 @@ use super::desc::{
 };
 use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
 use super::{
-    invalid, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings, MAX_COORDINATE,
-    MAX_PIXELS,
+    invalid, FileReport, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings,
+    MAX_COORDINATE, MAX_PIXELS,
 };
 use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
 use crate::material::param::{self, ColorRange, Range};
-use crate::material::{ColorParam, Invalid, Kind, Material, ScalarParam, Textures};
+use crate::material::{ColorParam, Invalid, Material, ScalarParam, Textures};
 use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
-use crate::mesh::{self, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use crate::mesh::{self, Model, TriangleMesh, NO_MATERIAL};
 use crate::texture::{Channels, ImageMap, Texture};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use textures::{read_image, ColorRef, TextureKind, TextureTable};
 
+mod file_material;
 mod textures;
 
 /// The factor of [`HitRecord::error`]: the hit point and its offset from the
@@ -123,6 +124,7 @@ impl Scene {
             placements: Vec::new(),
             sources,
             stats: SceneStats::default(),
+            reports: Vec::new(),
         };
         for (i, object) in desc.objects.iter().enumerate() {
             objects.add(i, object)?;
@@ -139,6 +141,7 @@ impl Scene {
             media,
             sources,
             mut stats,
+            reports,
             ..
         } = objects;
         let moves = instances.iter().any(|p| p.motion != Vec3::ZERO);
@@ -165,6 +168,7 @@ impl Scene {
         );
         let cutouts = materials.iter().any(|m| m.opacity.is_some());
         Ok(Scene {
+            reports,
             settings,
             camera,
             background,
@@ -302,6 +306,7 @@ struct Objects<'a> {
     placements: Vec<Placement>,
     sources: Vec<MeshSource>,
     stats: SceneStats,
+    reports: Vec<FileReport>,
 }
 
 impl<'a> Objects<'a> {
@@ -567,6 +572,7 @@ impl<'a> Objects<'a> {
             len: model.file_len,
         });
         self.stats.skipped_degenerate += model.skipped_degenerate as u64;
+        self.reports.push(FileReport::of(file, &model));
         let materials = vec![None; model.materials.len() + 1];
         self.models
             .insert(path.clone(), LoadedModel { model, materials });
@@ -585,29 +591,10 @@ impl<'a> Objects<'a> {
         if let Some(index) = loaded.materials[slot] {
             return index;
         }
-        let default = MeshMaterial::default();
-        let mesh_material = loaded.model.materials.get(slot).unwrap_or(&default);
-        let mut material = mesh_material.to_material();
-        // A base colour image, times the base colour, becomes the albedo's
-        // texture.
-        if let Some(image) = &mesh_material.base_color_texture {
-            let albedo = match &mut material.kind {
-                Kind::Diffuse(d) => Some(&mut d.albedo),
-                Kind::Metal(m) => Some(&mut m.albedo),
-                _ => None,
-            };
-            if let Some(albedo) = albedo {
-                let factor = Color::from_array(mesh_material.base_color);
-                self.textures
-                    .push(Texture::Map(Arc::new(ImageMap::color(image.clone()))));
-                let map = self.textures.len() as u32 - 1;
-                self.textures.push(Texture::Scaled {
-                    texture: map,
-                    factor,
-                });
-                *albedo = ColorParam::Texture(self.textures.len() as u32 - 1);
-            }
-        }
+        let material = match loaded.model.materials.get(slot) {
+            Some(m) => file_material::compile(m, &mut self.textures),
+            None => file_material::no_material(),
+        };
         let index = self.materials.len() as u32;
         self.materials.push(material);
         loaded.materials[slot] = Some(index);

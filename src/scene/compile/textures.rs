@@ -240,7 +240,7 @@ impl TextureTable<'_> {
                     Channels::Rgb => TextureKind::Color,
                     Channels::One(_) => TextureKind::Scalar,
                 },
-                Texture::Scaled { texture, .. } => {
+                Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
                     t = *texture;
                     continue;
                 }
