@@ -90,21 +90,20 @@ pub struct LightTexture {
 
 impl Light {
     /// Its power, up to a constant factor: what [`Lights`] chooses by.
-    fn power(&self, textures: &[Texture]) -> f64 {
+    fn power(&self, textures: &[Texture], grid: usize) -> f64 {
         let sides = if self.emission.two_sided { 2.0 } else { 1.0 };
-        f64::from(self.mean_luminance(textures))
+        f64::from(self.mean_luminance(textures, grid))
             * f64::from(self.shape.area())
             * std::f64::consts::PI
             * sides
     }
 
     /// The luminance of its radiance averaged over its area: a textured
-    /// light's over a 16 × 16 grid of points spread evenly by area.
-    fn mean_luminance(&self, textures: &[Texture]) -> f32 {
+    /// light's over a `n` × `n` grid of points spread evenly by area.
+    fn mean_luminance(&self, textures: &[Texture], n: usize) -> f32 {
         if self.texture.is_none() {
             return luminance(self.emission.radiance);
         }
-        let n = 16;
         let mut total = 0.0;
         for i in 0..n {
             for j in 0..n {
@@ -219,7 +218,20 @@ impl Lights {
         let environment = environment
             .map(|e| (e.integral(), e))
             .filter(|(integral, _)| *integral > 0.0);
-        let mut powers: Vec<f64> = lights.iter().map(|l| l.power(&textures)).collect();
+        // A textured light's power is estimated from a grid of its texture:
+        // 16 × 16 for a few lights, fewer for many (a textured mesh of a
+        // million emissive triangles), about 4 million lookups at most. An
+        // estimate only steers the choice of lights: any positive power
+        // leaves the image unbiased.
+        let textured = lights.iter().filter(|l| l.texture.is_some()).count().max(1);
+        let grid = ((4e6 / textured as f64).sqrt() as usize).clamp(2, 16);
+        let mut powers: Vec<f64> = {
+            use rayon::prelude::*;
+            lights
+                .par_iter()
+                .map(|l| l.power(&textures, grid))
+                .collect()
+        };
         powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
         let environment = environment.map(|(_, e)| e);
         if selection == LightSelection::Uniform {
