@@ -180,6 +180,20 @@ pub struct Model {
     pub file_len: u64,
     /// What the file holds that lumen does not render, one line each.
     pub warnings: Vec<String>,
+    /// The file's perspective cameras (glTF), in the order of its nodes.
+    pub cameras: Vec<ModelCamera>,
+}
+
+/// A camera of a model file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelCamera {
+    /// Its name in the file, if it has one.
+    pub name: Option<String>,
+    /// Camera to model space (column-major): the camera looks along −z,
+    /// +y up.
+    pub transform: Mat4,
+    /// The vertical field of view, in radians.
+    pub yfov: f32,
 }
 
 impl Model {

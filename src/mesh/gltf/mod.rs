@@ -71,6 +71,23 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     // glTF mesh index → index in model.meshes, for meshes already converted.
     let mut mesh_slot: Vec<Option<usize>> = vec![None; document.meshes().len()];
     for (node, transform) in walk_nodes(&document).map_err(err)? {
+        if let Some(camera) = node.camera() {
+            match camera.projection() {
+                gltf::camera::Projection::Perspective(p)
+                    if p.yfov().is_finite() && p.yfov() > 0.0 =>
+                {
+                    model.cameras.push(super::ModelCamera {
+                        name: camera.name().map(str::to_string),
+                        transform,
+                        yfov: p.yfov(),
+                    })
+                }
+                _ => model.warnings.push(format!(
+                    "camera {} is not a perspective camera lumen can use",
+                    camera.index()
+                )),
+            }
+        }
         let Some(mesh) = node.mesh() else { continue };
         let slot = match mesh_slot[mesh.index()] {
             Some(slot) => slot,

@@ -3,8 +3,8 @@
 //! placed once in world space or shared by instances.
 
 use super::desc::{
-    BackgroundDesc, BoundaryDesc, ColorDesc, MaterialDesc, ObjectDesc, ScalarDesc, ScaleDesc,
-    TransformDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, GltfCamera, MaterialDesc, ObjectDesc,
+    ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
 };
 use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
 use super::{
@@ -98,7 +98,7 @@ impl Scene {
         let settings = compile_settings(desc)?;
         // Checked before the objects are read (which may be slow); built
         // when it is known whether anything moves.
-        compile_camera(desc, &settings, true)?;
+        compile_camera(&desc.camera, &settings, true)?;
         let mut materials = Vec::with_capacity(desc.materials.len());
         let mut material_index = HashMap::with_capacity(desc.materials.len());
         let mut table = TextureTable::new(&desc.textures, base);
@@ -130,6 +130,7 @@ impl Scene {
             objects.add(i, object)?;
         }
         objects.place_meshes()?;
+        let gltf_camera = objects.gltf_camera()?;
         let background = compile_background(&desc.background, base, &mut objects.sources)?;
         let Objects {
             materials,
@@ -145,7 +146,11 @@ impl Scene {
             ..
         } = objects;
         let moves = instances.iter().any(|p| p.motion != Vec3::ZERO);
-        let camera = compile_camera(desc, &settings, moves)?;
+        let camera = compile_camera(
+            gltf_camera.as_ref().unwrap_or(&desc.camera),
+            &settings,
+            moves,
+        )?;
         let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
@@ -225,11 +230,10 @@ fn compile_background(
 /// The camera of `desc`. Where nothing `moves`, every ray is traced as the
 /// shutter opens: drawing a time would change nothing but the samples.
 fn compile_camera(
-    desc: &SceneDesc,
+    cam: &CameraDesc,
     settings: &Settings,
     moves: bool,
 ) -> Result<Camera, SceneError> {
-    let cam = &desc.camera;
     finite("camera.vfov", &[cam.vfov])?;
     finite("camera.lookfrom", &cam.lookfrom)?;
     finite("camera.lookat", &cam.lookat)?;
@@ -555,12 +559,7 @@ impl<'a> Objects<'a> {
     /// Loads mesh file `file` of object `i` (once per file), returning
     /// where it was found.
     fn load(&mut self, i: usize, file: &str) -> Result<PathBuf, SceneError> {
-        let path = if Path::new(file).is_absolute() {
-            PathBuf::from(file)
-        } else {
-            self.base.join(file)
-        };
-        let path = std::fs::canonicalize(&path).unwrap_or(path);
+        let path = model_path(self.base, file);
         if self.models.contains_key(&path) {
             return Ok(path);
         }
@@ -700,6 +699,75 @@ impl<'a> Objects<'a> {
         data.material.shrink_to_fit();
         Mesh { data }
     }
+}
+
+impl Objects<'_> {
+    /// The camera description with the place and field of view of the
+    /// glTF camera it names, if it names one.
+    fn gltf_camera(&self) -> Result<Option<CameraDesc>, SceneError> {
+        let Some(which) = &self.desc.camera.gltf else {
+            return Ok(None);
+        };
+        let mut all = Vec::new();
+        for (i, o) in self.desc.objects.iter().enumerate() {
+            let ObjectDesc::Mesh { file, .. } = o else {
+                continue;
+            };
+            let Some(loaded) = self.models.get(&model_path(self.base, file)) else {
+                continue;
+            };
+            let (transform, _) = compile_transform(i, o.transform())?;
+            all.extend(loaded.model.cameras.iter().map(|c| (c, transform)));
+        }
+        let found = match which {
+            GltfCamera::Index(n) => all.get(*n as usize),
+            GltfCamera::Name(name) => all.iter().find(|(c, _)| c.name.as_deref() == Some(name)),
+        };
+        let Some((c, t)) = found else {
+            let names: Vec<String> = all
+                .iter()
+                .enumerate()
+                .map(|(k, (c, _))| match &c.name {
+                    Some(n) => format!("{k} \"{n}\""),
+                    None => k.to_string(),
+                })
+                .collect();
+            let what = match which {
+                GltfCamera::Index(n) => format!("no camera {n}"),
+                GltfCamera::Name(n) => format!("no camera named \"{n}\""),
+            };
+            let have = if names.is_empty() {
+                "the scene's glTF models have no perspective cameras".to_string()
+            } else {
+                format!("the scene's glTF models have cameras {}", names.join(", "))
+            };
+            return Err(invalid("camera.gltf", format!("{what}: {have}")));
+        };
+        let m = c.transform;
+        let point = |p: glam::Vec3| t.point(Vec3::from(m.transform_point3(p)));
+        let eye = point(glam::Vec3::ZERO);
+        let ahead = point(glam::Vec3::NEG_Z);
+        let up = t.vector(Vec3::from(m.transform_vector3(glam::Vec3::Y)));
+        let triple = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        Ok(Some(CameraDesc {
+            lookfrom: triple(eye),
+            lookat: triple(ahead),
+            vup: triple(up),
+            vfov: f64::from(c.yfov).to_degrees(),
+            ..self.desc.camera.clone()
+        }))
+    }
+}
+
+/// Where a mesh file named `file` by a scene in `base` is, as the scene's
+/// table of loaded models knows it.
+fn model_path(base: &Path, file: &str) -> PathBuf {
+    let path = if Path::new(file).is_absolute() {
+        PathBuf::from(file)
+    } else {
+        base.join(file)
+    };
+    std::fs::canonicalize(&path).unwrap_or(path)
 }
 
 /// The uniform scale of `transform` when it is a similarity (rotation,

@@ -256,6 +256,22 @@ pub struct CameraDesc {
     /// objects are blurred along the part of their motion it covers.
     #[serde(default = "full_shutter", skip_serializing_if = "is_full_shutter")]
     pub shutter: [f64; 2],
+    /// A camera of the scene's glTF models, by number (counting the
+    /// cameras of every glTF mesh object in order) or by name: its place,
+    /// direction and field of view replace `lookfrom`, `lookat`, `vup` and
+    /// `vfov`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gltf: Option<GltfCamera>,
+}
+
+/// Which camera of the scene's glTF models.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum GltfCamera {
+    /// The camera's number.
+    Index(u32),
+    /// The camera's name.
+    Name(String),
 }
 
 /// The default shutter: open from time 0 to time 1.
@@ -279,6 +295,7 @@ impl Default for CameraDesc {
             defocus_angle: 0.0,
             focus_dist: None,
             shutter: FULL_SHUTTER,
+            gltf: None,
         }
     }
 }

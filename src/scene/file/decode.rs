@@ -15,8 +15,9 @@ use crate::light::LightSelection;
 use crate::material::KindInfo;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc, FilterDesc,
-    IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc, SamplingDesc,
-    ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
+    GltfCamera, IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc,
+    SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc,
+    MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -504,6 +505,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "defocus_angle",
             "focus_dist",
             "shutter",
+            "gltf",
         ],
         &[],
     )?;
@@ -518,7 +520,16 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             .unwrap_or(d.defocus_angle),
         focus_dist: t.optional("focus_dist", float)?,
         shutter: t.optional("shutter", pair)?.unwrap_or(d.shutter),
+        gltf: t.optional("gltf", gltf_camera)?,
     })
+}
+
+/// A glTF camera by number or name.
+fn gltf_camera(node: &Node, path: &str) -> Result<GltfCamera> {
+    match &node.value {
+        Value::String(name) => Ok(GltfCamera::Name(name.clone())),
+        _ => integer(node, path, 0, u64::from(u32::MAX)).map(|n| GltfCamera::Index(n as u32)),
+    }
 }
 
 /// One kind of a table tagged by `type`: its name, what it is called in
