@@ -358,6 +358,8 @@ fn read_file(path: &Path) -> Result<Vec<u8>, MeshError> {
 }
 
 #[cfg(test)]
+mod gltf_material_tests;
+#[cfg(test)]
 mod ply_tests;
 #[cfg(test)]
 mod tests;

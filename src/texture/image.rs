@@ -171,6 +171,30 @@ impl Image {
         }
     }
 
+    /// Why the image cannot be a tangent-space normal map, if it cannot:
+    /// such a map's normals point out of the surface (blue, z, above one
+    /// half, but for rounding); an object-space map or a colour image has
+    /// many that do not.
+    pub fn normal_map_problem(&self) -> Option<String> {
+        let n = self.width * self.height;
+        // At most a million texels looked at, spread over the image.
+        let step = (n / 1_000_000).max(1);
+        let (mut looked, mut inward) = (0usize, 0usize);
+        for i in (0..n).step_by(step) {
+            let [_, _, b, _] = self.texel_rgba(i % self.width, i / self.width, false);
+            looked += 1;
+            inward += usize::from(b < 0.45);
+        }
+        let fraction = inward as f64 / looked as f64;
+        (fraction > 0.05).then(|| {
+            format!(
+                "is not a tangent-space normal map: {:.0}% of its texels point into the \
+                 surface (blue below one half); object-space normal maps are not supported",
+                100.0 * fraction
+            )
+        })
+    }
+
     /// Bytes held by the texels.
     pub fn heap_bytes(&self) -> usize {
         let n = self.width * self.height;

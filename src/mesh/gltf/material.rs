@@ -127,6 +127,9 @@ fn material(
     };
     let normal = &m["normalTexture"];
     if let Some(n) = map(normal, "normalTexture", Channels::Rgb, false)? {
+        if let Some(problem) = n.image.normal_map_problem() {
+            return Err(at(&format!("normalTexture: its image {problem}")));
+        }
         let scale = number(&normal["scale"], 1.0, f32::MIN, f32::MAX)
             .map_err(|e| at(&format!("normalTexture.scale {e}")))?;
         out.normal_map = Some((n, scale));
@@ -460,7 +463,7 @@ fn number(v: &Value, default: f32, lo: f32, hi: f32) -> Result<f32, String> {
         .as_f64()
         .ok_or_else(|| format!("must be a number, got {v}"))? as f32;
     if !(x >= lo && x <= hi) || x.is_nan() {
-        return Err(if !x.is_finite() || x.abs() > f32::MAX / 2.0 {
+        return Err(if !x.is_finite() {
             format!("must be finite, got {v}")
         } else {
             format!("must be in [{lo}, {hi}], got {x}")

@@ -32,7 +32,13 @@ mod material;
 pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let err = |msg: String| MeshError::new(path, None, msg);
     check_glb_header(&bytes).map_err(err)?;
-    let invalid = |e: gltf::Error| err(format!("invalid glTF: {e}"));
+    let invalid = |e: gltf::Error| {
+        let e = e.to_string();
+        match e.strip_prefix("invalid glTF: ") {
+            Some(rest) => err(format!("invalid glTF: {rest}")),
+            None => err(format!("invalid glTF: {e}")),
+        }
+    };
     // The JSON as written, for what the crate does not read (material
     // extensions) and for the extensions the file needs, checked first.
     let raw = raw_json(&bytes).map_err(err)?;

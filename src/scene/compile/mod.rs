@@ -1108,6 +1108,9 @@ impl Textures for MaterialTextures<'_, '_> {
                 ))
             }
         };
+        if let Some(problem) = map.image.normal_map_problem() {
+            return Err(Invalid::new(field, format!("texture \"{name}\" {problem}")));
+        }
         if map.image.is_float() || !map.srgb {
             return Ok(t);
         }

@@ -1,0 +1,496 @@
+//! The physically based materials as scene files describe them: the kinds
+//! and their fields, textures of the right kind, normal and bump maps,
+//! cut-outs, and every mistake refused with the field it is in.
+
+mod common;
+
+use common::{compile_file, scene_file_error, scratch_dir};
+use lumen::material::Kind;
+use lumen::math::{Interval, Vec3};
+use lumen::ray::Ray;
+use lumen::scene::Scene;
+use std::path::Path;
+
+/// Writes a `w` × `h` 8-bit RGBA PNG whose texel (x, y) is `f(x, y)`.
+fn png(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) {
+    let image = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(f(x, y)));
+    image.save(path).unwrap();
+}
+
+/// The issue's own example, every kind with the names the interface
+/// promises, compiles to the kinds it names.
+#[test]
+fn the_new_kinds_compile_from_their_documented_fields() {
+    let dir = scratch_dir("materials-kinds");
+    png(&dir.join("paint.png"), 4, 4, |x, _| {
+        [40 * x as u8, 60, 200, 255]
+    });
+    png(&dir.join("flakes.png"), 4, 4, |x, y| {
+        [128 + x as u8, 128 + y as u8, 250, 255]
+    });
+    let scene = compile_file(
+        &dir,
+        "kinds.toml",
+        r#"
+[textures.paint-texture]
+type = "image"
+file = "paint.png"
+
+[textures.flakes-normal]
+type = "image"
+file = "flakes.png"
+
+[materials.gold]
+type = "conductor"
+metal = "Au"
+roughness = 0.3
+
+[materials.gold-by-index]
+type = "conductor"
+eta = [0.143, 0.374, 1.442]
+k = [3.983, 2.385, 1.603]
+alpha = 0.09
+
+[materials.frosted]
+type = "dielectric"
+ior = 1.5
+roughness = 0.2
+
+[materials.red-plastic]
+type = "plastic"
+albedo = [0.6, 0.05, 0.05]
+ior = 1.5
+roughness = 0.1
+
+[materials.car-paint]
+type = "principled"
+base_color = "paint-texture"
+metallic = 0.0
+roughness = 0.4
+clearcoat = 1.0
+clearcoat_roughness = 0.05
+normal_map = "flakes-normal"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, -3]
+radius = 1
+material = "gold"
+"#,
+    );
+    let kind = |name: &str| {
+        // Materials are compiled in the order of their names.
+        let names = [
+            "car-paint",
+            "frosted",
+            "gold",
+            "gold-by-index",
+            "red-plastic",
+        ];
+        let i = names.iter().position(|n| *n == name).unwrap();
+        scene.materials[i]
+    };
+    match kind("gold").kind {
+        Kind::Conductor(c) => {
+            assert!((c.eta.x - 0.143).abs() < 0.01 && (c.k.x - 3.98).abs() < 0.01);
+            assert!(c.roughness.squared);
+        }
+        other => panic!("gold is {other:?}"),
+    }
+    assert!(matches!(kind("gold-by-index").kind, Kind::Conductor(c) if !c.roughness.squared));
+    assert!(matches!(kind("frosted").kind, Kind::Dielectric(d) if d.roughness.is_some()));
+    assert!(matches!(kind("red-plastic").kind, Kind::Plastic(p) if p.ior == 1.5));
+    let paint = kind("car-paint");
+    assert!(matches!(paint.kind, Kind::Principled(_)));
+    assert!(paint.shape.is_some(), "the normal map");
+}
+
+/// Each mistake is refused before rendering, naming the field and what
+/// was expected.
+#[test]
+fn bad_material_fields_are_refused_with_the_field_and_the_reason() {
+    let dir = scratch_dir("materials-errors");
+    png(&dir.join("colour.png"), 2, 2, |_, _| [200, 100, 50, 255]);
+    png(&dir.join("inward.png"), 2, 2, |_, _| [128, 128, 10, 255]);
+    let scene = |material: &str| {
+        format!(
+            r#"
+[textures.colour]
+type = "image"
+file = "colour.png"
+
+[textures.green]
+type = "image"
+file = "colour.png"
+channel = "g"
+
+[textures.inward]
+type = "image"
+file = "inward.png"
+
+[materials.m]
+{material}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, -3]
+radius = 1
+material = "m"
+"#
+        )
+    };
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "type = \"conductor\"\nmetal = \"Au\"\nroughness = 1.5",
+            &["materials.m.roughness", "must be in [0, 1], got 1.5"],
+        ),
+        (
+            "type = \"conductor\"\nmetal = \"Au\"\nalpha = -0.1",
+            &["materials.m.alpha", "must not be negative"],
+        ),
+        (
+            "type = \"dielectric\"\nior = 1.5\nroughness = 0.2\nalpha = 0.04",
+            &["materials.m.alpha", "`roughness`", "not both"],
+        ),
+        (
+            "type = \"conductor\"\nmetal = \"Au\"\neta = [1, 1, 1]\nk = [1, 1, 1]",
+            &["materials.m.metal", "`metal` or `eta` and `k`, not both"],
+        ),
+        (
+            "type = \"conductor\"\neta = [0.2, -1, 1]\nk = [3, 2, 1]",
+            &["materials.m.eta", "finite and not negative"],
+        ),
+        (
+            "type = \"conductor\"\neta = [0.2, nan, 1]\nk = [3, 2, 1]",
+            &["materials.m.eta", "finite"],
+        ),
+        (
+            "type = \"conductor\"\nmetal = \"Gold\"",
+            &[
+                "materials.m.metal",
+                "unknown metal \"Gold\"",
+                "Au",
+                "Ag",
+                "Cu",
+            ],
+        ),
+        (
+            "type = \"principled\"\nmetallic = \"colour\"",
+            &[
+                "materials.m.metallic",
+                "is a colour; a scalar is expected",
+                "`channel`",
+            ],
+        ),
+        (
+            "type = \"principled\"\nbase_color = \"green\"",
+            &[
+                "materials.m.base_color",
+                "one channel of an image",
+                "colour",
+            ],
+        ),
+        (
+            "type = \"plastic\"\nalbedo = [0.5, 0.5, 0.5]\nnormal_map = \"inward\"",
+            &["materials.m.normal_map", "not a tangent-space normal map"],
+        ),
+        (
+            "type = \"principled\"\nnormal_map = \"green\"",
+            &["materials.m.normal_map", "not a normal map"],
+        ),
+        (
+            "type = \"principled\"\nior = 0.8",
+            &["materials.m.ior", "at least 1"],
+        ),
+        (
+            "type = \"principled\"\nopacity = 1.2",
+            &["materials.m.opacity", "must be in [0, 1]"],
+        ),
+        (
+            "type = \"principled\"\nalpha_cutoff = 0.5",
+            &["materials.m.alpha_cutoff", "`opacity`"],
+        ),
+        (
+            "type = \"principled\"\nnormal_scale = 2",
+            &["materials.m.normal_scale", "`normal_map`"],
+        ),
+        (
+            "type = \"plastic\"\nroughness = [0.1, 2]",
+            &["materials.m.roughness[1]", "must be in [0, 1]"],
+        ),
+        (
+            "type = \"principled\"\nattenuation_color = [0.5, 0.5, 0.5]",
+            &["materials.m.attenuation_color", "attenuation_distance"],
+        ),
+    ];
+    for (material, words) in cases {
+        let message = scene_file_error(&dir, &scene(material));
+        for w in *words {
+            assert!(message.contains(w), "{material}:\n{message}\nlacks {w:?}");
+        }
+    }
+}
+
+/// A quad of material `m` facing +z across (−1, −1, 0)–(1, 1, 0), its
+/// texture coordinates running along +x and +y (or, `mirrored`, along −x
+/// and −y), seen from (0, 0, 5): the shading normal near its centre.
+fn normal_at_centre(dir: &Path, material: &str, mirrored: bool) -> Vec3 {
+    let (corner, u, v) = if mirrored {
+        ("[1, 1, 0]", "[-2, 0, 0]", "[0, -2, 0]")
+    } else {
+        ("[-1, -1, 0]", "[2, 0, 0]", "[0, 2, 0]")
+    };
+    let scene = compile_file(
+        dir,
+        "quad.toml",
+        &format!(
+            r#"
+{material}
+
+[[objects]]
+type = "quad"
+corner = {corner}
+u = {u}
+v = {v}
+material = "m"
+"#
+        ),
+    );
+    let ray = Ray::new(Vec3::new(0.1, 0.1, 5.0), -Vec3::Z);
+    let hit = scene.hit(&ray, Interval::new(1e-4, f32::INFINITY)).unwrap();
+    let bsdf = scene
+        .material(&hit)
+        .bsdf(&hit, -ray.direction, &scene.textures)
+        .unwrap();
+    bsdf.frame.n
+}
+
+/// A normal map's red tilts the normal along +u, its green along +v (up
+/// the image, OpenGL's and glTF's convention), whichever way the surface's
+/// coordinates run; `normal_scale` scales the tilt.
+#[test]
+fn normal_maps_tilt_along_u_and_v() {
+    let dir = scratch_dir("materials-normal-map");
+    // Tilted by about 0.5 towards +u, then towards +v.
+    png(&dir.join("u.png"), 2, 2, |_, _| [192, 128, 221, 255]);
+    png(&dir.join("v.png"), 2, 2, |_, _| [128, 192, 221, 255]);
+    let material = |file: &str, scale: f64| {
+        format!(
+            "[textures.n]\ntype = \"image\"\nfile = \"{file}\"\n\n\
+             [materials.m]\ntype = \"principled\"\nnormal_map = \"n\"\nnormal_scale = {scale}\n"
+        )
+    };
+    // 128 of 255 is a tilt of 0.004, not 0.
+    let n = normal_at_centre(&dir, &material("u.png", 1.0), false);
+    assert!(n.x > 0.4 && n.y.abs() < 0.01 && n.z > 0.8, "{n}");
+    let n = normal_at_centre(&dir, &material("u.png", 1.0), true);
+    assert!(n.x < -0.4 && n.y.abs() < 0.01, "u runs along −x: {n}");
+    let n = normal_at_centre(&dir, &material("v.png", 1.0), false);
+    assert!(n.y > 0.4 && n.x.abs() < 0.01, "v runs along +y: {n}");
+    let mirrored = normal_at_centre(&dir, &material("v.png", 1.0), true);
+    assert!(
+        mirrored.y < -0.4 && mirrored.x.abs() < 0.01,
+        "v runs along −y: {mirrored}"
+    );
+    let half = normal_at_centre(&dir, &material("v.png", 0.5), false);
+    assert!(half.y > 0.2 && half.y < n.y, "{half} against {n}");
+    let flat = normal_at_centre(&dir, &material("v.png", 0.0), false);
+    assert!((flat - Vec3::Z).length() < 1e-5, "{flat}");
+}
+
+/// A bump map rising along u tilts the normal back, against +u, by the
+/// slope its scale gives it.
+#[test]
+fn bump_maps_tilt_the_normal_down_the_slope() {
+    let dir = scratch_dir("materials-bump");
+    // Height rising linearly along u (16 texels), grey.
+    png(&dir.join("ramp.png"), 16, 1, |x, _| {
+        let v = (x * 16) as u8;
+        [v, v, v, 255]
+    });
+    let material = |scale: f64| {
+        format!(
+            "[textures.h]\ntype = \"image\"\nfile = \"ramp.png\"\nchannel = \"r\"\n\n\
+             [materials.m]\ntype = \"plastic\"\nbump_map = \"h\"\nbump_scale = {scale}\n"
+        )
+    };
+    let n = normal_at_centre(&dir, &material(0.5), false);
+    // The value rises 16/255 a texel, 1/16 of u: 256/255 along u, times
+    // the scale, over the quad's width of 2.
+    let slope = -n.x / n.z;
+    let expected = 0.5 * 256.0 / 255.0 / 2.0;
+    assert!(
+        (slope - expected).abs() < 0.005,
+        "{n}: slope {slope}, not {expected}"
+    );
+    assert!(n.y.abs() < 1e-3, "{n}");
+    let mirrored = normal_at_centre(&dir, &material(0.5), true);
+    assert!(mirrored.x > 0.1, "u runs along −x: {mirrored}");
+}
+
+/// Rays pass through a surface where it is cut out (opacity below the
+/// cutoff), camera rays and shadow rays alike, and stop where it is there.
+#[test]
+fn cut_outs_let_rays_through_where_the_surface_is_not() {
+    let dir = scratch_dir("materials-cutout");
+    // Left half transparent, right half opaque.
+    png(&dir.join("mask.png"), 2, 1, |x, _| {
+        [255, 255, 255, if x == 0 { 0 } else { 255 }]
+    });
+    let scene = compile_file(
+        &dir,
+        "cutout.toml",
+        r#"
+[textures.mask]
+type = "image"
+file = "mask.png"
+channel = "a"
+filter = "nearest"
+
+[materials.leaf]
+type = "diffuse"
+albedo = [0.2, 0.8, 0.2]
+opacity = "mask"
+alpha_cutoff = 0.5
+
+[materials.wall]
+type = "diffuse"
+albedo = [0.8, 0.2, 0.2]
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, 0]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "leaf"
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, -1]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "wall"
+"#,
+    );
+    let leaf = 0; // materials in name order: leaf, wall
+    let first = |x: f32| {
+        let ray = Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z);
+        scene
+            .hit(&ray, Interval::new(1e-4, f32::INFINITY))
+            .unwrap()
+            .material
+    };
+    assert_ne!(first(-0.5), leaf, "through the cut-out half");
+    assert_eq!(first(0.5), leaf, "stopped by the solid half");
+    let shadow = |x: f32| {
+        let ray = Ray::new(Vec3::new(x, 0.0, -0.5), Vec3::Z);
+        scene.occluded(&ray, Interval::new(1e-4, 10.0))
+    };
+    assert!(!shadow(-0.5), "a shadow ray passes the cut-out");
+    assert!(shadow(0.5));
+}
+
+/// Without a cutoff, a surface of opacity a stops a fraction a of the rays
+/// (within four standard errors of the binomial count), the same rays
+/// every time.
+#[test]
+fn partial_opacity_stops_its_fraction_of_rays() {
+    let dir = scratch_dir("materials-blend");
+    let scene = compile_file(
+        &dir,
+        "blend.toml",
+        r#"
+[materials.veil]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+opacity = 0.3
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, 0]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "veil"
+"#,
+    );
+    let n = 20_000;
+    let hits = |scene: &Scene| {
+        (0..n)
+            .filter(|&i| {
+                let x = (i % 141) as f32 / 141.0 * 1.8 - 0.9;
+                let y = (i / 141) as f32 / 142.0 * 1.8 - 0.9;
+                let ray = Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z);
+                scene
+                    .hit(&ray, Interval::new(1e-4, f32::INFINITY))
+                    .is_some()
+            })
+            .count()
+    };
+    let stopped = hits(&scene);
+    let expected = 0.3 * n as f64;
+    let sigma = (n as f64 * 0.3 * 0.7).sqrt();
+    assert!(
+        (stopped as f64 - expected).abs() < 4.0 * sigma,
+        "{stopped} of {n} stopped"
+    );
+    assert_eq!(hits(&scene), stopped, "the same rays stop");
+}
+
+/// Principled glass with a volume darkens light by Beer–Lambert over the
+/// distance it travels inside: a white sky seen through a ball of
+/// attenuation colour c at distance d takes a tint of about c^(2r/d).
+#[test]
+fn principled_volumes_absorb_along_the_path_inside() {
+    let dir = scratch_dir("materials-volume");
+    let text = |attenuation: &str| {
+        format!(
+            r#"
+[render]
+width = 8
+height = 8
+samples_per_pixel = 64
+max_depth = 32
+integrator = "path"
+
+[camera]
+vfov = 2
+lookfrom = [0, 0, 10]
+lookat = [0, 0, 0]
+
+[background]
+type = "solid"
+color = [1, 1, 1]
+
+[materials.glass]
+type = "principled"
+base_color = [1, 1, 1]
+transmission = 1
+roughness = 0
+specular = 0
+thickness = 1
+{attenuation}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "glass"
+"#
+        )
+    };
+    let mean = |scene: &Scene| {
+        let stats = common::pixel_stats(scene);
+        let n = stats.mean.len() as f64;
+        [0, 1, 2].map(|c| stats.mean.iter().map(|p| p[c]).sum::<f64>() / n)
+    };
+    let clear = mean(&compile_file(&dir, "clear.toml", &text("")));
+    let tinted = mean(&compile_file(
+        &dir,
+        "tinted.toml",
+        &text("attenuation_color = [0.5, 1, 1]\nattenuation_distance = 2"),
+    ));
+    // Through the centre the path inside is 2: 0.5^(2/2) of the light.
+    let ratio = tinted[0] / clear[0];
+    assert!((ratio - 0.5).abs() < 0.03, "red kept {ratio}");
+    assert!((tinted[1] - clear[1]).abs() < 1e-6, "green untouched");
+}
