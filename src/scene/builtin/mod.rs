@@ -13,6 +13,8 @@ use super::desc::{
 };
 use crate::rng::Rng;
 
+pub mod materials;
+
 /// A named built-in scene.
 #[derive(Clone, Copy, Debug)]
 pub struct Builtin {
@@ -34,6 +36,8 @@ pub enum Book {
     NextWeek,
     /// *Ray Tracing: The Rest of Your Life*.
     RestOfYourLife,
+    /// Beyond the books: physically based materials.
+    Materials,
 }
 
 impl Book {
@@ -43,6 +47,7 @@ impl Book {
             Book::OneWeekend => "Ray Tracing in One Weekend",
             Book::NextWeek => "Ray Tracing: The Next Week",
             Book::RestOfYourLife => "Ray Tracing: The Rest of Your Life",
+            Book::Materials => "Beyond the books: physically based materials",
         }
     }
 }
@@ -122,6 +127,9 @@ scenes! {
   }
   RestOfYourLife {
     "cornell-glass-sphere", "The Rest of Your Life: the Cornell box with a glass ball, its light sampled directly (next-event estimation)" => cornell_glass_sphere;
+  }
+  Materials {
+    "materials", "Physically based materials, roughness 0 to 1 across: gold (conductor), glass (rough dielectric), red plastic, blue principled, principled metal" => materials::materials;
   }
 }
 

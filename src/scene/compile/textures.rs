@@ -279,7 +279,10 @@ pub const EMBEDDED_PREFIX: &str = "lumen:";
 
 /// The images built into lumen (for the built-in scenes, which must render
 /// anywhere without files): name and file bytes.
-const EMBEDDED: &[(&str, &[u8])] = &[("earth.png", include_bytes!("../../../assets/earth.png"))];
+const EMBEDDED: &[(&str, &[u8])] = &[
+    ("earth.png", include_bytes!("../../../assets/earth.png")),
+    ("sky.hdr", include_bytes!("../../../assets/sky.hdr")),
+];
 
 /// The bytes of the built-in image `name`.
 fn embedded(name: &str) -> Option<&'static [u8]> {
