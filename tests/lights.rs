@@ -194,7 +194,7 @@ fn the_figures_keep_the_books_estimator() {
     for b in lumen::scene::builtin::BUILTINS {
         let expected = match b.book {
             Book::OneWeekend | Book::NextWeek => Integrator::Bsdf,
-            Book::RestOfYourLife => Integrator::Path,
+            Book::RestOfYourLife | Book::Materials => Integrator::Path,
         };
         assert_eq!(b.desc().render.integrator, expected, "{}", b.name);
     }

@@ -149,8 +149,12 @@ pub struct Settings {
     pub noise_target: Option<f32>,
     /// Display gamma.
     pub gamma: f32,
-    /// Shadow-acne epsilon: smallest accepted hit distance.
+    /// Shadow-acne epsilon: smallest accepted hit distance (0 when the
+    /// scene gives none).
     pub epsilon: f32,
+    /// Whether rays leave surfaces offset by the hit's rounding error (all
+    /// but the notes' epsilon 0).
+    pub offset: bool,
     /// What camera rays show.
     pub shading: Shading,
 }

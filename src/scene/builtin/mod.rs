@@ -57,9 +57,17 @@ impl Builtin {
     pub fn desc(&self) -> SceneDesc {
         let mut d = (self.make)();
         d.caption = self.caption.to_string();
+        // The books' figures ignore hits closer than 0.001, as the notes
+        // fix shadow acne.
+        if self.book != Book::Materials && d.render.epsilon.is_none() {
+            d.render.epsilon = Some(BOOK_EPSILON);
+        }
         d
     }
 }
+
+/// The notes' epsilon.
+const BOOK_EPSILON: f64 = 0.001;
 
 macro_rules! scenes {
     ($( $book:ident { $( $name:literal, $caption:literal => $make:expr; )* } )*) => {
@@ -393,7 +401,7 @@ fn diffuse_grey(gamma: f64, blue: bool, depth: u32) -> SceneDesc {
 
 fn acne(epsilon: f64) -> SceneDesc {
     let mut r = render(100, 2.0);
-    r.epsilon = epsilon;
+    r.epsilon = Some(epsilon);
     sphere_on_ground(
         r,
         diffuse([0.5; 3], BounceDesc::SphereVolume),

@@ -31,11 +31,11 @@ mod textures;
 
 /// The factor of [`HitRecord::error`]: the hit point and its offset from the
 /// centre are each rounded to about 2⁻²⁴ of their size (the point's
-/// coordinates, the radius); 2⁻²⁰ leaves a wide margin over their sum. With
-/// epsilon 0 (the notes' demonstration of shadow acne) it is 0, and rays
-/// leave from the hit point itself, as in the notes.
-fn error_scale(epsilon: f32) -> f32 {
-    if epsilon > 0.0 {
+/// coordinates, the radius); 2⁻²⁰ leaves a wide margin over their sum.
+/// Without `offset` (epsilon 0, the notes' demonstration of shadow acne) it
+/// is 0, and rays leave from the hit point itself, as in the notes.
+fn error_scale(offset: bool) -> f32 {
+    if offset {
         1.0 / (1u32 << 20) as f32
     } else {
         0.0
@@ -151,7 +151,7 @@ impl Scene {
             &settings,
             moves,
         )?;
-        let world = World::new(top, groups, &instances, error_scale(settings.epsilon));
+        let world = World::new(top, groups, &instances, error_scale(settings.offset));
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
         let (lights, light_ids) = world.lights(&materials);
@@ -974,12 +974,14 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
             format!("must be greater than 0, got {}", r.gamma),
         ));
     }
-    finite("render.epsilon", &[r.epsilon])?;
-    if !(r.epsilon >= 0.0) {
-        return Err(invalid(
-            "render.epsilon",
-            format!("must not be negative, got {}", r.epsilon),
-        ));
+    if let Some(e) = r.epsilon {
+        finite("render.epsilon", &[e])?;
+        if !(e >= 0.0) {
+            return Err(invalid(
+                "render.epsilon",
+                format!("must not be negative, got {e}"),
+            ));
+        }
     }
     check_seed("render.seed", r.seed)?;
     let noise_target = match r.noise_target {
@@ -1003,7 +1005,8 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         integrator: r.integrator,
         light_selection: r.light_selection,
         gamma: r.gamma as f32,
-        epsilon: r.epsilon as f32,
+        epsilon: r.epsilon.map_or(0.0, |e| e as f32),
+        offset: r.epsilon != Some(0.0),
         shading: r.shading,
     })
 }

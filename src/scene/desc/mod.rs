@@ -141,8 +141,11 @@ pub struct RenderDesc {
     pub noise_target: Option<f64>,
     /// Display gamma: output = linear^(1/gamma). 1 disables the correction.
     pub gamma: f64,
-    /// Smallest ray parameter accepted as a hit; 0 shows shadow acne.
-    pub epsilon: f64,
+    /// Smallest ray parameter accepted as a hit (the notes' fix for shadow
+    /// acne; 0 shows the acne); absent, rays leave each surface by its
+    /// rounding error alone, which holds at any scale.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epsilon: Option<f64>,
     /// What a camera ray's colour shows.
     pub shading: ShadingDesc,
 }
@@ -181,7 +184,7 @@ impl Default for RenderDesc {
             sample_background: None,
             noise_target: None,
             gamma: 2.0,
-            epsilon: 0.001,
+            epsilon: None,
             shading: ShadingDesc::Path,
         }
     }

@@ -470,7 +470,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
         sample_background: t.optional("sample_background", boolean)?,
         noise_target: t.optional("noise_target", float)?,
         gamma: t.optional("gamma", float)?.unwrap_or(d.gamma),
-        epsilon: t.optional("epsilon", float)?.unwrap_or(d.epsilon),
+        epsilon: t.optional("epsilon", float)?,
         shading: t
             .optional("shading", |n, p| keyword(n, p, SHADINGS))?
             .unwrap_or(d.shading),

@@ -158,7 +158,7 @@ fn render(r: &RenderDesc) -> bool {
         && r.samples_per_pixel >= 1
         && r.max_depth >= 1
         && r.seed <= MAX_SEED
-        && finite(&[r.aspect_ratio, r.gamma, r.epsilon])
+        && finite(&[r.aspect_ratio, r.gamma, r.epsilon.unwrap_or(0.0)])
         && r.noise_target.is_none_or(f64::is_finite)
 }
 
