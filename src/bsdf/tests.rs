@@ -964,3 +964,87 @@ fn a_conductor_smooths_into_its_mirror() {
         last_angle = angle;
     }
 }
+
+/// No lobe gives a NaN, an infinity or a negative value at the edges of
+/// its parameters: roughness 0 and 1, an index of 1 (no interface), views
+/// and lights at grazing angles, and a shading normal tilted below the
+/// true surface (a normal map's, a smoothed mesh's) seen from either side.
+#[test]
+fn no_nan_at_the_edges() {
+    let smooth = Microfacet::new(0.0, 0.0, Model::Ggx);
+    let rough = Microfacet::new(1.0, 1.0, Model::Beckmann);
+    let mut lobes = vec![
+        Lobe::Conductor(Conductor {
+            eta: GOLD_ETA,
+            k: GOLD_K,
+            tint: Color::ONE,
+            roughness: Some(smooth),
+            multiscatter: true,
+        }),
+        Lobe::Conductor(Conductor {
+            eta: Vec3::ZERO,
+            k: Vec3::ZERO,
+            tint: Color::ONE,
+            roughness: None,
+            multiscatter: false,
+        }),
+    ];
+    for d in [smooth, rough] {
+        for eta in [1.0f32, 1.0 + 1e-6, 1.5] {
+            lobes.push(Lobe::ExactDielectric(ExactDielectric {
+                eta,
+                roughness: Some(d),
+                multiscatter: true,
+            }));
+            lobes.push(Lobe::Plastic(Plastic {
+                albedo: Color::ONE,
+                eta,
+                roughness: Some(d),
+                multiscatter: true,
+            }));
+            for (_, p) in principled_configurations(d) {
+                lobes.push(Lobe::Principled(Principled {
+                    eta,
+                    multiscatter: true,
+                    sheen_color: Color::ONE,
+                    sheen_roughness: super::sheen::MIN_ROUGHNESS,
+                    ..p
+                }));
+            }
+        }
+    }
+    let mut rng = Rng::new(31);
+    // Frames whose normal is tilted up to 89° from the true surface's, so
+    // that some views are above one and below the other.
+    let frames: Vec<(super::Frame, Vec3)> = [0.0f32, 1.2, 1.55]
+        .iter()
+        .map(|&tilt| {
+            let n = Vec3::new(tilt.sin(), 0.0, tilt.cos());
+            (super::Frame::from_normal_tangent(n, Vec3::X), Vec3::Z)
+        })
+        .collect();
+    for lobe in &lobes {
+        for &(frame, ng) in &frames {
+            let bsdf = super::Bsdf::new(frame, ng, *lobe);
+            for wo in directions(&mut rng, 30) {
+                for wi in directions(&mut rng, 10) {
+                    let (f, pdf) = bsdf.eval_and_pdf(wo, wi);
+                    assert!(
+                        f.is_finite() && f.min_element() >= 0.0 && pdf.is_finite() && pdf >= 0.0,
+                        "{lobe:?}: wo {wo} wi {wi}: {f} {pdf}"
+                    );
+                }
+                for _ in 0..20 {
+                    if let Some(s) =
+                        lobe.sample_local(frame.to_local(wo), rng.next_f32(), rng.next_2d())
+                    {
+                        assert!(
+                            s.value.is_finite() && s.value.min_element() >= 0.0 && s.pdf >= 0.0,
+                            "{lobe:?}: wo {wo}: {s:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

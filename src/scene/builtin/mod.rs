@@ -57,11 +57,6 @@ impl Builtin {
     pub fn desc(&self) -> SceneDesc {
         let mut d = (self.make)();
         d.caption = self.caption.to_string();
-        // The books' figures ignore hits closer than 0.001, as the notes
-        // fix shadow acne.
-        if self.book != Book::Materials && d.render.epsilon.is_none() {
-            d.render.epsilon = Some(BOOK_EPSILON);
-        }
         d
     }
 }
@@ -296,11 +291,12 @@ fn render(spp: u32, gamma: f64) -> RenderDesc {
 }
 
 /// A figure's settings: the books' estimator, which finds light only where
-/// the bounces meet it and plays no Russian roulette, as their figures were
-/// made.
+/// the bounces meet it and plays no Russian roulette, and their epsilon of
+/// 0.001 against shadow acne, as their figures were made.
 fn figure(render: RenderDesc) -> RenderDesc {
     RenderDesc {
         integrator: IntegratorDesc::Bsdf,
+        epsilon: render.epsilon.or(Some(BOOK_EPSILON)),
         ..render
     }
 }
