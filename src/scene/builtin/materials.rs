@@ -12,8 +12,11 @@ use crate::scene::desc::{
 /// The roughnesses across a row, smooth on the left.
 pub const ROUGHNESSES: [f64; 6] = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
 
-/// The rows, top to bottom: a name and the material at a roughness.
-pub fn rows() -> [(&'static str, fn(f64) -> MaterialDesc); 5] {
+/// A row of the chart: its name and its material at a roughness.
+pub type Row = (&'static str, fn(f64) -> MaterialDesc);
+
+/// The rows, top to bottom.
+pub fn rows() -> [Row; 5] {
     [
         ("gold", |r| {
             MaterialDesc::Conductor(ConductorDesc::named("Au", r))
