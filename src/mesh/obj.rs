@@ -556,7 +556,8 @@ impl MapStatement {
 /// Maps an MTL material onto [`MeshMaterial`] (documented in
 /// `docs/materials.md`):
 ///
-/// - base colour = `Kd` (0.8 grey when absent) × `map_Kd`;
+/// - base colour = `Kd` (0.8 grey when absent) × `map_Kd`; `map_Ks` the
+///   colour of a dielectric's specular reflection;
 /// - the PBR extension where given: roughness `Pr` / `map_Pr`, metallic
 ///   `Pm` / `map_Pm`, sheen `Ps`, clear coat `Pc` and its roughness `Pcr`;
 /// - else a metal when `Kd` is black (every channel < 0.01) and `Ks` is
@@ -694,6 +695,14 @@ fn convert_material(
     }
     if matches!(illum, 0 | 1) || (m.specular.is_some() && max(ks) == 0.0 && !pbr) {
         out.specular = Mapped::value(0.0);
+    } else if !metal {
+        // A specular colour map tints the dielectric's reflection.
+        out.specular_color.map = first(map(
+            "map_Ks",
+            m.specular_texture.as_deref(),
+            Channels::Rgb,
+            true,
+        )?);
     }
     if glass {
         out.transmission = Mapped::value(1.0);

@@ -974,3 +974,72 @@ const RICH_OBJ: &str = "mtllib m.mtl\n# a comment\n\
 const RICH_MTL: &str = "newmtl red\nKd 1 0.2 0\nKe 0 0 4\n\
     newmtl chrome\nKd 0 0 0\nKs 0.9 0.8 0.7\nNs 1000\nillum 3\n\
     newmtl glass\nKd 1 1 1\nNi 1.45\nd 0.1\nTr 0.9\nmap_Kd tex.png\n";
+
+/// An MTL file's maps and the PBR extension are read into the material:
+/// each map's channel and encoding, the options on its line, each image
+/// read once.
+#[test]
+fn mtl_maps_and_the_pbr_extension_are_read() {
+    use crate::texture::{Channels, Wrap};
+    let dir = TempDir::new();
+    let png = |name: &str, rgba: [u8; 4]| {
+        let image = ::image::RgbaImage::from_pixel(2, 2, ::image::Rgba(rgba));
+        image.save(dir.0.join(name)).unwrap();
+    };
+    png("colour.png", [200, 100, 50, 255]);
+    png("grey.png", [128, 128, 128, 255]);
+    png("cut.png", [255, 255, 255, 100]);
+    png("normal.png", [128, 128, 255, 255]);
+    dir.write(
+        "m.mtl",
+        "newmtl painted\nKd 1 1 1\nKs 0.5 0.5 0.5\nNs 50\n\
+         map_Kd -s 2 2 -clamp on colour.png\nmap_Ks colour.png\nmap_Ns grey.png\n\
+         map_d cut.png\nbump -bm 0.5 grey.png\nKe 1 1 1\nmap_Ke colour.png\n\
+         newmtl pbr\nKd 0.5 0.5 0.5\nPr 0.3\nPm 1\nmap_Pr grey.png\nPc 0.8\nPcr 0.1\nnorm normal.png\n",
+    );
+    let path = dir.write(
+        "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n\
+         usemtl painted\nf 1/1/1 2/2/1 3/3/1\nusemtl pbr\nf 3/3/1 2/2/1 1/1/1\n",
+    );
+    let m = load(&path).unwrap();
+    let painted = &m.materials[0];
+    let base = painted.base_color.map.as_ref().unwrap();
+    assert!(base.srgb && base.channels == Channels::Rgb);
+    assert_eq!(base.wrap, [Wrap::Clamp; 2]);
+    assert_eq!(base.transform.rows, [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    assert!(painted.specular_color.map.is_some(), "map_Ks");
+    assert!(
+        painted.roughness_from_gloss && painted.roughness.map.is_some(),
+        "map_Ns"
+    );
+    let alpha = painted.alpha.map.as_ref().unwrap();
+    assert_eq!(
+        alpha.channels,
+        Channels::One(3),
+        "an image with alpha cuts by it"
+    );
+    assert_eq!(painted.alpha_mode, AlphaMode::Blend);
+    let (bump, height) = painted.bump_map.as_ref().unwrap();
+    assert_eq!((*height, bump.srgb), (0.5, false));
+    assert!(painted.emission.map.is_some() && painted.emission.value == [1.0; 3]);
+    // The same file named by three maps is read once.
+    assert!(std::sync::Arc::ptr_eq(
+        &base.image,
+        &painted.emission.map.as_ref().unwrap().image
+    ));
+    let pbr = &m.materials[1];
+    assert_eq!((pbr.roughness.value, pbr.metallic.value), (0.3, 1.0));
+    assert_eq!(
+        pbr.roughness.map.as_ref().unwrap().channels,
+        Channels::One(0)
+    );
+    assert_eq!(
+        (pbr.clearcoat.value, pbr.clearcoat_roughness.value),
+        (0.8, 0.1)
+    );
+    assert!(!pbr.normal_map.as_ref().unwrap().0.srgb);
+    // A normal map asks for tangents, which MikkTSpace made from the
+    // vertex normals and coordinates.
+    assert!(m.meshes[0].tangents.is_some());
+}
