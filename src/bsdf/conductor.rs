@@ -58,16 +58,7 @@ impl Conductor {
         if !(wi.z > 0.0 && wo.dot(wm) > 0.0) {
             return None;
         }
-        // Evaluated as `eval_and_pdf` evaluates it, so that a sample's
-        // density is the one light sampling weighs it against.
-        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
-        let value = f_cos / pdf;
-        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
-            value,
-            wi,
-            pdf,
-            flags: self.flags(),
-        })
+        BsdfSample::evaluated(self.eval_and_pdf(wo, wi), wi, self.flags())
     }
 
     /// f·cos θi on the rough surface, through microfacet normal `wm`.

@@ -142,16 +142,7 @@ impl ExactDielectric {
         if reflected != (flags == LobeFlags::REFLECTION) || wi.z == 0.0 {
             return None;
         }
-        // Evaluated as `eval_and_pdf` evaluates it, so that a sample's
-        // density is the one light sampling weighs it against.
-        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
-        let value = f_cos / pdf;
-        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
-            value,
-            wi,
-            pdf,
-            flags: flags | LobeFlags::GLOSSY,
-        })
+        BsdfSample::evaluated(self.eval_and_pdf(wo, wi), wi, flags | LobeFlags::GLOSSY)
     }
 
     /// The smooth interface: mirror reflection or Snell refraction, chosen

@@ -174,6 +174,23 @@ pub struct BsdfSample {
     pub flags: LobeFlags,
 }
 
+impl BsdfSample {
+    /// The sample of direction `wi` drawn by a lobe whose `eval_and_pdf`
+    /// gives `(f_cos, pdf)` there: evaluated as `eval_and_pdf` evaluates
+    /// it, so that its density is the one light sampling weighs it
+    /// against; `None` where the density is zero or the value not finite.
+    #[inline]
+    pub fn evaluated((f_cos, pdf): (Color, f32), wi: Vec3, flags: LobeFlags) -> Option<BsdfSample> {
+        let value = f_cos / pdf;
+        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
+            value,
+            wi,
+            pdf,
+            flags,
+        })
+    }
+}
+
 /// The lobe of a [`Bsdf`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Lobe {

@@ -114,14 +114,7 @@ impl Plastic {
         if !(wi.z > 0.0) {
             return None;
         }
-        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
-        let value = f_cos / pdf;
-        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
-            value,
-            wi,
-            pdf,
-            flags: LobeFlags::REFLECTION | part,
-        })
+        BsdfSample::evaluated(self.eval_and_pdf(wo, wi), wi, LobeFlags::REFLECTION | part)
     }
 
     /// f(wo, wi)·|cos θi| and the density of `wi` (the coat's mirror

@@ -238,19 +238,12 @@ impl Principled {
         if wi.z == 0.0 || (wi.z < 0.0) != transmitted {
             return None;
         }
-        let (f_cos, pdf) = self.eval_and_pdf(wo, wi);
-        let value = f_cos / pdf;
         let side = if transmitted {
             LobeFlags::TRANSMISSION
         } else {
             LobeFlags::REFLECTION
         };
-        (pdf > 0.0 && value.is_finite()).then_some(BsdfSample {
-            value,
-            wi,
-            pdf,
-            flags: flags | side,
-        })
+        BsdfSample::evaluated(self.eval_and_pdf(wo, wi), wi, flags | side)
     }
 
     /// f(wo, wi)·|cos θi| and the density of `wi`.

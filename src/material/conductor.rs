@@ -2,8 +2,8 @@
 //! measured one by name, or η and k given), smooth or rough.
 
 use super::metals;
-use super::param::{Invalid, RoughnessDesc, Textures, Triple};
-use super::roughness::{DistributionDesc, Roughness};
+use super::param::{Invalid, Textures, Triple};
+use super::roughness::Roughness;
 use super::{Kind, Material};
 use crate::bsdf::conductor::Conductor as ConductorLobe;
 use crate::geometry::HitRecord;
@@ -11,6 +11,7 @@ use crate::math::{Color, Vec3};
 use crate::texture::Texture;
 
 material_desc! {
+    microfacets;
     /// A metal: Fresnel reflection by a complex index of refraction, off a
     /// mirror or rough microfacets.
     pub struct ConductorDesc {
@@ -25,18 +26,6 @@ material_desc! {
         /// The imaginary part (absorption) per channel, ≥ 0.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub k: Option<Triple>,
-        /// Roughness in [0, 1] (α = roughness²); 0, the default, is a mirror.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub roughness: Option<RoughnessDesc>,
-        /// The microfacet width α itself, instead of `roughness`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub alpha: Option<RoughnessDesc>,
-        /// The microfacet distribution: "ggx" (the default) or "beckmann".
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub distribution: Option<DistributionDesc>,
-        /// Return the energy single-scattering microfacets lose.
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        pub multiscatter: bool,
     }
 }
 
@@ -93,13 +82,7 @@ impl ConductorDesc {
                 ))
             }
         };
-        let roughness = Roughness::compile(
-            field,
-            self.roughness.as_ref(),
-            self.alpha.as_ref(),
-            self.distribution,
-            textures,
-        )?;
+        let roughness = self.microfacets(field, 0.0, textures)?;
         Ok(Material::new(Kind::Conductor(Conductor {
             eta,
             k,

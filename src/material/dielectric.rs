@@ -1,7 +1,7 @@
 //! The dielectric material: clear glass, water, diamond.
 
 use super::param::{Invalid, RoughnessDesc, Textures};
-use super::roughness::{DistributionDesc, Roughness};
+use super::roughness::Roughness;
 use super::{Kind, Material};
 use crate::bsdf::dielectric::{ExactDielectric, SmoothDielectric};
 use crate::bsdf::Lobe;
@@ -9,6 +9,7 @@ use crate::geometry::HitRecord;
 use crate::texture::Texture;
 
 material_desc! {
+    microfacets;
     /// A clear refracting material.
     pub struct DielectricDesc {
         /// Index of refraction, > 0.
@@ -16,20 +17,6 @@ material_desc! {
         /// Never reflect partially (no Schlick term).
         #[serde(default)]
         pub refract_only: bool,
-        /// Roughness in [0, 1] (α = roughness²): frosted glass. 0, the
-        /// default, is the notes' smooth glass (Schlick's reflectance); any
-        /// other value reflects and refracts by the exact Fresnel equations.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub roughness: Option<RoughnessDesc>,
-        /// The microfacet width α itself, instead of `roughness`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub alpha: Option<RoughnessDesc>,
-        /// The microfacet distribution: "ggx" (the default) or "beckmann".
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub distribution: Option<DistributionDesc>,
-        /// Return the energy single-scattering microfacets lose.
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        pub multiscatter: bool,
     }
 }
 
@@ -63,13 +50,7 @@ impl DielectricDesc {
                 format!("index of refraction must be greater than 0, got {ior}"),
             ));
         }
-        let roughness = Roughness::compile(
-            field,
-            self.roughness.as_ref(),
-            self.alpha.as_ref(),
-            self.distribution,
-            textures,
-        )?;
+        let roughness = self.microfacets(field, 0.0, textures)?;
         // Given as zero (or not given): the notes' glass, to the bit.
         let zero = |r: Option<&RoughnessDesc>| {
             r.is_none_or(|r| matches!(r, RoughnessDesc::Value(v) if *v == 0.0))

@@ -13,6 +13,61 @@
 /// opacity), so that each kind is declared once for every reader, for
 /// export and for the documentation's list.
 macro_rules! material_desc {
+    // A rough kind: its own fields, then the microfacets' (roughness or
+    // alpha, distribution, multiscatter), then every kind's.
+    (
+        microfacets;
+        $(#[$meta:meta])*
+        pub struct $name:ident {
+            $( $(#[$fmeta:meta])* pub $field:ident : $ty:ty, )*
+        }
+    ) => {
+        material_desc! {
+            $(#[$meta])*
+            pub struct $name {
+                $( $(#[$fmeta])* pub $field: $ty, )*
+                /// Roughness in [0, 1] (α = roughness²), a pair `[u, v]` for
+                /// a surface rougher along its tangent than its bitangent, or
+                /// a scalar texture.
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub roughness: Option<$crate::material::param::RoughnessDesc>,
+                /// The microfacet width α itself, instead of `roughness`.
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub alpha: Option<$crate::material::param::RoughnessDesc>,
+                /// The microfacet distribution: "ggx" (the default) or
+                /// "beckmann".
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub distribution: Option<$crate::material::roughness::DistributionDesc>,
+                /// Return the energy single-scattering microfacets lose.
+                #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+                pub multiscatter: bool,
+            }
+        }
+
+        impl $name {
+            /// The microfacets of the material at `field`: its `roughness`
+            /// or `alpha`, or roughness `default` when it gives neither.
+            pub(super) fn microfacets(
+                &self,
+                field: &str,
+                default: f64,
+                textures: &mut dyn $crate::material::param::Textures,
+            ) -> Result<$crate::material::roughness::Roughness, $crate::material::param::Invalid> {
+                let fallback = $crate::material::param::RoughnessDesc::Value(default);
+                let roughness = match (&self.roughness, &self.alpha) {
+                    (None, None) if default != 0.0 => Some(&fallback),
+                    (r, _) => r.as_ref(),
+                };
+                $crate::material::roughness::Roughness::compile(
+                    field,
+                    roughness,
+                    self.alpha.as_ref(),
+                    self.distribution,
+                    textures,
+                )
+            }
+        }
+    };
     (
         $(#[$meta:meta])*
         pub struct $name:ident {

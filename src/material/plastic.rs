@@ -1,14 +1,15 @@
 //! The plastic material: a diffuse base under a clear dielectric coat,
 //! smooth or rough (see [`crate::bsdf::plastic`] for the model).
 
-use super::param::{self, ColorDesc, ColorParam, ColorRange, Invalid, RoughnessDesc, Textures};
-use super::roughness::{DistributionDesc, Roughness};
+use super::param::{self, ColorDesc, ColorParam, ColorRange, Invalid, Textures};
+use super::roughness::Roughness;
 use super::{Kind, Material};
 use crate::bsdf::plastic::Plastic as PlasticLobe;
 use crate::geometry::HitRecord;
 use crate::texture::Texture;
 
 material_desc! {
+    microfacets;
     /// A coated diffuse surface: paint, plastic, varnished wood.
     pub struct PlasticDesc {
         /// The base's albedo, each channel in [0, 1], or a texture; 0.5
@@ -18,19 +19,6 @@ material_desc! {
         /// The coat's index of refraction, > 0; 1.5 when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub ior: Option<f64>,
-        /// The coat's roughness in [0, 1] (α = roughness²); 0, the default,
-        /// is a smooth coat.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub roughness: Option<RoughnessDesc>,
-        /// The coat's microfacet width α itself, instead of `roughness`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub alpha: Option<RoughnessDesc>,
-        /// The microfacet distribution: "ggx" (the default) or "beckmann".
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub distribution: Option<DistributionDesc>,
-        /// Return the energy the coat's single-scattering microfacets lose.
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        pub multiscatter: bool,
     }
 }
 
@@ -61,13 +49,7 @@ impl PlasticDesc {
             self.ior.unwrap_or(DEFAULT_IOR),
             param::Range::Positive,
         )?;
-        let roughness = Roughness::compile(
-            field,
-            self.roughness.as_ref(),
-            self.alpha.as_ref(),
-            self.distribution,
-            textures,
-        )?;
+        let roughness = self.microfacets(field, 0.0, textures)?;
         Ok(Material::new(Kind::Plastic(Plastic {
             albedo,
             ior,

@@ -5,10 +5,10 @@
 //! ([`crate::mesh`]), and scene files describe it with the same names.
 
 use super::param::{
-    self, ColorDesc, ColorParam, ColorRange, Invalid, Range, RoughnessDesc, ScalarDesc,
-    ScalarParam, Textures, Triple,
+    self, ColorDesc, ColorParam, ColorRange, Invalid, Range, ScalarDesc, ScalarParam, Textures,
+    Triple,
 };
-use super::roughness::{DistributionDesc, Roughness};
+use super::roughness::Roughness;
 use super::{Kind, Material, Shape};
 use crate::bsdf::microfacet::{Microfacet, Model, SMOOTH_ALPHA};
 use crate::bsdf::principled::Principled as PrincipledLobe;
@@ -18,6 +18,7 @@ use crate::math::{Color, Vec3};
 use crate::texture::Texture;
 
 material_desc! {
+    microfacets;
     /// The glTF metallic-roughness material with its layers.
     pub struct PrincipledDesc {
         /// The base colour, each channel in [0, 1], or a texture; 0.8 grey
@@ -27,17 +28,6 @@ material_desc! {
         /// How much of it is metal, in [0, 1]; 0 when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub metallic: Option<ScalarDesc>,
-        /// Roughness in [0, 1] (α = roughness²), a pair for anisotropy, or
-        /// a texture; 0.5 when absent.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub roughness: Option<RoughnessDesc>,
-        /// The microfacet width α itself, instead of `roughness`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub alpha: Option<RoughnessDesc>,
-        /// The microfacet distribution: "ggx" (the default, glTF's) or
-        /// "beckmann".
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub distribution: Option<DistributionDesc>,
         /// The dielectric's index of refraction (`KHR_materials_ior`),
         /// ≥ 1; 1.5 when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -85,9 +75,6 @@ material_desc! {
         /// The sheen's roughness in [0, 1]; 0 when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub sheen_roughness: Option<ScalarDesc>,
-        /// Return the energy single-scattering microfacets lose.
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        pub multiscatter: bool,
     }
 }
 
@@ -137,17 +124,7 @@ impl PrincipledDesc {
                 format!("must be at least 1 (the index inside over the index outside), got {ior}"),
             ));
         }
-        let roughness = match (&self.roughness, &self.alpha) {
-            (None, None) => Some(RoughnessDesc::Value(0.5)),
-            (r, _) => r.clone(),
-        };
-        let roughness = Roughness::compile(
-            field,
-            roughness.as_ref(),
-            self.alpha.as_ref(),
-            self.distribution,
-            textures,
-        )?;
+        let roughness = self.microfacets(field, 0.5, textures)?;
         let absorption = self.absorption(field)?;
         let coat_normal = match &self.clearcoat_normal_map {
             Some(name) => Some(textures.normal_map(&at("clearcoat_normal_map"), name)?),
