@@ -11,6 +11,7 @@ use crate::film::Film;
 use crate::render::render;
 use crate::scene::builtin;
 use crate::scene::desc::{BackgroundDesc, DielectricDesc, MaterialDesc, MetalDesc, SceneDesc};
+use crate::scene::file::Format;
 use crate::scene::{Integrator, Sampling, Scene, SceneError};
 use std::time::Duration;
 
@@ -47,8 +48,21 @@ pub fn sky_spheres() -> SceneDesc {
     desc
 }
 
-/// The efficiency workloads: [`sky_spheres`], the mesh workload, and the
-/// Cornell box at 300 × 300 (lit by its ceiling light alone).
+/// The materials workload: spheres of gold at two roughnesses, a silver
+/// mirror, frosted glass, red plastic and a diffuse control on a grey floor
+/// under a white sky, 320 × 180. It is the scene the peer renderers
+/// compare against, read from the same file
+/// (`scripts/peers/materials-scene.toml`).
+pub fn materials_spheres() -> SceneDesc {
+    let text = include_str!("../../scripts/peers/materials-scene.toml");
+    crate::scene::file::SceneFile::parse("materials-scene.toml", text.to_string(), Format::Toml)
+        .expect("the materials workload's scene file is valid")
+        .desc
+}
+
+/// The efficiency workloads: [`sky_spheres`], the mesh workload, the
+/// Cornell box at 300 × 300 (lit by its ceiling light alone) and
+/// [`materials_spheres`].
 pub fn workloads() -> Vec<(&'static str, SceneDesc)> {
     let mut cornell = builtin::cornell_box();
     cornell.render.width = 300;
@@ -56,6 +70,7 @@ pub fn workloads() -> Vec<(&'static str, SceneDesc)> {
         ("sky-spheres-400x225", sky_spheres()),
         ("bunny-235k-400x400", super::bunny_scene(BUNNY_235K)),
         ("cornell-box-300x300", cornell),
+        ("materials-320x180", materials_spheres()),
     ]
 }
 

@@ -135,8 +135,9 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
 }
 
 /// The standard workloads: the cover at 400×225 and the three-ball scene
-/// (depth 50), and the mesh workload ([`bunny_scene`], depth 8), at `spp`
-/// samples per pixel.
+/// (depth 50), the mesh workload ([`bunny_scene`], depth 8) and the
+/// materials workload ([`efficiency::materials_spheres`], depth 16), at
+/// `spp` samples per pixel.
 pub fn standard_workloads(spp: u32) -> Vec<Workload> {
     let mut cover = builtin::cover();
     cover.render.width = 400;
@@ -160,6 +161,10 @@ pub fn standard_workloads(spp: u32) -> Vec<Workload> {
     list.push(Workload {
         name: "bunny-235k-400x400",
         desc: bunny_scene(BUNNY_235K),
+    });
+    list.push(Workload {
+        name: "materials-320x180",
+        desc: efficiency::materials_spheres(),
     });
     for w in &mut list {
         w.desc.render.samples_per_pixel = spp;

@@ -125,8 +125,9 @@ enum Command {
         #[arg(long, value_name = "N", requires = "instances", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
         instance_count: Option<u64>,
         /// Run only the workload of this name (cover-400x225,
-        /// three-spheres-400x225, bunny-235k-400x400; with --efficiency,
-        /// sky-spheres-400x225, bunny-235k-400x400).
+        /// three-spheres-400x225, bunny-235k-400x400, materials-320x180;
+        /// with --efficiency, sky-spheres-400x225, bunny-235k-400x400,
+        /// cornell-box-300x300, materials-320x180).
         #[arg(long, value_name = "NAME", conflicts_with_all = ["scaling", "field", "instances"])]
         workload: Option<String>,
         /// Instead of throughput, measure efficiency, 1 / (variance × time):
