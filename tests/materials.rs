@@ -494,3 +494,51 @@ material = "glass"
     assert!((ratio - 0.5).abs() < 0.03, "red kept {ratio}");
     assert!((tinted[1] - clear[1]).abs() < 1e-6, "green untouched");
 }
+
+/// A transmitting surface of index 1 (glTF's "air") bounds nothing: a
+/// white sky seen through a ball of it is white, as principled glass and
+/// as rough glass (it was black: at index 1 no microfacet refracts).
+#[test]
+fn glass_of_index_one_lets_light_straight_through() {
+    let dir = scratch_dir("materials-ior-one");
+    for material in [
+        "type = \"principled\"\ntransmission = 1\nthickness = 1\nbase_color = [1, 1, 1]\nroughness = 0\nspecular = 0\nior = 1",
+        "type = \"dielectric\"\nior = 1\nroughness = 0.05",
+    ] {
+        let scene = compile_file(
+            &dir,
+            "one.toml",
+            &format!(
+                r#"
+[render]
+width = 8
+height = 8
+samples_per_pixel = 32
+max_depth = 16
+integrator = "path"
+
+[camera]
+vfov = 5
+lookfrom = [0, 0, 10]
+lookat = [0, 0, 0]
+
+[background]
+type = "solid"
+color = [1, 1, 1]
+
+[materials.air]
+{material}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "air"
+"#
+            ),
+        );
+        let stats = common::pixel_stats(&scene);
+        let mean: f64 = stats.mean.iter().map(|p| p[0]).sum::<f64>() / stats.mean.len() as f64;
+        assert!((mean - 1.0).abs() < 0.02, "{material}: {mean}");
+    }
+}

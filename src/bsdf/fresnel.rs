@@ -111,6 +111,27 @@ pub fn diffuse_reflectance(eta: f32) -> f32 {
     }
 }
 
+/// The relative index a rough interface of index `ior` (> 0) has seen
+/// from its outside (`front`) or inside, kept at least 10⁻³ away from 1:
+/// at exactly 1 light goes straight on, the generalised half vector of a
+/// refraction is zero, and no microfacet could be said to refract it; so
+/// near 1 the interface is an index of 1.001, whose refraction is as
+/// straight as makes no difference.
+#[inline]
+pub fn rough_eta(ior: f32, front: bool) -> f32 {
+    const LEAST: f32 = 1.001;
+    let ior = if ior >= 1.0 {
+        ior.max(LEAST)
+    } else {
+        ior.min(1.0 / LEAST)
+    };
+    if front {
+        ior
+    } else {
+        1.0 / ior
+    }
+}
+
 /// `w` mirrored about unit `n`: 2(w·n)n − w (both pointing away).
 #[inline]
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {

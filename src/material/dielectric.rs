@@ -101,11 +101,7 @@ impl Dielectric {
                 refract_only: self.refract_only,
             }),
             Some(r) => Lobe::ExactDielectric(ExactDielectric {
-                eta: if hit.front_face {
-                    self.ior
-                } else {
-                    1.0 / self.ior
-                },
+                eta: crate::bsdf::fresnel::rough_eta(self.ior, hit.front_face),
                 roughness: r.at(hit, textures),
                 multiscatter: self.multiscatter,
             }),

@@ -253,11 +253,7 @@ impl Principled {
             f0,
             f90: strength,
             transmission: unit(&self.transmission),
-            eta: if hit.front_face {
-                self.ior
-            } else {
-                1.0 / self.ior
-            },
+            eta: crate::bsdf::fresnel::rough_eta(self.ior, hit.front_face),
             thin,
             clearcoat,
             coat: Microfacet::new(coat_alpha, coat_alpha, Model::Ggx),
