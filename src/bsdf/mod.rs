@@ -77,6 +77,10 @@ impl Frame {
     /// `tangent` is zero or along `n`.
     #[inline]
     pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Frame {
+        // A normal a little off unit length (a sphere's (p − c)/r at a
+        // rounded point) would make every direction turned through the
+        // frame a little longer or shorter, and paths compound it.
+        let n = n.normalize();
         let t = (tangent - n * n.dot(tangent)).normalize_or_zero();
         if t == Vec3::ZERO {
             return Frame::from_normal(n);
@@ -316,7 +320,9 @@ impl Bsdf {
                 let uc = sampler.get_1d(Dim::BsdfChoice);
                 let u = sampler.get_2d(Dim::Bsdf);
                 let s = lobe.sample_local(self.frame.to_local(wo), uc, u)?;
-                let wi = self.frame.to_world(s.wi);
+                // Unit, as the intersection tests assume, whatever the
+                // rounding of the turn.
+                let wi = self.frame.to_world(s.wi).normalize();
                 (self.sides_agree(wo, wi, s.flags.is_transmission()) && s.value.is_finite())
                     .then_some(BsdfSample { wi, ..s })
             }

@@ -34,6 +34,9 @@ use std::f32::consts::FRAC_1_PI;
 /// The coat's reflectance at normal incidence (index 1.5).
 const COAT_F0: f32 = 0.04;
 
+/// How near 1 an index counts as no interface at all.
+const NO_INTERFACE: f32 = 1e-3;
+
 /// The least probability of sampling a layer that scatters at all, so
 /// that every direction it reaches has a density.
 const MIN_WEIGHT: f32 = 0.02;
@@ -101,6 +104,9 @@ impl Principled {
             f = f | LobeFlags::DIFFUSE;
             if self.transmission > 0.0 {
                 f = f | LobeFlags::TRANSMISSION;
+                if self.no_interface() {
+                    f = f | LobeFlags::SPECULAR;
+                }
             }
         }
         f
@@ -223,6 +229,9 @@ impl Principled {
         } else if uc < w.coat + w.specular + w.cosine {
             (cosine_hemisphere(u), LobeFlags::DIFFUSE)
         } else if w.transmission > 0.0 {
+            if self.no_interface() {
+                return Some(self.straight_through(wo, &w));
+            }
             let wm = d.sample_wm(wo, u);
             let wi = if self.thin {
                 let r = fresnel::reflect(wo, wm);
@@ -327,10 +336,34 @@ impl Principled {
         (f, c.pdf(co, wm) / (4.0 * co.dot(wm)))
     }
 
+    /// Whether the surface bounds a volume of the same index as outside
+    /// (glTF's "air", index 1): no microfacet refracts there, and light
+    /// goes straight on whatever the roughness.
+    #[inline]
+    fn no_interface(&self) -> bool {
+        !self.thin && (self.eta - 1.0).abs() < NO_INTERFACE
+    }
+
+    /// The transmitted sample of a surface with [`Self::no_interface`]: a
+    /// delta along −`wo`, weighed as the rest of the transmission is.
+    #[inline]
+    fn straight_through(&self, wo: Vec3, w: &Weights) -> BsdfSample {
+        let tint = self.base_color * ((1.0 - self.metallic) * self.transmission);
+        let t = 1.0 - self.dielectric_fresnel(wo.z).max_element();
+        let under = 1.0 - self.coat_weight(wo);
+        BsdfSample {
+            value: tint * (t * under * self.sheen_scale(wo.z) / w.transmission),
+            wi: -wo,
+            pdf: w.transmission,
+            flags: LobeFlags::TRANSMISSION | LobeFlags::SPECULAR,
+        }
+    }
+
     /// The transmission (f·|cos θi|) and its density.
     #[inline]
     fn transmit(&self, wo: Vec3, wi: Vec3, w: &Weights) -> (Color, f32) {
-        if w.transmission <= 0.0 {
+        // A delta where there is no interface: nothing to evaluate.
+        if w.transmission <= 0.0 || self.no_interface() {
             return (Color::ZERO, 0.0);
         }
         let d = &self.specular;

@@ -253,7 +253,11 @@ impl Principled {
             f0,
             f90: strength,
             transmission: unit(&self.transmission),
-            eta: crate::bsdf::fresnel::rough_eta(self.ior, hit.front_face),
+            eta: if hit.front_face {
+                self.ior
+            } else {
+                1.0 / self.ior
+            },
             thin,
             clearcoat,
             coat: Microfacet::new(coat_alpha, coat_alpha, Model::Ggx),
