@@ -43,7 +43,7 @@ integrator = "bsdf"
 gamma = 1
 
 [camera]
-vfov = 40
+vfov = 0.8
 {}
 
 [background]
@@ -58,7 +58,9 @@ albedo = [0.5, 0.5, 0.5]
 {object}
 material = "grey"
 "#,
-                        camera(4.0 * scale)
+                        // Far away, as cameras often are: the rounding of
+                        // a hit point grows with the ray's length.
+                        camera(200.0 * scale)
                     ),
                 );
                 let stats = pixel_stats(&scene);

@@ -145,11 +145,19 @@ impl Shapes {
     /// The record of a hit on `shape` (item `index`) at distance `t` of
     /// `ray`, in the space the shapes are stored in.
     #[inline(always)]
-    fn record(&self, ray: &Ray, t: f32, shape: Shape, index: u32, error_scale: f32) -> HitRecord {
+    fn record(&self, ray: &Ray, t: f32, shape: Shape, index: u32, rounding: Rounding) -> HitRecord {
+        let error_scale = rounding.scale;
         match shape {
             Shape::Sphere(k) => {
                 let surface = &self.spheres[k];
-                let point = ray.at(t);
+                let mut point = ray.at(t);
+                if rounding.onto_spheres {
+                    // Moved back onto the sphere: the rounding of o + t·d
+                    // grows with the ray's origin and length, and could
+                    // leave the point inside a sphere a ray then leaves.
+                    let off = point - surface.center;
+                    point = surface.center + off * (surface.radius / off.length());
+                }
                 let outward = (point - surface.center) * surface.inverse_radius;
                 let (normal, front_face) = face_normal(ray, outward);
                 // Along u = φ/2π about +y (see `Sphere::uv`).
@@ -401,7 +409,18 @@ pub(crate) struct World {
     groups: Vec<Group>,
     /// Per instance of `bvh`.
     placed: Vec<Placed>,
-    error_scale: f32,
+    rounding: Rounding,
+}
+
+/// How a hit's rounding is handled: the factor of its error bound (0: rays
+/// leave from the hit point itself, the notes' shadow acne), and whether a
+/// sphere's hit point is moved back onto the sphere (scenes that give no
+/// epsilon, where nothing else keeps a ray from finding again the sphere it
+/// leaves; the books' figures keep their points as they were).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rounding {
+    pub(crate) scale: f32,
+    pub(crate) onto_spheres: bool,
 }
 
 impl World {
@@ -411,7 +430,7 @@ impl World {
         top: Shapes,
         groups: Vec<Group>,
         instances: &[PlacedGroup],
-        error_scale: f32,
+        rounding: Rounding,
     ) -> World {
         let mut items = top.primitives();
         let trees: Vec<Instance> = instances
@@ -447,7 +466,7 @@ impl World {
             top,
             groups,
             placed,
-            error_scale,
+            rounding,
         }
     }
 
@@ -487,9 +506,7 @@ impl World {
     #[inline(always)]
     pub(crate) fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
         match self.top.locate(hit.index as usize) {
-            Ok(shape) => self
-                .top
-                .record(ray, hit.t, shape, hit.index, self.error_scale),
+            Ok(shape) => self.top.record(ray, hit.t, shape, hit.index, self.rounding),
             Err(i) => self.instance_record(ray, hit, i),
         }
     }
@@ -505,10 +522,9 @@ impl World {
             .shapes
             .locate(hit.sub as usize)
             .expect("instances hold no instances");
-        let inner =
-            group
-                .shapes
-                .record(&object_ray, hit.t * scale, shape, hit.sub, self.error_scale);
+        let inner = group
+            .shapes
+            .record(&object_ray, hit.t * scale, shape, hit.sub, self.rounding);
         let point = instance.world_point(inner.point, ray.time());
         let (normal, front_face) = face_normal(ray, transform.normal(inner.outward_normal()));
         let shading_normal = if inner.is_smooth() {
@@ -530,7 +546,7 @@ impl World {
             dpdv: transform.vector(inner.dpdv),
             color: inner.color,
             error: inner.error * placed.stretch * 4.0
-                + point.abs().max_element() * self.error_scale,
+                + point.abs().max_element() * self.rounding.scale,
         }
     }
 }

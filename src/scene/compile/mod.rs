@@ -6,7 +6,7 @@ use super::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, GltfCamera, MaterialDesc, ObjectDesc,
     ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
 };
-use super::world::{Group, Mesh, PlacedGroup, Shapes, Surface, World};
+use super::world::{Group, Mesh, PlacedGroup, Rounding, Shapes, Surface, World};
 use super::{
     invalid, FileReport, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings,
     MAX_COORDINATE, MAX_PIXELS,
@@ -151,7 +151,11 @@ impl Scene {
             &settings,
             moves,
         )?;
-        let world = World::new(top, groups, &instances, error_scale(settings.offset));
+        let rounding = Rounding {
+            scale: error_scale(settings.offset),
+            onto_spheres: desc.render.epsilon.is_none(),
+        };
+        let world = World::new(top, groups, &instances, rounding);
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
         let (lights, light_ids) = world.lights(&materials);
