@@ -2,7 +2,12 @@
 # Efficiency (1 / (variance x seconds per render)) of lumen and its peer
 # renderers on one scene at one sample count: docs/peers.md, "Efficiency".
 #
-#   scripts/peers/efficiency.sh bunny|spheres|cornell SPP [CONFIG...]
+#   scripts/peers/efficiency.sh bunny|spheres|cornell|materials SPP [CONFIG...]
+#
+# materials: scripts/peers/materials-scene.toml (gold at two roughnesses, a
+# silver mirror, frosted glass, plastic and a diffuse ball on a floor; the
+# `materials-320x180` workload of `lumen bench`), Mitsuba's stock BSDFs
+# (mitsuba_materials.py).
 #
 # cornell: `lumen scenes export cornell-box` with its light one-sided, the
 # `path` integrator and width CORNELL_WIDTH (mitsuba_cornell.py,
@@ -58,11 +63,14 @@ set -euo pipefail
 
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/../.." && pwd)
-SCENE=${1:?usage: efficiency.sh bunny|spheres|cornell SPP [CONFIG...]}
-SPP=${2:?usage: efficiency.sh bunny|spheres|cornell SPP [CONFIG...]}
+SCENE=${1:?usage: efficiency.sh bunny|spheres|cornell|materials SPP [CONFIG...]}
+SPP=${2:?usage: efficiency.sh bunny|spheres|cornell|materials SPP [CONFIG...]}
 shift 2
 CONFIGS=("$@")
-if [[ ${#CONFIGS[@]} -eq 0 && $SCENE == cornell ]]; then
+if [[ ${#CONFIGS[@]} -eq 0 && $SCENE == materials ]]; then
+    CONFIGS=(lumen:sobol:rr5 lumen:independent:rr5
+             mitsuba:independent:rr5 mitsuba:multijitter:rr5 mitsuba:ldsampler:rr5 mitsuba:stratified:rr5)
+elif [[ ${#CONFIGS[@]} -eq 0 && $SCENE == cornell ]]; then
     CONFIGS=(lumen:sobol:rr5 mitsuba:multijitter:rr5 cycles:startup:on cycles:AUTOMATIC:on
              cycles:SOBOL_BURLEY:on cycles:startup:on:off)
 elif [[ ${#CONFIGS[@]} -eq 0 ]]; then
@@ -85,7 +93,7 @@ THREADS=${THREADS:-2}
 CORNELL_WIDTH=${CORNELL_WIDTH:-300}
 mkdir -p "$OUT"
 
-case $SCENE in bunny|spheres|cornell) ;; *) echo "efficiency.sh: scene must be bunny, spheres or cornell" >&2; exit 2 ;; esac
+case $SCENE in bunny|spheres|cornell|materials) ;; *) echo "efficiency.sh: scene must be bunny, spheres, cornell or materials" >&2; exit 2 ;; esac
 
 need_mitsuba=0; need_cycles=0
 for c in "${CONFIGS[@]}"; do
@@ -115,6 +123,8 @@ elif [[ $SCENE == cornell ]]; then
     sed 's/two_sided = true/two_sided = false/; s/integrator = "bsdf"/integrator = "path"/;'" s/^width = .*/width = $CORNELL_WIDTH/" \
         "$OUT/cornell-export.toml" >"$LUMEN_SCENE"
     rm -f "$OUT/cornell-export.toml"
+elif [[ $SCENE == materials ]]; then
+    LUMEN_SCENE=$HERE/materials-scene.toml
 else
     LUMEN_SCENE=$HERE/spheres-scene.toml
 fi
@@ -186,6 +196,10 @@ run_config() {
         local rrarg=off; [[ $rr == rr5 ]] && rrarg=5
         if [[ $SCENE == bunny ]]; then
             "$LUMEN_PEERS_PYTHON" "$HERE/mitsuba_bunny.py" "$MESH" --spp "$SPP" --sampler "$s" \
+                --rr-depth "$rrarg" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" \
+                --threads "$THREADS" >"$log" 2>&1
+        elif [[ $SCENE == materials ]]; then
+            "$LUMEN_PEERS_PYTHON" "$HERE/mitsuba_materials.py" "$LUMEN_SCENE" --spp "$SPP" --sampler "$s" \
                 --rr-depth "$rrarg" --seeds "$SEED_A" "$SEED_B" --out-template "$tmpl" \
                 --threads "$THREADS" >"$log" 2>&1
         elif [[ $SCENE == cornell ]]; then

@@ -721,8 +721,9 @@ def check_metals(mi, metals_rs, names=("Au", "Ag")):
     return lines, ok
 
 
-def build_scene(mi, scene, spp, seed=0, rr_depth=5, max_depth=None, smith="separable"):
-    d = peerlib.mitsuba_path_scene(mi, scene, spp, "independent", seed, max_depth, rr_depth)
+def build_scene(mi, scene, spp, seed=0, rr_depth=5, max_depth=None, smith="separable",
+                sampler="independent"):
+    d = peerlib.mitsuba_path_scene(mi, scene, spp, sampler, seed, max_depth, rr_depth)
     d["sky"] = {"type": "constant",
                 "radiance": {"type": "rgb", "value": peerlib.rgb(scene["background"]["color"])}}
     bsdfs = {name: material_dict(name, m, smith) for name, m in scene["materials"].items()}
@@ -777,6 +778,9 @@ def main(argv=None):
                          "(the hcsmith / hcplastic wrappers), or lumencoat: correlated, with the "
                          "plastic's coat T and Ri as lumen tabulates them")
     ap.add_argument("--threads", type=int, default=0, help="Dr.Jit worker threads (default: all cores)")
+    ap.add_argument("--sampler", default="independent",
+                    choices=["independent", "stratified", "multijitter", "ldsampler"],
+                    help="Mitsuba's sampler (efficiency measurements; the comparison uses independent)")
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--print-materials", action="store_true", help="print the translation and exit")
     ap.add_argument("--check-metals", metavar="METALS_RS",
@@ -842,7 +846,7 @@ def main(argv=None):
 
     t0 = time.perf_counter()
     seed0 = args.seeds[0] if args.seeds else args.seed
-    ms = build_scene(mi, scene, spp, seed0, rr_depth, args.max_depth, args.smith)
+    ms = build_scene(mi, scene, spp, seed0, rr_depth, args.max_depth, args.smith, args.sampler)
     t_build = time.perf_counter() - t0
 
     def render(seed):
