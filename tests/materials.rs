@@ -88,7 +88,7 @@ material = "gold"
             "red-plastic",
         ];
         let i = names.iter().position(|n| *n == name).unwrap();
-        scene.materials[i]
+        scene.materials[i].clone()
     };
     match kind("gold").kind {
         Kind::Conductor(c) => {

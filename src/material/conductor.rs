@@ -83,12 +83,12 @@ impl ConductorDesc {
             }
         };
         let roughness = self.microfacets(field, 0.0, textures)?;
-        Ok(Material::new(Kind::Conductor(Conductor {
+        Ok(Material::new(Kind::Conductor(Box::new(Conductor {
             eta,
             k,
             roughness,
             multiscatter: self.multiscatter,
-        })))
+        }))))
     }
 }
 

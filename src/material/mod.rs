@@ -568,7 +568,7 @@ impl Opacity {
 }
 
 /// How a material scatters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Kind {
     /// Reflects and transmits nothing: a path that meets it ends there (the
     /// notes' lights).
@@ -579,16 +579,18 @@ pub enum Kind {
     Metal(Metal),
     /// Clear refracting material such as glass or water.
     Dielectric(Dielectric),
-    /// A metal by its complex index of refraction.
-    Conductor(Conductor),
+    /// A metal by its complex index of refraction (out of line, as the
+    /// other large kinds).
+    Conductor(Box<Conductor>),
     /// A diffuse base under a clear coat.
-    Plastic(Plastic),
-    /// The glTF metallic-roughness material.
-    Principled(Principled),
+    Plastic(Box<Plastic>),
+    /// The glTF metallic-roughness material (out of line: it is large,
+    /// and the table of materials every hit reads stays small).
+    Principled(Box<Principled>),
 }
 
 /// A surface material.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// How it scatters.
     pub kind: Kind,

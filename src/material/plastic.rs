@@ -50,12 +50,12 @@ impl PlasticDesc {
             param::Range::Positive,
         )?;
         let roughness = self.microfacets(field, 0.0, textures)?;
-        Ok(Material::new(Kind::Plastic(Plastic {
+        Ok(Material::new(Kind::Plastic(Box::new(Plastic {
             albedo,
             ior,
             roughness,
             multiscatter: self.multiscatter,
-        })))
+        }))))
     }
 }
 

@@ -130,7 +130,7 @@ impl PrincipledDesc {
             Some(name) => Some(textures.normal_map(&at("clearcoat_normal_map"), name)?),
             None => None,
         };
-        Ok(Material::new(Kind::Principled(Principled {
+        Ok(Material::new(Kind::Principled(Box::new(Principled {
             base_color,
             vertex_color: false,
             metallic,
@@ -147,7 +147,7 @@ impl PrincipledDesc {
             sheen_color,
             sheen_roughness,
             multiscatter: self.multiscatter,
-        })))
+        }))))
     }
 
     /// σ of the volume's absorption from `attenuation_color` and

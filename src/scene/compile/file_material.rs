@@ -66,7 +66,7 @@ pub(super) fn compile(m: &MeshMaterial, textures: &mut Vec<Texture>) -> Material
         sheen_roughness: table.scalar(&m.sheen_roughness),
         multiscatter: false,
     };
-    let mut material = Material::new(Kind::Principled(principled));
+    let mut material = Material::new(Kind::Principled(Box::new(principled)));
     let emission = table.color(
         &m.emission,
         |x| if x > 0.0 && x.is_finite() { x } else { 0.0 },
