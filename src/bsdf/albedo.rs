@@ -13,14 +13,22 @@
 //! and densities are unchanged; what it loses is reciprocity, which a
 //! compensated lobe gives up (the tests leave it out).
 //!
-//! The albedos are tabulated on first use, by deterministic quadrature of
-//! the visible-normal sampling (a 48 × 48 grid of midpoints per entry for a
+//! The albedos are tabulated by deterministic quadrature of the
+//! visible-normal sampling (a 48 × 48 grid of midpoints per entry for a
 //! conductor, 32 × 32 for a dielectric), over a 32 × 32 grid of μ and √α
-//! (and for dielectrics 12 indices of refraction
-//! from 1 to 3, each from both sides), and interpolated linearly. An
-//! anisotropic surface looks up √(αx αy).
+//! (and for dielectrics 12 indices of refraction from 1 to 3, each from
+//! both sides), and interpolated linearly. An anisotropic surface looks up
+//! √(αx αy).
+//!
+//! The quadrature (`albedo/quadrature.rs`) takes 50 million evaluations,
+//! seconds of CPU that every render using a coat or `multiscatter` paid
+//! at its start, so its results ship in `albedo/tables.bin`
+//! (little-endian `f32`: the conductor's table, then the dielectric's
+//! reflected and then transmitted power, each layer by layer, √α by √α).
+//! `cargo test --release --lib write_albedo_tables -- --ignored` makes
+//! the file again; `tables_are_their_quadrature` recomputes a sample of
+//! its entries on every test run.
 
-use super::fresnel;
 use super::microfacet::{Microfacet, Model};
 use crate::math::Vec3;
 use std::sync::OnceLock;
@@ -33,95 +41,9 @@ const ETA_MAX: f32 = 3.0;
 /// The most grazing μ of the tables.
 const MU_MIN: f32 = 0.002;
 
-/// μ at grid index `i`: from [`MU_MIN`] (grazing) to 1, closer together
-/// near grazing, where the albedo changes fastest.
-fn mu_at(i: usize) -> f32 {
-    let t = i as f32 / (N_MU - 1) as f32;
-    MU_MIN + (1.0 - MU_MIN) * t * t
-}
-
 /// √α at grid index `j`: from 0.02 to 1.
 fn r_at(j: usize) -> f32 {
     0.02 + 0.98 * j as f32 / (N_R - 1) as f32
-}
-
-/// η at grid index `k`: from 1 to [`ETA_MAX`].
-fn eta_at(k: usize) -> f32 {
-    1.0 + (ETA_MAX - 1.0) * k as f32 / (N_ETA - 1) as f32
-}
-
-/// The direction at incidence cosine `mu` in the x–z plane.
-fn direction(mu: f32) -> Vec3 {
-    Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)
-}
-
-/// The midpoints of an n × n grid over [0, 1)²: fine enough that the
-/// directions cut off by the horizon, a step in u, cost under 0.5%.
-fn grid(n: usize) -> impl Iterator<Item = [f32; 2]> {
-    (0..n * n).map(move |k| {
-        [
-            ((k % n) as f32 + 0.5) / n as f32,
-            ((k / n) as f32 + 0.5) / n as f32,
-        ]
-    })
-}
-
-/// Quadrature points per side for a conductor's entry and a dielectric's.
-const CONDUCTOR_GRID: usize = 48;
-const DIELECTRIC_GRID: usize = 32;
-
-/// The albedo of a white (F = 1) single-scattering conductor seen from
-/// `wo`: the mean of G(wo, wi)/G₁(wo) over visible normals, 1 − the lost
-/// energy (Beckmann's normals are drawn by D cos θ, weighted accordingly).
-fn conductor_albedo(d: &Microfacet, wo: Vec3) -> f32 {
-    let mut sum = 0.0f64;
-    for u in grid(CONDUCTOR_GRID) {
-        let wm = d.sample_wm(wo, u);
-        let wi = fresnel::reflect(wo, wm);
-        if wi.z <= 0.0 || wo.dot(wm) <= 0.0 {
-            continue;
-        }
-        let pdf = d.pdf(wo, wm) / (4.0 * wo.dot(wm));
-        let f_cos = d.d(wm) * d.g(wo, wi) / (4.0 * wo.z);
-        if pdf > 0.0 {
-            sum += f64::from(f_cos / pdf);
-        }
-    }
-    (sum / (CONDUCTOR_GRID * CONDUCTOR_GRID) as f64) as f32
-}
-
-/// The albedo, counted as power (without the η² of radiance), of a
-/// single-scattering dielectric interface of relative index `eta` seen
-/// from `wo`: what it reflects and what it transmits.
-fn dielectric_albedo(d: &Microfacet, wo: Vec3, eta: f32) -> [f32; 2] {
-    let (mut reflected, mut transmitted) = (0.0f64, 0.0f64);
-    for u in grid(DIELECTRIC_GRID) {
-        let wm = d.sample_wm(wo, u);
-        let dot_o = wo.dot(wm);
-        if dot_o <= 0.0 {
-            continue;
-        }
-        let r = fresnel::dielectric(dot_o, eta);
-        let pdf_m = d.pdf(wo, wm);
-        if !(pdf_m > 0.0) {
-            continue;
-        }
-        // Per microfacet drawn, what reaches each side: D G |wo·wm|/wo.z
-        // over the density of wm (the Jacobians of reflection and
-        // refraction cancel against the BSDF's own).
-        let weight = |wi: Vec3| d.d(wm) * d.g(wo, wi) * dot_o / (wo.z * pdf_m);
-        let wr = fresnel::reflect(wo, wm);
-        if wr.z > 0.0 {
-            reflected += f64::from(r * weight(wr));
-        }
-        if let Some((wt, _)) = fresnel::refract(wo, wm, eta) {
-            if wt.z < 0.0 {
-                transmitted += f64::from((1.0 - r) * weight(wt));
-            }
-        }
-    }
-    let n = (DIELECTRIC_GRID * DIELECTRIC_GRID) as f64;
-    [(reflected / n) as f32, (transmitted / n) as f32]
 }
 
 /// A table of albedos over (η, √α, μ).
@@ -146,66 +68,41 @@ impl Table {
     }
 }
 
-/// Tables of `C` albedos over `layers` layers, entry by entry from
-/// `albedo(layer, microfacets, direction)`.
-fn build<const C: usize>(
-    layers: usize,
-    albedo: impl Fn(usize, &Microfacet, Vec3) -> [f32; C] + Sync,
-) -> [Table; C] {
-    let entry = |n: usize| {
-        let (k, j, i) = (n / (N_R * N_MU), n / N_MU % N_R, n % N_MU);
-        let r = r_at(j);
-        let model = if k % 2 == 0 {
-            Model::Ggx
-        } else {
-            Model::Beckmann
-        };
-        let d = Microfacet::new(r * r, r * r, model);
-        albedo(k, &d, direction(mu_at(i)))
-    };
-    // On threads of its own, not rayon's: a render's workers wait for the
-    // table while it is made, and could not make it.
-    let n = layers * N_R * N_MU;
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(16);
-    let chunk = n.div_ceil(threads);
-    let mut values = vec![[0.0f32; C]; n];
-    std::thread::scope(|s| {
-        for (c, part) in values.chunks_mut(chunk).enumerate() {
-            let entry = &entry;
-            s.spawn(move || {
-                for (o, v) in part.iter_mut().enumerate() {
-                    *v = entry(c * chunk + o);
-                }
-            });
-        }
-    });
-    std::array::from_fn(|c| Table {
-        values: values.iter().map(|v| v[c]).collect(),
-    })
+/// Layers of the conductor's table (GGX, Beckmann) and of the
+/// dielectric's (each η from outside and inside, GGX and Beckmann).
+const CONDUCTOR_LAYERS: usize = 2;
+const DIELECTRIC_LAYERS: usize = 4 * N_ETA;
+/// Entries per layer.
+const LAYER: usize = N_R * N_MU;
+
+const DATA: &[u8] = include_bytes!("albedo/tables.bin");
+const _: () = assert!(
+    DATA.len() == 4 * (CONDUCTOR_LAYERS + 2 * DIELECTRIC_LAYERS) * LAYER,
+    "albedo/tables.bin does not have the tables' size"
+);
+
+/// The albedos of white conductors, and the power that dielectric
+/// interfaces reflect and transmit.
+struct Tables {
+    conductor: Table,
+    reflected: Table,
+    transmitted: Table,
 }
 
-/// Layers: GGX, Beckmann.
-fn conductor_table() -> &'static Table {
-    static TABLE: OnceLock<Table> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        let [t] = build(2, |_, d, wo| [conductor_albedo(d, wo).max(1e-3)]);
-        t
-    })
-}
-
-/// The albedos of dielectric interfaces: what they reflect and what they
-/// transmit. Layers: for each η of the grid, seen from outside (η) and
-/// from inside (1/η), GGX and Beckmann.
-fn dielectric_tables() -> &'static [Table; 2] {
-    static TABLES: OnceLock<[Table; 2]> = OnceLock::new();
+fn tables() -> &'static Tables {
+    static TABLES: OnceLock<Tables> = OnceLock::new();
     TABLES.get_or_init(|| {
-        build(4 * N_ETA, |k, d, wo| {
-            let eta = eta_at(k / 4);
-            let eta = if (k / 2) % 2 == 0 { eta } else { 1.0 / eta };
-            dielectric_albedo(d, wo, eta)
-        })
+        let mut floats = DATA
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        let mut take = |layers: usize| Table {
+            values: floats.by_ref().take(layers * LAYER).collect(),
+        };
+        Tables {
+            conductor: take(CONDUCTOR_LAYERS),
+            reflected: take(DIELECTRIC_LAYERS),
+            transmitted: take(DIELECTRIC_LAYERS),
+        }
     })
 }
 
@@ -235,7 +132,7 @@ const RI_POINTS: usize = 64;
 fn internal_reflectance_table() -> &'static Vec<f32> {
     static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
     TABLE.get_or_init(|| {
-        let [reflected, _] = dielectric_tables();
+        let reflected = &tables().reflected;
         let mut out = Vec::with_capacity(N_ETA * 2 * N_R);
         for k in 0..N_ETA {
             for model in 0..2 {
@@ -266,14 +163,18 @@ fn layer(d: &Microfacet) -> (usize, f32) {
 /// seen at incidence cosine `mu`.
 pub fn conductor(d: &Microfacet, mu: f32) -> f32 {
     let (model, r) = layer(d);
-    conductor_table().lookup(model, r, mu)
+    tables().conductor.lookup(model, r, mu)
 }
 
 /// The single-scattering albedo (as power) of a dielectric interface of
 /// microfacets `d` and relative index `eta` (from the side seen) at
 /// incidence cosine `mu`, interpolated between the tabulated indices.
 pub fn dielectric(d: &Microfacet, eta: f32, mu: f32) -> f32 {
-    let [reflected, transmitted] = dielectric_tables();
+    let Tables {
+        reflected,
+        transmitted,
+        ..
+    } = tables();
     across_eta(d, eta, |k, r| {
         (reflected.lookup(k, r, mu) + transmitted.lookup(k, r, mu)).max(1e-3)
     })
@@ -283,7 +184,7 @@ pub fn dielectric(d: &Microfacet, eta: f32, mu: f32) -> f32 {
 /// coat of microfacets `d` and index `eta` (> 1) lets through to what it
 /// covers, counted as power.
 pub fn coat_transmittance(d: &Microfacet, eta: f32, mu: f32) -> f32 {
-    let [_, transmitted] = dielectric_tables();
+    let transmitted = &tables().transmitted;
     across_eta(d, eta.max(1.0), |k, r| transmitted.lookup(k, r, mu)).clamp(0.0, 1.0)
 }
 
@@ -314,8 +215,52 @@ pub fn dielectric_compensation(d: &Microfacet, eta: f32, wo: Vec3) -> f32 {
 }
 
 #[cfg(test)]
+mod quadrature;
+
+#[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Makes `albedo/tables.bin` from the quadrature.
+    #[test]
+    #[ignore = "rewrites src/bsdf/albedo/tables.bin"]
+    fn write_albedo_tables() {
+        let bytes: Vec<u8> = quadrature::all()
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/bsdf/albedo/tables.bin");
+        std::fs::write(path, bytes).unwrap();
+    }
+
+    /// The shipped tables are what the quadrature makes: a sample of their
+    /// entries (every conductor's 37th, every dielectric's 53rd, spread
+    /// over all layers, roughnesses and angles) made again. The quadrature
+    /// is deterministic; the tolerance leaves room only for the last bits
+    /// of another platform's sin and cos.
+    #[test]
+    fn tables_are_their_quadrature() {
+        let t = tables();
+        let close = |shipped: f32, made: f32, what: &str, n: usize| {
+            assert!(
+                (shipped - made).abs() <= 1e-5,
+                "{what} entry {n}: shipped {shipped}, quadrature {made}"
+            );
+        };
+        for n in (0..CONDUCTOR_LAYERS * LAYER).step_by(37) {
+            close(
+                t.conductor.values[n],
+                quadrature::conductor_entry(n),
+                "conductor",
+                n,
+            );
+        }
+        for n in (0..DIELECTRIC_LAYERS * LAYER).step_by(53) {
+            let [r, tr] = quadrature::dielectric_entry(n);
+            close(t.reflected.values[n], r, "reflected", n);
+            close(t.transmitted.values[n], tr, "transmitted", n);
+        }
+    }
 
     /// A white conductor loses nothing when smooth, more as it roughens,
     /// and about a third at roughness 1 seen from above (Kulla & Conty's

@@ -60,20 +60,37 @@ pub fn brdf(r: f32, wo: Vec3, wi: Vec3) -> f32 {
 const N_MU: usize = 32;
 const N_R: usize = 32;
 
+/// The table's entries, made by [`integrate`] at roughness `r_at(j)` and
+/// μ `mu_at(i)`, row by row of roughness; shipped as little-endian `f32`
+/// (`cargo test --release --lib write_sheen_table -- --ignored` makes it
+/// again, `table_is_its_quadrature` checks a sample on every test run)
+/// rather than made at each start, a tenth of a second of CPU.
+const DATA: &[u8] = include_bytes!("sheen_table.bin");
+const _: () = assert!(
+    DATA.len() == 4 * N_R * N_MU,
+    "sheen_table.bin has the wrong size"
+);
+
+/// The roughness of the table's row `j`.
+#[cfg(test)]
+fn r_at(j: usize) -> f32 {
+    MIN_ROUGHNESS + (1.0 - MIN_ROUGHNESS) * j as f32 / (N_R - 1) as f32
+}
+
+/// The μ of the table's column `i`.
+#[cfg(test)]
+fn mu_at(i: usize) -> f32 {
+    (i as f32 / (N_MU - 1) as f32).max(0.01)
+}
+
 /// The directional albedo of white sheen of roughness `r` seen at cosine
-/// `mu`, ∫ f cos θi dωi, interpolated in a table made on first use.
+/// `mu`, ∫ f cos θi dωi, interpolated in the table.
 pub fn albedo(r: f32, mu: f32) -> f32 {
     static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
     let table = TABLE.get_or_init(|| {
-        let mut out = Vec::with_capacity(N_R * N_MU);
-        for j in 0..N_R {
-            let r = MIN_ROUGHNESS + (1.0 - MIN_ROUGHNESS) * j as f32 / (N_R - 1) as f32;
-            for i in 0..N_MU {
-                let mu = (i as f32 / (N_MU - 1) as f32).max(0.01);
-                out.push(integrate(r, mu));
-            }
-        }
-        out
+        DATA.chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect()
     });
     let fj = ((r - MIN_ROUGHNESS) / (1.0 - MIN_ROUGHNESS) * (N_R - 1) as f32)
         .clamp(0.0, (N_R - 1) as f32);
@@ -86,6 +103,7 @@ pub fn albedo(r: f32, mu: f32) -> f32 {
 }
 
 /// ∫ f cos θi dωi by midpoints over (cos θi, φ).
+#[cfg(test)]
 fn integrate(r: f32, mu: f32) -> f32 {
     let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let (nc, np) = (96, 48);
@@ -107,6 +125,36 @@ fn integrate(r: f32, mu: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn entry(n: usize) -> f32 {
+        integrate(r_at(n / N_MU), mu_at(n % N_MU))
+    }
+
+    /// Makes `sheen_table.bin` from the quadrature.
+    #[test]
+    #[ignore = "rewrites src/bsdf/sheen_table.bin"]
+    fn write_sheen_table() {
+        let bytes: Vec<u8> = (0..N_R * N_MU)
+            .flat_map(|n| entry(n).to_le_bytes())
+            .collect();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/bsdf/sheen_table.bin");
+        std::fs::write(path, bytes).unwrap();
+    }
+
+    /// The shipped table is what the quadrature makes (every 29th entry made
+    /// again; the tolerance leaves room only for another platform's last
+    /// bits of powf and exp).
+    #[test]
+    fn table_is_its_quadrature() {
+        for n in (0..N_R * N_MU).step_by(29) {
+            let shipped = f32::from_le_bytes(DATA[4 * n..4 * n + 4].try_into().unwrap());
+            let made = entry(n);
+            assert!(
+                (shipped - made).abs() <= 1e-5,
+                "entry {n}: shipped {shipped}, quadrature {made}"
+            );
+        }
+    }
 
     /// The distribution is normalised (∫ D cos θm dωm = 1).
     #[test]
