@@ -266,9 +266,9 @@ impl Principled {
         let under = 1.0 - coat;
         if wi.z > 0.0 {
             let (layers, pdf) = self.reflect(wo, wi, &w);
-            let (coat_f, coat_pdf) = self.coat_reflect(wo, wi);
+            let (coat_f_cos, coat_pdf) = self.coat_reflect(wo, wi);
             (
-                (layers * under + Color::splat(coat * coat_f)) * wi.z,
+                layers * (under * wi.z) + Color::splat(coat * coat_f_cos),
                 pdf + w.coat * coat_pdf,
             )
         } else {
@@ -312,8 +312,8 @@ impl Principled {
         (f, pdf)
     }
 
-    /// The coat's reflection (f of a white coat, without the cosine) and
-    /// the density of sampling it.
+    /// The coat's reflection (f·cos θi of a white coat, the cosine to the
+    /// coat's normal) and the density of sampling it.
     #[inline]
     fn coat_reflect(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
         if self.clearcoat <= 0.0 {
@@ -331,9 +331,12 @@ impl Principled {
         if wm == Vec3::ZERO || co.dot(wm) <= 0.0 {
             return (0.0, 0.0);
         }
+        // The cosine is the coat's own (ci.z), not the base's: a coat
+        // whose normal is tilted from the base's reflects its Fresnel
+        // weight, whatever the tilt.
         let c = &self.coat;
-        let f = c.d(wm) * c.g(co, ci) / (4.0 * co.z * ci.z);
-        (f, c.pdf(co, wm) / (4.0 * co.dot(wm)))
+        let f_cos = c.d(wm) * c.g(co, ci) / (4.0 * co.z);
+        (f_cos, c.pdf(co, wm) / (4.0 * co.dot(wm)))
     }
 
     /// Whether the surface bounds a volume of the same index as outside
