@@ -122,7 +122,7 @@ fn step(
     let record = scene.record(ray, hit);
     let material = scene.material(&record);
     if !record.front_face {
-        if let Some(sigma) = material.absorption() {
+        if let Some(sigma) = material.absorption(&record, &scene.textures) {
             // The segment ran inside an absorbing volume (Beer–Lambert).
             path.throughput *= (-sigma * hit.t).exp();
         }

@@ -70,6 +70,8 @@ roughness = 0.4
 clearcoat = 1.0
 clearcoat_roughness = 0.05
 normal_map = "flakes-normal"
+clearcoat_normal_map = "flakes-normal"
+clearcoat_normal_scale = 0.5
 
 [[objects]]
 type = "sphere"
@@ -101,7 +103,10 @@ material = "gold"
     assert!(matches!(kind("frosted").kind, Kind::Dielectric(d) if d.roughness.is_some()));
     assert!(matches!(kind("red-plastic").kind, Kind::Plastic(p) if p.ior == 1.5));
     let paint = kind("car-paint");
-    assert!(matches!(paint.kind, Kind::Principled(_)));
+    match &paint.kind {
+        Kind::Principled(p) => assert_eq!(p.coat_normal.map(|(_, s)| s), Some(0.5)),
+        other => panic!("car-paint is {other:?}"),
+    }
     assert!(paint.shape.is_some(), "the normal map");
 }
 
@@ -200,7 +205,22 @@ material = "m"
         ),
         (
             "type = \"principled\"\nior = 0.8",
-            &["materials.m.ior", "at least 1"],
+            &["materials.m.ior", "from 1 to 1000"],
+        ),
+        (
+            "type = \"plastic\"\nior = 0.5\nroughness = 0.3",
+            &["materials.m.ior", "from 1 to 1000", "got 0.5"],
+        ),
+        (
+            "type = \"principled\"\nior = 1e30",
+            &["materials.m.ior", "from 1 to 1000"],
+        ),
+        (
+            "type = \"principled\"\nclearcoat = 1\nclearcoat_normal_scale = 0.5",
+            &[
+                "materials.m.clearcoat_normal_scale",
+                "`clearcoat_normal_map`",
+            ],
         ),
         (
             "type = \"principled\"\nopacity = 1.2",
@@ -493,6 +513,28 @@ material = "glass"
     let ratio = tinted[0] / clear[0];
     assert!((ratio - 0.5).abs() < 0.03, "red kept {ratio}");
     assert!((tinted[1] - clear[1]).abs() < 1e-6, "green untouched");
+
+    // Where a thickness texture is 0 the surface is a thin wall, not the
+    // side of a volume: light crosses the ball straight and nothing on the
+    // way absorbs it (it was tinted as if inside a volume).
+    image::GrayImage::from_pixel(2, 2, image::Luma([0]))
+        .save(dir.join("zero.png"))
+        .unwrap();
+    let thin = mean(&compile_file(
+        &dir,
+        "thin.toml",
+        &text("attenuation_color = [0.5, 1, 1]\nattenuation_distance = 2")
+            .replace("thickness = 1", "thickness = \"zero\"")
+            .replace(
+                "[materials.glass]",
+                "[textures.zero]\ntype = \"image\"\nfile = \"zero.png\"\nchannel = \"r\"\n\n[materials.glass]",
+            ),
+    ));
+    assert!(
+        (thin[0] / thin[1] - 1.0).abs() < 1e-3,
+        "a thin wall tints red by {}",
+        thin[0] / thin[1]
+    );
 }
 
 /// A transmitting surface of index 1 (glTF's "air") bounds nothing: a

@@ -668,11 +668,15 @@ impl Material {
     }
 
     /// How much the volume it encloses absorbs per unit length (glTF's
-    /// `KHR_materials_volume` attenuation), if it absorbs.
+    /// `KHR_materials_volume` attenuation), if it absorbs, for a ray that
+    /// leaves the volume at `hit`. A point where the thickness is 0 is a
+    /// thin wall, not the side of a volume, and absorbs nothing.
     #[inline(always)]
-    pub fn absorption(&self) -> Option<Color> {
+    pub fn absorption(&self, hit: &HitRecord, textures: &[Texture]) -> Option<Color> {
         match &self.kind {
-            Kind::Principled(p) if p.thickness != ScalarParam::Const(0.0) => p.absorption,
+            Kind::Principled(p) if p.thickness != ScalarParam::Const(0.0) => {
+                p.absorption.filter(|_| p.thickness.at(hit, textures) > 0.0)
+            }
             _ => None,
         }
     }

@@ -47,7 +47,7 @@ impl PlasticDesc {
         let ior = param::number(
             &format!("{field}.ior"),
             self.ior.unwrap_or(DEFAULT_IOR),
-            param::Range::Positive,
+            param::Range::LayerIor,
         )?;
         let roughness = self.microfacets(field, 0.0, textures)?;
         Ok(Material::new(Kind::Plastic(Box::new(Plastic {

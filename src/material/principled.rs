@@ -68,6 +68,10 @@ material_desc! {
         /// surface, not the base's normal map.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub clearcoat_normal_map: Option<String>,
+        /// How far the coat's normal map tilts the normal, as
+        /// `normal_scale` does for the base's; 1 when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub clearcoat_normal_scale: Option<f64>,
         /// The sheen's colour (`KHR_materials_sheen`), each channel in
         /// [0, 1]; black (no sheen) when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -117,18 +121,24 @@ impl PrincipledDesc {
             ColorRange::NonNegative,
         )?;
         let sheen_color = color("sheen_color", &self.sheen_color, 0.0, ColorRange::Unit)?;
-        let ior = param::number(&at("ior"), self.ior.unwrap_or(1.5), Range::Positive)?;
-        if ior < 1.0 {
-            return Err(Invalid::new(
-                at("ior"),
-                format!("must be at least 1 (the index inside over the index outside), got {ior}"),
-            ));
-        }
+        let ior = param::number(&at("ior"), self.ior.unwrap_or(1.5), Range::LayerIor)?;
         let roughness = self.microfacets(field, 0.5, textures)?;
         let absorption = self.absorption(field)?;
-        let coat_normal = match &self.clearcoat_normal_map {
-            Some(name) => Some(textures.normal_map(&at("clearcoat_normal_map"), name)?),
-            None => None,
+        let coat_normal = match (&self.clearcoat_normal_map, self.clearcoat_normal_scale) {
+            (Some(name), scale) => Some((
+                textures.normal_map(&at("clearcoat_normal_map"), name)?,
+                match scale {
+                    Some(v) => param::number(&at("clearcoat_normal_scale"), v, Range::NonNegative)?,
+                    None => 1.0,
+                },
+            )),
+            (None, Some(_)) => {
+                return Err(Invalid::new(
+                    at("clearcoat_normal_scale"),
+                    "scales `clearcoat_normal_map`, which the material does not have",
+                ))
+            }
+            (None, None) => None,
         };
         Ok(Material::new(Kind::Principled(Box::new(Principled {
             base_color,
@@ -206,8 +216,8 @@ pub struct Principled {
     pub clearcoat: ScalarParam,
     /// Its roughness.
     pub clearcoat_roughness: ScalarParam,
-    /// Its own normal map, if any.
-    pub coat_normal: Option<u32>,
+    /// Its own normal map, if any, and the map's scale.
+    pub coat_normal: Option<(u32, f32)>,
     /// The sheen's colour.
     pub sheen_color: ColorParam,
     /// The sheen's roughness.
@@ -273,11 +283,7 @@ impl Principled {
     #[inline]
     fn coat_normal_at(&self, hit: &HitRecord, textures: &[Texture], frame: &Frame) -> Vec3 {
         let n = match self.coat_normal {
-            Some(texture) => Shape::Normal {
-                texture,
-                scale: 1.0,
-            }
-            .normal(hit, textures),
+            Some((texture, scale)) => Shape::Normal { texture, scale }.normal(hit, textures),
             None => hit.shading_normal,
         };
         let local = frame.to_local(n).normalize_or_zero();
@@ -305,7 +311,7 @@ impl Principled {
             .filter_map(ScalarParam::texture)
             .chain(colors.iter().filter_map(ColorParam::texture))
             .chain(self.roughness.textures())
-            .chain(self.coat_normal)
+            .chain(self.coat_normal.map(|(texture, _)| texture))
             .collect()
     }
 }

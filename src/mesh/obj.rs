@@ -13,6 +13,7 @@
 //! Line (`l`) and point (`p`) elements have no surface and are ignored.
 
 use super::{AlphaMode, Mapped, MeshError, MeshMaterial, Model, TriangleMesh, NO_MATERIAL};
+use crate::material::param::MAX_LAYER_IOR;
 use crate::texture::{Channels, Filter, Image, ImageMap, UvTransform, Wrap};
 use glam::Mat4;
 use std::borrow::Cow;
@@ -367,10 +368,43 @@ fn load_mtl(path: &Path, error: &RefCell<Option<MeshError>>) -> tobj::MTLLoadRes
     };
     match tobj::load_mtl_buf(&mut text.as_bytes()) {
         Ok(r) => {
-            // tobj keeps `Tr` as text; check it here, where the line is known.
-            for (line, keyword, mut words) in lines(&text) {
-                if keyword == "Tr" && words.next().and_then(|w| w.parse::<f32>().ok()).is_none() {
+            // tobj keeps `Tr` as text, and reads `inf` and `nan` as numbers;
+            // check them here, where the line is known.
+            for (line, keyword, words) in lines(&text) {
+                let mut numbers = words.take(3).map(|w| w.parse::<f32>().ok());
+                let first = numbers.next().flatten();
+                if keyword == "Tr" && first.is_none() {
                     return fail(MeshError::new(path, Some(line), "Tr needs a number"));
+                }
+                let colour = matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke" | "Tf");
+                let scalar = matches!(
+                    keyword,
+                    "Ns" | "Ni"
+                        | "d"
+                        | "Tr"
+                        | "Pr"
+                        | "Pm"
+                        | "Ps"
+                        | "Pc"
+                        | "Pcr"
+                        | "aniso"
+                        | "anisor"
+                );
+                let infinite = std::iter::once(first)
+                    .chain(numbers)
+                    .flatten()
+                    .any(|v| !v.is_finite());
+                if (colour || scalar) && infinite {
+                    let what = if colour {
+                        "finite numbers"
+                    } else {
+                        "a finite number"
+                    };
+                    return fail(MeshError::new(
+                        path,
+                        Some(line),
+                        format!("{keyword} needs {what}"),
+                    ));
                 }
             }
             Ok(r)
@@ -422,15 +456,16 @@ fn check_mtl<'a>(path: &Path, text: &'a str) -> Result<Cow<'a, str>, MeshError> 
 fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
     let found = lines(text).find_map(|(line, keyword, words)| {
         let words: Vec<&str> = words.collect();
-        let number = |w: Option<&&str>| w.is_some_and(|w| w.parse::<f32>().is_ok());
+        let number =
+            |w: Option<&&str>| w.is_some_and(|w| w.parse::<f32>().is_ok_and(f32::is_finite));
         let bad = match keyword {
             "newmtl" => words
                 .is_empty()
                 .then(|| "newmtl without a name".to_string()),
             "Ka" | "Kd" | "Ks" | "Ke" => (!words.iter().take(3).all(|w| number(Some(w))))
-                .then(|| format!("{keyword} needs numbers")),
+                .then(|| format!("{keyword} needs finite numbers")),
             "Ns" | "Ni" | "d" => {
-                (!number(words.first())).then(|| format!("{keyword} needs a number"))
+                (!number(words.first())).then(|| format!("{keyword} needs a finite number"))
             }
             "illum" => words
                 .first()
@@ -654,7 +689,10 @@ fn convert_material(
         },
         metallic: Mapped::value(if metal { 1.0 } else { 0.0 }),
         roughness: Mapped::value((2.0 / (ns + 2.0)).sqrt().sqrt()),
-        ior: m.optical_density.unwrap_or(defaults.ior).max(1.0),
+        ior: m
+            .optical_density
+            .unwrap_or(defaults.ior)
+            .clamp(1.0, MAX_LAYER_IOR as f32),
         emission: Mapped {
             value: m
                 .emissive

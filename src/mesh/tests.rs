@@ -418,7 +418,13 @@ fn malformed_mtl_is_refused_naming_the_mtl_file_and_line() {
     for (mtl, line, words) in [
         (&b"newmtl a\nKd 1 1\n"[..], 2, "Kd has 2 numbers"),
         (b"newmtl a\n\nKs\n", 3, "Ks has 0 numbers"),
-        (b"newmtl a\nKd 1 1 1\nNs shiny\n", 3, "Ns needs a number"),
+        (
+            b"newmtl a\nKd 1 1 1\nNs shiny\n",
+            3,
+            "Ns needs a finite number",
+        ),
+        (b"newmtl a\nNi inf\n", 2, "Ni needs a finite number"),
+        (b"newmtl a\nKd 1 nan 1\n", 2, "Kd needs finite numbers"),
         (b"newmtl a\nillum x\n", 2, "illum"),
         (b"newmtl a\nTr clear\n", 2, "Tr"),
         (b"newmtl a\nKd 1 1 1\xff\n", 2, "UTF-8"),

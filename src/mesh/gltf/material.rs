@@ -11,6 +11,7 @@
 
 use super::super::material::{AlphaMode, Mapped};
 use super::super::{MeshError, MeshMaterial, DEFAULT_IOR};
+use crate::material::param::MAX_LAYER_IOR;
 use crate::texture::{Channels, Filter, Image, ImageMap, UvTransform, Wrap};
 use rayon::prelude::*;
 use serde_json::Value;
@@ -168,16 +169,18 @@ fn material(
     };
     out.double_sided = m["doubleSided"].as_bool().unwrap_or(false);
     let ior = &ext["KHR_materials_ior"];
-    out.ior =
-        number(&ior["ior"], DEFAULT_IOR, 0.0, f32::MAX).map_err(|e| at(&format!("ior {e}")))?;
+    out.ior = number(&ior["ior"], DEFAULT_IOR, 0.0, MAX_LAYER_IOR as f32)
+        .map_err(|e| at(&format!("ior {e}")))?;
     if out.ior != 0.0 && out.ior < 1.0 {
         return Err(at(&format!("ior must be 0 or at least 1, got {}", out.ior)));
     }
     if out.ior == 0.0 {
         // The extension's "Fresnel 1" mode: a mirror-like dielectric; the
         // nearest lumen has is a very high index.
-        warn(at("KHR_materials_ior with ior 0 is read as ior 1000"));
-        out.ior = 1000.0;
+        warn(at(&format!(
+            "KHR_materials_ior with ior 0 is read as ior {MAX_LAYER_IOR}"
+        )));
+        out.ior = MAX_LAYER_IOR as f32;
     }
     let s = &ext["KHR_materials_specular"];
     out.specular = Mapped {

@@ -61,7 +61,7 @@ pub(super) fn compile(m: &MeshMaterial, textures: &mut Vec<Texture>) -> Material
         coat_normal: m
             .clearcoat_normal_map
             .as_ref()
-            .map(|(map, _)| table.map(map)),
+            .map(|(map, scale)| (table.map(map), *scale)),
         sheen_color: table.color(&m.sheen_color, unit),
         sheen_roughness: table.scalar(&m.sheen_roughness),
         multiscatter: false,
@@ -158,6 +158,34 @@ impl Table<'_> {
                     })
                 })
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::Image;
+
+    /// The coat's normal map keeps its scale (glTF's
+    /// `clearcoatNormalTexture.scale`) and refers to the map's texture.
+    #[test]
+    fn the_coats_normal_map_keeps_its_scale() {
+        let image = Arc::new(Image::from_rgba8(1, 1, vec![[128, 128, 255, 255]]));
+        let m = MeshMaterial {
+            clearcoat: Mapped::value(1.0),
+            clearcoat_normal_map: Some((ImageMap::color(image), 0.5)),
+            ..MeshMaterial::default()
+        };
+        let mut textures = Vec::new();
+        let material = compile(&m, &mut textures);
+        match &material.kind {
+            Kind::Principled(p) => {
+                let (texture, scale) = p.coat_normal.expect("the coat's normal map");
+                assert_eq!(scale, 0.5);
+                assert!((texture as usize) < textures.len());
+            }
+            other => panic!("compiled to {other:?}"),
         }
     }
 }
