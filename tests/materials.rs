@@ -209,7 +209,11 @@ material = "m"
         ),
         (
             "type = \"plastic\"\nior = 0.5\nroughness = 0.3",
-            &["materials.m.ior", "from 1 to 1000", "got 0.5"],
+            &["materials.m.ior", "from 1 to 3", "got 0.5"],
+        ),
+        (
+            "type = \"plastic\"\nior = 4",
+            &["materials.m.ior", "from 1 to 3", "got 4"],
         ),
         (
             "type = \"principled\"\nior = 1e30",

@@ -36,7 +36,9 @@ use std::sync::OnceLock;
 const N_MU: usize = 32;
 const N_R: usize = 32;
 const N_ETA: usize = 12;
-const ETA_MAX: f32 = 3.0;
+/// The largest index the dielectric tables cover (a rough coat of a
+/// larger one would be looked up as this).
+pub const ETA_MAX: f32 = 3.0;
 
 /// The most grazing μ of the tables.
 const MU_MIN: f32 = 0.002;

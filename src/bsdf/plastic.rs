@@ -57,7 +57,9 @@ impl Plastic {
     #[inline]
     fn transmittance(&self, mu: f32) -> f32 {
         match &self.roughness {
-            None => 1.0 - fresnel::dielectric(mu, self.eta),
+            // Rounding can put the reflectance a hair above 1 at large
+            // indices.
+            None => (1.0 - fresnel::dielectric(mu, self.eta)).max(0.0),
             Some(d) => albedo::coat_transmittance(d, self.eta, mu),
         }
     }
@@ -66,7 +68,7 @@ impl Plastic {
     #[inline]
     fn internal_reflectance(&self) -> f32 {
         match &self.roughness {
-            None => fresnel::diffuse_reflectance(1.0 / self.eta),
+            None => fresnel::diffuse_reflectance(1.0 / self.eta).clamp(0.0, 1.0),
             Some(d) => albedo::coat_internal_reflectance(d, self.eta),
         }
     }

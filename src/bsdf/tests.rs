@@ -1032,19 +1032,24 @@ fn no_nan_at_the_edges() {
             multiscatter: false,
         }),
     ];
-    for d in [smooth, rough] {
-        for eta in [1.0f32, 1.0 + 1e-6, 1.5] {
+    // Roughness 0 given as no microfacets at all (a delta), as well as the
+    // smallest and the largest α.
+    for d in [None, Some(smooth), Some(rough)] {
+        for eta in [1.0f32, 1.0 + 1e-6, 1.5, 1000.0] {
             lobes.push(Lobe::ExactDielectric(ExactDielectric {
                 eta,
-                roughness: Some(d),
-                multiscatter: true,
+                roughness: d,
+                multiscatter: d.is_some(),
             }));
             lobes.push(Lobe::Plastic(Plastic {
                 albedo: Color::ONE,
-                eta,
-                roughness: Some(d),
-                multiscatter: true,
+                eta: eta.min(super::albedo::ETA_MAX),
+                roughness: d,
+                multiscatter: d.is_some(),
             }));
+            let Some(d) = d else {
+                continue;
+            };
             for (_, p) in principled_configurations(d) {
                 lobes.push(Lobe::Principled(Principled {
                     eta,

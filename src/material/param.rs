@@ -283,14 +283,15 @@ pub enum Range {
     Positive,
     /// Within [0, 1].
     Unit,
-    /// The index of a coat or a glTF dielectric, relative to the outside:
-    /// from 1 (no interface) to [`MAX_LAYER_IOR`]. Below 1 a coat's
-    /// internal reflection would be total where its tables assume none,
-    /// and the layer would give more than it receives.
-    LayerIor,
+    /// The index of a layer over what it covers (a coat, a glTF
+    /// dielectric), relative to the outside: from 1 (no interface) to the
+    /// given largest. Below 1 a coat's internal reflection would be total
+    /// where its model assumes none, and the layer would give more than
+    /// it receives.
+    Index(f64),
 }
 
-/// The largest index a coat or a glTF dielectric may have: far beyond any
+/// The largest index a glTF dielectric (`principled`) may have: far beyond any
 /// real material's (diamond 2.42, germanium about 4 in the infrared) and
 /// the index glTF's "ior 0" is read as, small enough that 1/η² is a normal
 /// number.
@@ -310,7 +311,7 @@ impl Range {
             Range::NonNegative => v >= 0.0,
             Range::Positive => v as f32 > 0.0,
             Range::Unit => (0.0..=1.0).contains(&v),
-            Range::LayerIor => (1.0..=MAX_LAYER_IOR).contains(&v),
+            Range::Index(max) => (1.0..=max).contains(&v),
         };
         if ok {
             Ok(v as f32)
@@ -320,8 +321,8 @@ impl Range {
                 Range::NonNegative => format!("must not be negative, got {v}"),
                 Range::Positive => format!("must be greater than 0, got {v}"),
                 Range::Unit => format!("must be in [0, 1], got {v}"),
-                Range::LayerIor => format!(
-                    "must be from 1 to {MAX_LAYER_IOR} (the index inside over the index outside), got {v}"
+                Range::Index(max) => format!(
+                    "must be from 1 to {max} (the index inside over the index outside), got {v}"
                 ),
             })
         }

@@ -25,6 +25,10 @@ material_desc! {
 /// The coat's index when none is given.
 const DEFAULT_IOR: f64 = 1.5;
 
+/// The largest index a coat may have: where the tables of a rough coat
+/// end, and the fits of a smooth coat's internal reflection still hold.
+const MAX_IOR: f64 = crate::bsdf::albedo::ETA_MAX as f64;
+
 impl PlasticDesc {
     /// Plastic of albedo `albedo` under a coat of roughness `roughness`.
     pub fn new(albedo: impl Into<ColorDesc>, roughness: f64) -> Self {
@@ -47,7 +51,7 @@ impl PlasticDesc {
         let ior = param::number(
             &format!("{field}.ior"),
             self.ior.unwrap_or(DEFAULT_IOR),
-            param::Range::LayerIor,
+            param::Range::Index(MAX_IOR),
         )?;
         let roughness = self.microfacets(field, 0.0, textures)?;
         Ok(Material::new(Kind::Plastic(Box::new(Plastic {

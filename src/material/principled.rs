@@ -121,7 +121,11 @@ impl PrincipledDesc {
             ColorRange::NonNegative,
         )?;
         let sheen_color = color("sheen_color", &self.sheen_color, 0.0, ColorRange::Unit)?;
-        let ior = param::number(&at("ior"), self.ior.unwrap_or(1.5), Range::LayerIor)?;
+        let ior = param::number(
+            &at("ior"),
+            self.ior.unwrap_or(1.5),
+            Range::Index(param::MAX_LAYER_IOR),
+        )?;
         let roughness = self.microfacets(field, 0.5, textures)?;
         let absorption = self.absorption(field)?;
         let coat_normal = match (&self.clearcoat_normal_map, self.clearcoat_normal_scale) {
