@@ -318,9 +318,9 @@ impl SurfaceDesc<'_> {
                 two_sided: self.two_sided,
             });
         } else if self.emission_strength.is_some() {
-            return Err(Invalid::new(
+            return Err(Invalid::scales_missing(
                 format!("{field}.emission_strength"),
-                "scales `emission`, which the material does not have",
+                "emission",
             ));
         } else if let Some(e) = &mut material.emission {
             e.two_sided = self.two_sided;
@@ -343,9 +343,9 @@ impl SurfaceDesc<'_> {
             )),
             (Some(name), None) => {
                 if self.bump_scale.is_some() {
-                    return Err(Invalid::new(
+                    return Err(Invalid::scales_missing(
                         format!("{field}.bump_scale"),
-                        "scales `bump_map`, which the material does not have",
+                        "bump_map",
                     ));
                 }
                 let texture = textures.normal_map(&format!("{field}.normal_map"), name)?;
@@ -356,9 +356,9 @@ impl SurfaceDesc<'_> {
             }
             (None, Some(name)) => {
                 if self.normal_scale.is_some() {
-                    return Err(Invalid::new(
+                    return Err(Invalid::scales_missing(
                         format!("{field}.normal_scale"),
-                        "scales `normal_map`, which the material does not have",
+                        "normal_map",
                     ));
                 }
                 let at = format!("{field}.bump_map");
@@ -383,10 +383,7 @@ impl SurfaceDesc<'_> {
                 ] {
                     if v.is_some() {
                         let map = name.replace("_scale", "_map");
-                        return Err(Invalid::new(
-                            format!("{field}.{name}"),
-                            format!("scales `{map}`, which the material does not have"),
-                        ));
+                        return Err(Invalid::scales_missing(format!("{field}.{name}"), &map));
                     }
                 }
                 Ok(None)
@@ -674,9 +671,7 @@ impl Material {
     #[inline(always)]
     pub fn absorption(&self, hit: &HitRecord, textures: &[Texture]) -> Option<Color> {
         match &self.kind {
-            Kind::Principled(p) if p.thickness != ScalarParam::Const(0.0) => {
-                p.absorption.filter(|_| p.thickness.at(hit, textures) > 0.0)
-            }
+            Kind::Principled(p) => p.absorption.filter(|_| p.thickness.at(hit, textures) > 0.0),
             _ => None,
         }
     }

@@ -269,6 +269,14 @@ impl Invalid {
             message: message.into(),
         }
     }
+
+    /// Field `field` scales `map`, which the material does not have.
+    pub fn scales_missing(field: impl Into<String>, map: &str) -> Self {
+        Invalid::new(
+            field,
+            format!("scales `{map}`, which the material does not have"),
+        )
+    }
 }
 
 /// What a material's parameters are checked against while they are

@@ -137,9 +137,9 @@ impl PrincipledDesc {
                 },
             )),
             (None, Some(_)) => {
-                return Err(Invalid::new(
+                return Err(Invalid::scales_missing(
                     at("clearcoat_normal_scale"),
-                    "scales `clearcoat_normal_map`, which the material does not have",
+                    "clearcoat_normal_map",
                 ))
             }
             (None, None) => None,

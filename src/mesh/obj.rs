@@ -368,44 +368,10 @@ fn load_mtl(path: &Path, error: &RefCell<Option<MeshError>>) -> tobj::MTLLoadRes
     };
     match tobj::load_mtl_buf(&mut text.as_bytes()) {
         Ok(r) => {
-            // tobj keeps `Tr` as text, and reads `inf` and `nan` as numbers;
-            // check them here, where the line is known.
-            for (line, keyword, words) in lines(&text) {
-                let mut numbers = words.take(3).map(|w| w.parse::<f32>().ok());
-                let first = numbers.next().flatten();
-                if keyword == "Tr" && first.is_none() {
-                    return fail(MeshError::new(path, Some(line), "Tr needs a number"));
-                }
-                let colour = matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke" | "Tf");
-                let scalar = matches!(
-                    keyword,
-                    "Ns" | "Ni"
-                        | "d"
-                        | "Tr"
-                        | "Pr"
-                        | "Pm"
-                        | "Ps"
-                        | "Pc"
-                        | "Pcr"
-                        | "aniso"
-                        | "anisor"
-                );
-                let infinite = std::iter::once(first)
-                    .chain(numbers)
-                    .flatten()
-                    .any(|v| !v.is_finite());
-                if (colour || scalar) && infinite {
-                    let what = if colour {
-                        "finite numbers"
-                    } else {
-                        "a finite number"
-                    };
-                    return fail(MeshError::new(
-                        path,
-                        Some(line),
-                        format!("{keyword} needs {what}"),
-                    ));
-                }
+            // tobj keeps `Tr` as text, and reads `inf` and `nan` as numbers:
+            // what it accepted is checked line by line all the same.
+            if let Some((line, msg)) = bad_mtl_line(&text) {
+                return fail(MeshError::new(path, Some(line), msg));
             }
             Ok(r)
         }
@@ -454,7 +420,16 @@ fn check_mtl<'a>(path: &Path, text: &'a str) -> Result<Cow<'a, str>, MeshError> 
 
 /// Turns a tobj MTL error into one that names the line at fault.
 fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
-    let found = lines(text).find_map(|(line, keyword, words)| {
+    match bad_mtl_line(text) {
+        Some((line, msg)) => MeshError::new(path, Some(line), msg),
+        None => MeshError::new(path, None, format!("invalid MTL: {e}")),
+    }
+}
+
+/// The first line of an MTL file that is malformed, and what is wrong
+/// with it.
+fn bad_mtl_line(text: &str) -> Option<(usize, String)> {
+    lines(text).find_map(|(line, keyword, words)| {
         let words: Vec<&str> = words.collect();
         let number =
             |w: Option<&&str>| w.is_some_and(|w| w.parse::<f32>().is_ok_and(f32::is_finite));
@@ -464,7 +439,7 @@ fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
                 .then(|| "newmtl without a name".to_string()),
             "Ka" | "Kd" | "Ks" | "Ke" => (!words.iter().take(3).all(|w| number(Some(w))))
                 .then(|| format!("{keyword} needs finite numbers")),
-            "Ns" | "Ni" | "d" => {
+            "Ns" | "Ni" | "d" | "Tr" => {
                 (!number(words.first())).then(|| format!("{keyword} needs a finite number"))
             }
             "illum" => words
@@ -477,11 +452,7 @@ fn mtl_error(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
             _ => None,
         };
         bad.map(|msg| (line, msg))
-    });
-    match found {
-        Some((line, msg)) => MeshError::new(path, Some(line), msg),
-        None => MeshError::new(path, None, format!("invalid MTL: {e}")),
-    }
+    })
 }
 
 /// The images an MTL file's materials name, each read once.

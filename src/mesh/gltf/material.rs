@@ -35,12 +35,6 @@ pub(super) const SUPPORTED: &[&str] = &[
 /// Extensions that change nothing lumen renders, accepted without a word.
 pub(super) const HARMLESS: &[&str] = &["KHR_xmp", "KHR_xmp_json_ld", "KHR_materials_variants"];
 
-/// The parts of a glTF file's JSON that materials refer to.
-pub(super) struct Json<'a> {
-    /// The whole document.
-    pub root: &'a Value,
-}
-
 /// A texture reference read from a material: the texture, its channel and
 /// encoding, and how it is mapped.
 struct TextureRef {
@@ -52,12 +46,12 @@ struct TextureRef {
 /// Reads material `i` of `json`, its textures resolved against the decoded
 /// `images`; `warn` collects what lumen reads but does not render.
 fn material(
-    json: &Json,
+    json: &Value,
     i: usize,
     images: &[Option<Arc<Image>>],
     warn: &mut dyn FnMut(String),
 ) -> Result<MeshMaterial, String> {
-    let m = &json.root["materials"][i];
+    let m = &json["materials"][i];
     let name = m["name"]
         .as_str()
         .map_or_else(|| format!("material {i}"), str::to_string);
@@ -94,6 +88,44 @@ fn material(
             uv_set: r.uv_set,
         }))
     };
+    // A factor of `obj` within [0, hi] and its texture, one channel of the
+    // image, read as it is.
+    let scalar = |obj: &Value,
+                  factor: &str,
+                  default: f32,
+                  hi: f32,
+                  texture: &str,
+                  channel: u8|
+     -> Result<Mapped<f32>, String> {
+        Ok(Mapped {
+            value: number(&obj[factor], default, 0.0, hi)
+                .map_err(|e| at(&format!("{factor} {e}")))?,
+            map: map(&obj[texture], texture, Channels::One(channel), false)?,
+        })
+    };
+    // A colour factor of `obj` within [0, hi] and its sRGB texture.
+    let color = |obj: &Value,
+                 factor: &str,
+                 default: [f32; 3],
+                 hi: f32,
+                 texture: &str|
+     -> Result<Mapped<[f32; 3]>, String> {
+        Ok(Mapped {
+            value: numbers::<3>(&obj[factor], default, 0.0, hi)
+                .map_err(|e| at(&format!("{factor} {e}")))?,
+            map: map(&obj[texture], texture, Channels::Rgb, true)?,
+        })
+    };
+    // A normal texture of `obj` and its scale.
+    let normal = |obj: &Value, texture: &str| -> Result<Option<(ImageMap, f32)>, String> {
+        let info = &obj[texture];
+        let Some(n) = map(info, texture, Channels::Rgb, false)? else {
+            return Ok(None);
+        };
+        let scale = number(&info["scale"], 1.0, f32::MIN, f32::MAX)
+            .map_err(|e| at(&format!("{texture}.scale {e}")))?;
+        Ok(Some((n, scale)))
+    };
     let pbr = &m["pbrMetallicRoughness"];
     let base = numbers::<4>(&pbr["baseColorFactor"], [1.0; 4], 0.0, 1.0)
         .map_err(|e| at(&format!("baseColorFactor {e}")))?;
@@ -106,34 +138,29 @@ fn material(
         value: base[3],
         map: map(base_map, "baseColorTexture", Channels::One(3), false)?,
     };
-    out.metallic = Mapped {
-        value: number(&pbr["metallicFactor"], 1.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("metallicFactor {e}")))?,
-        map: map(
-            &pbr["metallicRoughnessTexture"],
-            "metallicRoughnessTexture",
-            Channels::One(2),
-            false,
-        )?,
-    };
-    out.roughness = Mapped {
-        value: number(&pbr["roughnessFactor"], 1.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("roughnessFactor {e}")))?,
-        map: map(
-            &pbr["metallicRoughnessTexture"],
-            "metallicRoughnessTexture",
-            Channels::One(1),
-            false,
-        )?,
-    };
-    let normal = &m["normalTexture"];
-    if let Some(n) = map(normal, "normalTexture", Channels::Rgb, false)? {
-        if let Some(problem) = n.image.normal_map_problem() {
-            return Err(at(&format!("normalTexture: its image {problem}")));
-        }
-        let scale = number(&normal["scale"], 1.0, f32::MIN, f32::MAX)
-            .map_err(|e| at(&format!("normalTexture.scale {e}")))?;
-        out.normal_map = Some((n, scale));
+    out.metallic = scalar(
+        pbr,
+        "metallicFactor",
+        1.0,
+        1.0,
+        "metallicRoughnessTexture",
+        2,
+    )?;
+    out.roughness = scalar(
+        pbr,
+        "roughnessFactor",
+        1.0,
+        1.0,
+        "metallicRoughnessTexture",
+        1,
+    )?;
+    out.normal_map = normal(m, "normalTexture")?;
+    if let Some(problem) = out
+        .normal_map
+        .as_ref()
+        .and_then(|(n, _)| n.image.normal_map_problem())
+    {
+        return Err(at(&format!("normalTexture: its image {problem}")));
     }
     let ext = &m["extensions"];
     let strength = number(
@@ -143,17 +170,8 @@ fn material(
         f32::MAX,
     )
     .map_err(|e| at(&format!("emissiveStrength {e}")))?;
-    let emissive = numbers::<3>(&m["emissiveFactor"], [0.0; 3], 0.0, f32::MAX)
-        .map_err(|e| at(&format!("emissiveFactor {e}")))?;
-    out.emission = Mapped {
-        value: emissive.map(|e| e * strength),
-        map: map(
-            &m["emissiveTexture"],
-            "emissiveTexture",
-            Channels::Rgb,
-            true,
-        )?,
-    };
+    out.emission = color(m, "emissiveFactor", [0.0; 3], f32::MAX, "emissiveTexture")?;
+    out.emission.value = out.emission.value.map(|e| e * strength);
     out.alpha_mode = match m["alphaMode"].as_str().unwrap_or("OPAQUE") {
         "OPAQUE" => AlphaMode::Opaque,
         "MASK" => AlphaMode::Mask(
@@ -183,100 +201,43 @@ fn material(
         out.ior = MAX_LAYER_IOR as f32;
     }
     let s = &ext["KHR_materials_specular"];
-    out.specular = Mapped {
-        value: number(&s["specularFactor"], 1.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("specularFactor {e}")))?,
-        map: map(
-            &s["specularTexture"],
-            "specularTexture",
-            Channels::One(3),
-            false,
-        )?,
-    };
-    out.specular_color = Mapped {
-        value: numbers::<3>(&s["specularColorFactor"], [1.0; 3], 0.0, f32::MAX)
-            .map_err(|e| at(&format!("specularColorFactor {e}")))?,
-        map: map(
-            &s["specularColorTexture"],
-            "specularColorTexture",
-            Channels::Rgb,
-            true,
-        )?,
-    };
+    out.specular = scalar(s, "specularFactor", 1.0, 1.0, "specularTexture", 3)?;
+    out.specular_color = color(
+        s,
+        "specularColorFactor",
+        [1.0; 3],
+        f32::MAX,
+        "specularColorTexture",
+    )?;
     let t = &ext["KHR_materials_transmission"];
-    out.transmission = Mapped {
-        value: number(&t["transmissionFactor"], 0.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("transmissionFactor {e}")))?,
-        map: map(
-            &t["transmissionTexture"],
-            "transmissionTexture",
-            Channels::One(0),
-            false,
-        )?,
-    };
+    out.transmission = scalar(t, "transmissionFactor", 0.0, 1.0, "transmissionTexture", 0)?;
     let v = &ext["KHR_materials_volume"];
-    out.thickness = Mapped {
-        value: number(&v["thicknessFactor"], 0.0, 0.0, f32::MAX)
-            .map_err(|e| at(&format!("thicknessFactor {e}")))?,
-        map: map(
-            &v["thicknessTexture"],
-            "thicknessTexture",
-            Channels::One(1),
-            false,
-        )?,
-    };
+    out.thickness = scalar(v, "thicknessFactor", 0.0, f32::MAX, "thicknessTexture", 1)?;
     out.attenuation_color = numbers::<3>(&v["attenuationColor"], [1.0; 3], 0.0, 1.0)
         .map_err(|e| at(&format!("attenuationColor {e}")))?;
     out.attenuation_distance = number(&v["attenuationDistance"], f32::INFINITY, 0.0, f32::INFINITY)
         .map_err(|e| at(&format!("attenuationDistance {e}")))?;
     let c = &ext["KHR_materials_clearcoat"];
-    out.clearcoat = Mapped {
-        value: number(&c["clearcoatFactor"], 0.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("clearcoatFactor {e}")))?,
-        map: map(
-            &c["clearcoatTexture"],
-            "clearcoatTexture",
-            Channels::One(0),
-            false,
-        )?,
-    };
-    out.clearcoat_roughness = Mapped {
-        value: number(&c["clearcoatRoughnessFactor"], 0.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("clearcoatRoughnessFactor {e}")))?,
-        map: map(
-            &c["clearcoatRoughnessTexture"],
-            "clearcoatRoughnessTexture",
-            Channels::One(1),
-            false,
-        )?,
-    };
-    let coat_normal = &c["clearcoatNormalTexture"];
-    if let Some(n) = map(coat_normal, "clearcoatNormalTexture", Channels::Rgb, false)? {
-        let scale = number(&coat_normal["scale"], 1.0, f32::MIN, f32::MAX)
-            .map_err(|e| at(&format!("clearcoatNormalTexture.scale {e}")))?;
-        out.clearcoat_normal_map = Some((n, scale));
-    }
+    out.clearcoat = scalar(c, "clearcoatFactor", 0.0, 1.0, "clearcoatTexture", 0)?;
+    out.clearcoat_roughness = scalar(
+        c,
+        "clearcoatRoughnessFactor",
+        0.0,
+        1.0,
+        "clearcoatRoughnessTexture",
+        1,
+    )?;
+    out.clearcoat_normal_map = normal(c, "clearcoatNormalTexture")?;
     let sh = &ext["KHR_materials_sheen"];
-    out.sheen_color = Mapped {
-        value: numbers::<3>(&sh["sheenColorFactor"], [0.0; 3], 0.0, 1.0)
-            .map_err(|e| at(&format!("sheenColorFactor {e}")))?,
-        map: map(
-            &sh["sheenColorTexture"],
-            "sheenColorTexture",
-            Channels::Rgb,
-            true,
-        )?,
-    };
-    out.sheen_roughness = Mapped {
-        value: number(&sh["sheenRoughnessFactor"], 0.0, 0.0, 1.0)
-            .map_err(|e| at(&format!("sheenRoughnessFactor {e}")))?,
-        map: map(
-            &sh["sheenRoughnessTexture"],
-            "sheenRoughnessTexture",
-            Channels::One(3),
-            false,
-        )?,
-    };
+    out.sheen_color = color(sh, "sheenColorFactor", [0.0; 3], 1.0, "sheenColorTexture")?;
+    out.sheen_roughness = scalar(
+        sh,
+        "sheenRoughnessFactor",
+        0.0,
+        1.0,
+        "sheenRoughnessTexture",
+        3,
+    )?;
     if let Some(exts) = ext.as_object() {
         for name in exts.keys() {
             if !SUPPORTED.contains(&name.as_str()) && !HARMLESS.contains(&name.as_str()) {
@@ -292,24 +253,24 @@ fn material(
 /// image files are read from.
 pub(super) fn materials<'b>(
     path: &Path,
-    json: &Json,
+    json: &Value,
     view_bytes: &(dyn Fn(usize) -> Option<&'b [u8]> + Sync),
     read_uri: &(dyn Fn(&str) -> Result<Vec<u8>, String> + Sync),
     warnings: &mut Vec<String>,
 ) -> Result<Vec<MeshMaterial>, MeshError> {
     let err = |m: String| MeshError::new(path, None, m);
-    let n = json.root["materials"].as_array().map_or(0, Vec::len);
+    let n = json["materials"].as_array().map_or(0, Vec::len);
     // The images the materials use (through their textures).
     let mut used = BTreeSet::new();
     for i in 0..n {
         let mut found = Vec::new();
-        texture_indices(&json.root["materials"][i], &mut found);
+        texture_indices(&json["materials"][i], &mut found);
         for t in found {
-            let source = json.root["textures"][t]["source"].as_u64();
+            let source = json["textures"][t]["source"].as_u64();
             let source = source.ok_or_else(|| {
                 err(format!(
                     "material {i}: texture {t} {}",
-                    if json.root["textures"][t].is_null() {
+                    if json["textures"][t].is_null() {
                         "does not exist"
                     } else {
                         "has no image (`source`), or one only an extension lumen lacks can read"
@@ -319,7 +280,7 @@ pub(super) fn materials<'b>(
             used.insert(source as usize);
         }
     }
-    let count = json.root["images"].as_array().map_or(0, Vec::len);
+    let count = json["images"].as_array().map_or(0, Vec::len);
     if let Some(&bad) = used.iter().find(|&&i| i >= count) {
         return Err(err(format!(
             "image {bad} does not exist (the file has {count})"
@@ -362,13 +323,13 @@ fn texture_indices(v: &Value, out: &mut Vec<usize>) {
 /// The bytes of image `i` decoded: from its buffer view or its URI; PNG
 /// and JPEG only.
 fn decode_image<'b>(
-    json: &Json,
+    json: &Value,
     i: usize,
     view_bytes: &(dyn Fn(usize) -> Option<&'b [u8]> + Sync),
     read_uri: &(dyn Fn(&str) -> Result<Vec<u8>, String> + Sync),
     path: &Path,
 ) -> Result<Image, String> {
-    let image = &json.root["images"][i];
+    let image = &json["images"][i];
     let owned;
     let bytes: &[u8] = if let Some(view) = image["bufferView"].as_u64() {
         view_bytes(view as usize).ok_or_else(|| {
@@ -393,8 +354,8 @@ fn decode_image<'b>(
 }
 
 /// The decoded image of texture `t`.
-fn image_of(json: &Json, t: usize, images: &[Option<Arc<Image>>]) -> Result<Arc<Image>, String> {
-    let source = json.root["textures"][t]["source"]
+fn image_of(json: &Value, t: usize, images: &[Option<Arc<Image>>]) -> Result<Arc<Image>, String> {
+    let source = json["textures"][t]["source"]
         .as_u64()
         .ok_or_else(|| format!("texture {t} has no image"))? as usize;
     images
@@ -406,11 +367,11 @@ fn image_of(json: &Json, t: usize, images: &[Option<Arc<Image>>]) -> Result<Arc<
 
 /// The wrap modes and filter of texture `t`'s sampler (repeat and linear
 /// without one).
-fn sampler_of(json: &Json, t: usize) -> Result<([Wrap; 2], Filter), String> {
-    let Some(s) = json.root["textures"][t]["sampler"].as_u64() else {
+fn sampler_of(json: &Value, t: usize) -> Result<([Wrap; 2], Filter), String> {
+    let Some(s) = json["textures"][t]["sampler"].as_u64() else {
         return Ok(([Wrap::Repeat; 2], Filter::Bilinear));
     };
-    let sampler = &json.root["samplers"][s as usize];
+    let sampler = &json["samplers"][s as usize];
     if sampler.is_null() {
         return Err(format!("texture {t}: sampler {s} does not exist"));
     }

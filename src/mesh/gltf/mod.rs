@@ -32,12 +32,14 @@ mod material;
 pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let err = |msg: String| MeshError::new(path, None, msg);
     check_glb_header(&bytes).map_err(err)?;
+    // Some of the crate's messages say "invalid glTF" already.
     let invalid = |e: gltf::Error| {
         let e = e.to_string();
-        match e.strip_prefix("invalid glTF: ") {
-            Some(rest) => err(format!("invalid glTF: {rest}")),
-            None => err(format!("invalid glTF: {e}")),
-        }
+        err(if e.starts_with("invalid glTF: ") {
+            e
+        } else {
+            format!("invalid glTF: {e}")
+        })
     };
     // The JSON as written, for what the crate does not read (material
     // extensions) and for the extensions the file needs, checked first.
@@ -61,13 +63,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
         data.get(view.offset()..view.offset().checked_add(view.length())?)
     };
     let uri_bytes = |uri: &str| read_uri(dir, uri);
-    let materials = material::materials(
-        path,
-        &material::Json { root: &raw },
-        &view_bytes,
-        &uri_bytes,
-        &mut warnings,
-    )?;
+    let materials = material::materials(path, &raw, &view_bytes, &uri_bytes, &mut warnings)?;
     warnings.extend(unrendered(&raw));
     let mut model = Model {
         materials,
