@@ -460,24 +460,21 @@ material = "veil"
     assert_eq!(hits(&scene), stopped, "the same rays stop");
 }
 
-/// Principled glass with a volume darkens light by Beer–Lambert over the
-/// distance it travels inside: a white sky seen through a ball of
-/// attenuation colour c at distance d takes a tint of about c^(2r/d).
-#[test]
-fn principled_volumes_absorb_along_the_path_inside() {
-    let dir = scratch_dir("materials-volume");
-    let text = |attenuation: &str| {
-        format!(
-            r#"
+/// A scene file: a ball of radius 1 at the origin in `material` (the body
+/// of its table), under a white sky, seen from 10 away across a field of
+/// `vfov` degrees, 8 × 8 pixels at `spp` samples and paths of `depth`.
+fn ball_under_white_sky(material: &str, spp: u32, depth: u32, vfov: f64) -> String {
+    format!(
+        r#"
 [render]
 width = 8
 height = 8
-samples_per_pixel = 64
-max_depth = 32
+samples_per_pixel = {spp}
+max_depth = {depth}
 integrator = "path"
 
 [camera]
-vfov = 2
+vfov = {vfov}
 lookfrom = [0, 0, 10]
 lookat = [0, 0, 0]
 
@@ -485,23 +482,27 @@ lookat = [0, 0, 0]
 type = "solid"
 color = [1, 1, 1]
 
-[materials.glass]
-type = "principled"
-base_color = [1, 1, 1]
-transmission = 1
-roughness = 0
-specular = 0
-thickness = 1
-{attenuation}
+[materials.ball]
+{material}
 
 [[objects]]
 type = "sphere"
 center = [0, 0, 0]
 radius = 1
-material = "glass"
+material = "ball"
 "#
-        )
-    };
+    )
+}
+
+/// Principled glass with a volume darkens light by Beer–Lambert over the
+/// distance it travels inside: a white sky seen through a ball of
+/// attenuation colour c at distance d takes a tint of about c^(2r/d).
+#[test]
+fn principled_volumes_absorb_along_the_path_inside() {
+    let dir = scratch_dir("materials-volume");
+    let glass = "type = \"principled\"\nbase_color = [1, 1, 1]\ntransmission = 1\nroughness = 0\nspecular = 0\nthickness = 1";
+    let text =
+        |attenuation: &str| ball_under_white_sky(&format!("{glass}\n{attenuation}"), 64, 32, 2.0);
     let mean = |scene: &Scene| {
         let stats = common::pixel_stats(scene);
         let n = stats.mean.len() as f64;
@@ -530,8 +531,8 @@ material = "glass"
         &text("attenuation_color = [0.5, 1, 1]\nattenuation_distance = 2")
             .replace("thickness = 1", "thickness = \"zero\"")
             .replace(
-                "[materials.glass]",
-                "[textures.zero]\ntype = \"image\"\nfile = \"zero.png\"\nchannel = \"r\"\n\n[materials.glass]",
+                "[materials.ball]",
+                "[textures.zero]\ntype = \"image\"\nfile = \"zero.png\"\nchannel = \"r\"\n\n[materials.ball]",
             ),
     ));
     assert!(
@@ -551,38 +552,7 @@ fn glass_of_index_one_lets_light_straight_through() {
         "type = \"principled\"\ntransmission = 1\nthickness = 1\nbase_color = [1, 1, 1]\nroughness = 0\nspecular = 0\nior = 1",
         "type = \"dielectric\"\nior = 1\nroughness = 0.05",
     ] {
-        let scene = compile_file(
-            &dir,
-            "one.toml",
-            &format!(
-                r#"
-[render]
-width = 8
-height = 8
-samples_per_pixel = 32
-max_depth = 16
-integrator = "path"
-
-[camera]
-vfov = 5
-lookfrom = [0, 0, 10]
-lookat = [0, 0, 0]
-
-[background]
-type = "solid"
-color = [1, 1, 1]
-
-[materials.air]
-{material}
-
-[[objects]]
-type = "sphere"
-center = [0, 0, 0]
-radius = 1
-material = "air"
-"#
-            ),
-        );
+        let scene = compile_file(&dir, "one.toml", &ball_under_white_sky(material, 32, 16, 5.0));
         let stats = common::pixel_stats(&scene);
         let mean: f64 = stats.mean.iter().map(|p| p[0]).sum::<f64>() / stats.mean.len() as f64;
         assert!((mean - 1.0).abs() < 0.02, "{material}: {mean}");
