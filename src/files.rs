@@ -71,7 +71,7 @@ pub fn temp_path_of(path: &Path, pid: u32) -> PathBuf {
 }
 
 /// What a path that exists but is not a regular file is, in words.
-fn kind(meta: &fs::Metadata) -> &'static str {
+pub fn kind(meta: &fs::Metadata) -> &'static str {
     let t = meta.file_type();
     if t.is_dir() {
         return "a directory";

@@ -157,6 +157,7 @@ fn overrides_replace_the_files_settings() {
         integrator: Some(Integrator::Bsdf),
         light_selection: Some(LightSelection::Uniform),
         noise_target: Some(0.25),
+        allow_outside: false,
     };
     let s = file.compile(&o).unwrap().settings;
     assert_eq!((s.width, s.height), (40, 20), "height keeps the proportion");

@@ -208,6 +208,7 @@ fn expected() -> SceneDesc {
             file: "tetra.obj".into(),
             material: None,
             smooth: true,
+            allow_outside: false,
             transform: vec![TransformDesc::Matrix([
                 [1.0, 0.0, 0.0, 0.5],
                 [0.0, 1.0, 0.0, 0.0],
@@ -219,6 +220,7 @@ fn expected() -> SceneDesc {
             file: "tetra.obj".into(),
             material: Some("gold".into()),
             smooth: false,
+            allow_outside: false,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [1.0, 1.0, 0.0],
@@ -351,6 +353,7 @@ fn every_step_form_reads_alone() {
                     file: "t.obj".into(),
                     material: None,
                     smooth: true,
+                    allow_outside: false,
                     transform: vec![step.clone()],
                 },
             ),

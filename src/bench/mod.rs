@@ -90,6 +90,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
         file: file.into(),
         material: Some("bunny".into()),
         smooth: false,
+        allow_outside: false,
         transform: Vec::new(),
     });
     desc
@@ -122,6 +123,7 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
             file: file.into(),
             material: Some("bunny".into()),
             smooth: false,
+            allow_outside: false,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [0.0, 1.0, 0.0],

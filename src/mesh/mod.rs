@@ -309,18 +309,38 @@ impl fmt::Display for MeshError {
 /// The file extensions [`load`] accepts.
 pub const SUPPORTED_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ply"];
 
+/// How a mesh file is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Whether the files a model names (glTF buffers and images, MTL files
+    /// and their maps) may lie outside the model's folder. Off by default:
+    /// scene files and models travel, and a model must not read the machine
+    /// it is rendered on (`"uri": "/etc/passwd"`).
+    pub allow_outside: bool,
+}
+
 /// Loads a mesh file, choosing the format by extension (case-insensitive):
 /// `.obj` (with the MTL files it names; a missing MTL file only means no
-/// materials), `.gltf`, `.glb` or `.ply` (no materials).
+/// materials), `.gltf`, `.glb` or `.ply` (no materials). The files the model
+/// names must be inside its folder; see [`load_with`].
 pub fn load(path: &Path) -> Result<Model, MeshError> {
+    load_with(path, LoadOptions::default())
+}
+
+/// [`load`] with the given options.
+pub fn load_with(path: &Path, options: LoadOptions) -> Result<Model, MeshError> {
+    // What the file is matters before what it is called.
+    crate::input::check(path).map_err(|e| MeshError::new(path, None, e.to_string()))?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let format = match ext.as_deref() {
+    type Reader = fn(&Path, Vec<u8>, LoadOptions) -> Result<Model, MeshError>;
+    let format: Reader = match ext.as_deref() {
         Some("obj") => obj::load,
         Some("gltf") | Some("glb") => gltf::load,
-        Some("ply") => ply::load,
+        // PLY names no other file.
+        Some("ply") => |path, bytes, _| ply::load(path, bytes),
         _ => {
             return Err(MeshError::new(
                 path,
@@ -337,24 +357,60 @@ pub fn load(path: &Path) -> Result<Model, MeshError> {
     let mut model = Model {
         file_crc,
         file_len,
-        ..format(path, bytes)?
+        ..format(path, bytes, options)?
     };
     model.generate_tangents();
     Ok(model)
 }
 
-/// Reads a whole file, with a clear error for a missing file or a directory.
+/// Reads a whole mesh file: a regular file of at most
+/// [`MAX_MESH_BYTES`](crate::input::MAX_MESH_BYTES).
 fn read_file(path: &Path) -> Result<Vec<u8>, MeshError> {
-    if path.is_dir() {
-        return Err(MeshError::new(path, None, "is a directory, not a file"));
+    crate::input::read(path, crate::input::MAX_MESH_BYTES)
+        .map_err(|e| MeshError::new(path, None, e.to_string()))
+}
+
+/// Checks that the model whose folder is `folder` may read `path` (a file
+/// it names, written `shown`): inside `folder`, once links and `..` are
+/// resolved, unless `options` allow files outside. A file that does not
+/// exist passes, for the reader to report.
+pub(crate) fn confined(
+    folder: &Path,
+    path: &Path,
+    shown: &str,
+    options: LoadOptions,
+) -> Result<(), String> {
+    if options.allow_outside {
+        return Ok(());
     }
-    std::fs::read(path).map_err(|e| {
-        let why = match e.kind() {
-            std::io::ErrorKind::NotFound => "no such file".to_string(),
-            _ => format!("cannot read: {e}"),
-        };
-        MeshError::new(path, None, why)
-    })
+    let outside = || {
+        format!(
+            "`{shown}` is outside the model's folder; a model reads only files in its folder \
+             unless its mesh object sets `allow_outside = true` (or lumen is given --allow-outside)"
+        )
+    };
+    // Refused as written, before anything is looked up.
+    let inside = path.strip_prefix(folder).ok().and_then(|rel| {
+        rel.components().try_fold(0usize, |depth, c| match c {
+            std::path::Component::ParentDir => depth.checked_sub(1),
+            std::path::Component::Normal(_) => Some(depth + 1),
+            std::path::Component::CurDir => Some(depth),
+            _ => None,
+        })
+    });
+    if inside.is_none() {
+        return Err(outside());
+    }
+    // And as found: a link inside the folder may lead out of it.
+    let dir = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
+    match (std::fs::canonicalize(dir), std::fs::canonicalize(path)) {
+        (Ok(dir), Ok(found)) if !found.starts_with(&dir) => Err(outside()),
+        _ => Ok(()),
+    }
 }
 
 #[cfg(test)]

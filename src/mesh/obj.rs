@@ -24,7 +24,11 @@ use std::sync::Arc;
 
 /// Loads an OBJ file and the MTL files it names.
 /// `bytes` are the file's content.
-pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
+pub(super) fn load(
+    path: &Path,
+    bytes: Vec<u8>,
+    load_options: super::LoadOptions,
+) -> Result<Model, MeshError> {
     let text = utf8(path, &bytes)?;
     let text = check_faces(path, text)?;
 
@@ -44,6 +48,14 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
             return Err(tobj::LoadError::OpenFileFailed);
         }
         let file = dir.join(name);
+        if let Err(why) = super::confined(&dir, &file, &name.to_string_lossy(), load_options) {
+            mtl_error.borrow_mut().get_or_insert(MeshError::new(
+                path,
+                None,
+                format!("mtllib: {why}"),
+            ));
+            return Err(tobj::LoadError::GenericFailure);
+        }
         *mtl_path.borrow_mut() = Some(file.clone());
         load_mtl(&file, &mtl_error)
     });
@@ -54,7 +66,11 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     // A missing MTL file leaves the materials empty (or an error that only
     // says so); the triangles then have no material.
     let mtl = mtl_path.borrow().clone();
-    let mut images = Images::default();
+    let mut images = Images {
+        read: HashMap::new(),
+        folder: dir.clone(),
+        options: load_options,
+    };
     let materials: Vec<MeshMaterial> = materials
         .unwrap_or_default()
         .iter()
@@ -351,12 +367,10 @@ fn load_mtl(path: &Path, error: &RefCell<Option<MeshError>>) -> tobj::MTLLoadRes
         error.borrow_mut().get_or_insert(e);
         Err(tobj::LoadError::GenericFailure)
     };
-    let bytes = match std::fs::read(path) {
+    let bytes = match crate::input::read(path, crate::input::MAX_MTL_BYTES) {
         Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(tobj::LoadError::OpenFileFailed)
-        }
-        Err(e) => return fail(MeshError::new(path, None, format!("cannot read: {e}"))),
+        Err(crate::input::ReadError::NotFound) => return Err(tobj::LoadError::OpenFileFailed),
+        Err(e) => return fail(MeshError::new(path, None, e.to_string())),
     };
     let text = match utf8(path, &bytes) {
         Ok(t) => t,
@@ -456,9 +470,11 @@ fn bad_mtl_line(text: &str) -> Option<(usize, String)> {
 }
 
 /// The images an MTL file's materials name, each read once.
-#[derive(Default)]
 struct Images {
     read: HashMap<PathBuf, Arc<Image>>,
+    /// The model's folder, which the images must be in.
+    folder: PathBuf,
+    options: super::LoadOptions,
 }
 
 impl Images {
@@ -468,6 +484,7 @@ impl Images {
         if let Some(image) = self.read.get(&path) {
             return Ok(image.clone());
         }
+        super::confined(&self.folder, &path, file, self.options)?;
         let image = Arc::new(Image::read(&path).map_err(|e| e.to_string())?);
         self.read.insert(path, image.clone());
         Ok(image)

@@ -476,6 +476,9 @@ pub struct Overrides {
     pub light_selection: Option<LightSelection>,
     /// The noise target of adaptive sampling.
     pub noise_target: Option<f64>,
+    /// Lets every mesh object's files lie outside its folder, as
+    /// `allow_outside = true` on each would.
+    pub allow_outside: bool,
 }
 
 impl Overrides {
@@ -510,6 +513,13 @@ impl Overrides {
         }
         if let Some(t) = self.noise_target {
             r.noise_target = Some(t);
+        }
+        if self.allow_outside {
+            for object in &mut desc.objects {
+                if let desc::ObjectDesc::Mesh { allow_outside, .. } = object {
+                    *allow_outside = true;
+                }
+            }
         }
     }
 }

@@ -88,9 +88,11 @@ impl Image {
     /// Reads an image file (`.exr`, `.hdr`, `.png`, `.jpg`/`.jpeg`, by its
     /// content); see [`Image::decode`].
     pub fn read(path: &Path) -> Result<Image, ImageError> {
-        let bytes = std::fs::read(path).map_err(|e| ImageError::Read {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        let bytes = crate::input::read(path, crate::input::MAX_IMAGE_BYTES).map_err(|e| {
+            ImageError::Read {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            }
         })?;
         Image::decode(&bytes, &path.display().to_string())
     }

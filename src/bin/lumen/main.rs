@@ -259,6 +259,11 @@ struct SettingArgs {
     /// error is at most this (e.g. 0.01); --spp stays the upper bound.
     #[arg(long, value_name = "ERROR")]
     noise_target: Option<f64>,
+    /// Let mesh files read files outside their folder (glTF buffers and
+    /// images, MTL files and maps), as `allow_outside = true` on every mesh
+    /// object does.
+    #[arg(long)]
+    allow_outside: bool,
     /// Worker threads (default: one per core). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
     threads: Option<u32>,
@@ -312,6 +317,7 @@ impl SettingArgs {
             integrator: self.integrator.map(Integrator::from),
             light_selection: self.light_selection.map(LightSelection::from),
             noise_target: self.noise_target,
+            allow_outside: self.allow_outside,
         }
     }
 }

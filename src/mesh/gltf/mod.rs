@@ -29,7 +29,11 @@ mod material;
 
 /// Loads a `.gltf` or `.glb` file.
 /// `bytes` are the file's content.
-pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
+pub(super) fn load(
+    path: &Path,
+    bytes: Vec<u8>,
+    options: super::LoadOptions,
+) -> Result<Model, MeshError> {
     let err = |msg: String| MeshError::new(path, None, msg);
     check_glb_header(&bytes).map_err(err)?;
     // Some of the crate's messages say "invalid glTF" already.
@@ -53,7 +57,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     // Checked above; the crate would refuse those it was not built for.
     json.extensions_required.clear();
     let document = gltf::Document::from_json(json).map_err(invalid)?;
-    let buffers = load_buffers(path, &document, blob)?;
+    let buffers = load_buffers(path, &document, blob, options)?;
 
     let dir = path.parent().unwrap_or(Path::new(""));
     let views: Vec<gltf::buffer::View> = document.views().collect();
@@ -62,7 +66,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
         let data = buffers.get(view.buffer().index())?;
         data.get(view.offset()..view.offset().checked_add(view.length())?)
     };
-    let uri_bytes = |uri: &str| read_uri(dir, uri);
+    let uri_bytes = |uri: &str| read_uri(dir, uri, options, None);
     let materials = material::materials(path, &raw, &view_bytes, &uri_bytes, &mut warnings)?;
     warnings.extend(unrendered(&raw));
     let mut model = Model {
@@ -170,9 +174,16 @@ fn check_attribute_indices(json: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
-/// The bytes a URI of the file names: a base64 data URI, or a file beside
-/// the glTF file (`dir`).
-fn read_uri(dir: &Path, uri: &str) -> Result<Vec<u8>, String> {
+/// The bytes a URI of the file names: a base64 data URI, or a file in the
+/// glTF file's folder `dir` (or anywhere, if `options` allow it). A buffer's
+/// file is read to its declared `byteLength` (`length`) and no further; an
+/// image's whole, up to [`MAX_IMAGE_BYTES`](crate::input::MAX_IMAGE_BYTES).
+fn read_uri(
+    dir: &Path,
+    uri: &str,
+    options: super::LoadOptions,
+    length: Option<u64>,
+) -> Result<Vec<u8>, String> {
     if uri.starts_with("data:") {
         let (_, payload) = uri
             .split_once(";base64,")
@@ -187,7 +198,12 @@ fn read_uri(dir: &Path, uri: &str) -> Result<Vec<u8>, String> {
         ));
     }
     let file = dir.join(percent_decode(uri));
-    std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))
+    super::confined(dir, &file, uri, options)?;
+    let read = match length {
+        Some(n) => crate::input::read_prefix(&file, n, crate::input::MAX_MESH_BYTES),
+        None => crate::input::read(&file, crate::input::MAX_IMAGE_BYTES),
+    };
+    read.map_err(|e| format!("`{}`: {e}", file.display()))
 }
 
 /// The bytes of every buffer: the GLB's binary chunk, a base64 data URI, or a
@@ -196,16 +212,20 @@ fn load_buffers(
     path: &Path,
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
+    options: super::LoadOptions,
 ) -> Result<Vec<Vec<u8>>, MeshError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let err = |m: String| MeshError::new(path, None, format!("buffer {}: {m}", buffer.index()));
+        let length = buffer.length() as u64;
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
                 .take()
                 .ok_or_else(|| err("refers to the GLB binary chunk, which is missing".into()))?,
-            gltf::buffer::Source::Uri(uri) => read_uri(dir, uri).map_err(err)?,
+            gltf::buffer::Source::Uri(uri) => {
+                read_uri(dir, uri, options, Some(length)).map_err(err)?
+            }
         };
         if data.len() < buffer.length() {
             return Err(err(format!(

@@ -526,13 +526,17 @@ impl<'a> Objects<'a> {
                 file,
                 material,
                 smooth,
+                allow_outside,
                 ..
             } => {
                 let override_material = material
                     .as_deref()
                     .map(|name| self.material(i, name))
                     .transpose()?;
-                let path = self.load(i, file)?;
+                let options = mesh::LoadOptions {
+                    allow_outside: *allow_outside,
+                };
+                let path = self.load(i, file, options)?;
                 let model = &self.models[&path].model;
                 for (mesh, node) in &model.instances {
                     let node = mat4_transform(node).ok_or_else(|| {
@@ -562,13 +566,18 @@ impl<'a> Objects<'a> {
 
     /// Loads mesh file `file` of object `i` (once per file), returning
     /// where it was found.
-    fn load(&mut self, i: usize, file: &str) -> Result<PathBuf, SceneError> {
+    fn load(
+        &mut self,
+        i: usize,
+        file: &str,
+        options: mesh::LoadOptions,
+    ) -> Result<PathBuf, SceneError> {
         let path = model_path(self.base, file);
         if self.models.contains_key(&path) {
             return Ok(path);
         }
         let fail = |message: String| invalid(format!("objects[{i}].file"), message);
-        let model = mesh::load(&path).map_err(|e| fail(e.to_string()))?;
+        let model = mesh::load_with(&path, options).map_err(|e| fail(e.to_string()))?;
         self.sources.push(MeshSource {
             file: file.to_string(),
             crc: model.file_crc,

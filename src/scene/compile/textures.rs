@@ -310,8 +310,8 @@ pub(crate) fn read_image(
                 ))
             })?
             .to_vec(),
-        None => std::fs::read(&path)
-            .map_err(|e| fail(format!("cannot read {}: {e}", path.display())))?,
+        None => crate::input::read(&path, crate::input::MAX_IMAGE_BYTES)
+            .map_err(|e| fail(format!("{}: {e}", path.display())))?,
     };
     let image =
         Image::decode(&bytes, &path.display().to_string()).map_err(|e| fail(e.to_string()))?;

@@ -560,6 +560,11 @@ pub enum ObjectDesc {
         /// shades every triangle flat.
         #[serde(default = "yes", skip_serializing_if = "is_true")]
         smooth: bool,
+        /// Whether the files the mesh file names (glTF buffers and images,
+        /// MTL files and their maps) may lie outside its folder; see
+        /// [`LoadOptions`](crate::mesh::LoadOptions).
+        #[serde(default, skip_serializing_if = "is_false")]
+        allow_outside: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -606,6 +611,10 @@ fn yes() -> bool {
 
 fn is_true(b: &bool) -> bool {
     *b
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 impl ObjectDesc {

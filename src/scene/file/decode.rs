@@ -881,7 +881,14 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
         name: "mesh",
         kind: ObjectKind::Mesh,
         what: "a mesh",
-        fields: &["type", "file", "material", "smooth", "transform"],
+        fields: &[
+            "type",
+            "file",
+            "material",
+            "smooth",
+            "allow_outside",
+            "transform",
+        ],
         elsewhere: &[
             ("center", "spheres"),
             ("radius", "spheres"),
@@ -968,6 +975,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             file: t.require("file", what, string)?.to_string(),
             material: t.optional("material", string)?.map(str::to_string),
             smooth: t.optional("smooth", boolean)?.unwrap_or(true),
+            allow_outside: t.optional("allow_outside", boolean)?.unwrap_or(false),
             transform,
         },
         ObjectKind::Medium => ObjectDesc::Medium {

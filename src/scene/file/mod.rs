@@ -196,7 +196,8 @@ impl SceneFile {
         let format = Format::from_extension(path).ok_or_else(|| {
             fail("unknown scene file type: the name must end in .toml or .json".into())
         })?;
-        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let bytes = crate::input::read(path, crate::input::MAX_SCENE_BYTES)
+            .map_err(|e| fail(format!("the scene file {e}")))?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let offset = e.utf8_error().valid_up_to();
             let text = String::from_utf8_lossy(e.as_bytes()).into_owned();

@@ -1,0 +1,137 @@
+//! Taking memory without aborting. Rust's collections abort the process when
+//! the system refuses an allocation, and on Linux the system rarely refuses:
+//! it overcommits, and the out-of-memory killer ends the process later. So
+//! what an input makes lumen hold (a file read, a film, instances, a part's
+//! pixels) is counted first and checked against the memory this machine (or
+//! its container) has free, then reserved with `try_reserve`; either failing
+//! is an error that says how much was needed.
+
+use std::fmt;
+
+/// Memory that could not be had: what it was for, how many bytes, and how
+/// many were free when that is known.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MemoryError {
+    /// What needed it, in words ("the film", "the file").
+    pub what: String,
+    /// Bytes needed.
+    pub bytes: u64,
+    /// Bytes free, when the system says.
+    pub available: Option<u64>,
+}
+
+impl fmt::Display for MemoryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+        write!(
+            f,
+            "{} needs {:.2} GiB of memory",
+            self.what,
+            gib(self.bytes)
+        )?;
+        match self.available {
+            Some(free) => write!(
+                f,
+                ", more than the {:.2} GiB this machine has free",
+                gib(free)
+            ),
+            None => write!(f, ", which the system refused"),
+        }
+    }
+}
+
+impl std::error::Error for MemoryError {}
+
+/// Bytes of memory this process can still take: the system's
+/// `MemAvailable`, or less when a control group (a container, a Slurm job)
+/// sets a lower limit. `None` where the system does not say (not Linux).
+pub fn available() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse::<u64>()
+        .ok()?;
+    let system = kib.saturating_mul(1024);
+    Some(match cgroup_room() {
+        Some(room) => system.min(room),
+        None => system,
+    })
+}
+
+/// What a cgroup v2 memory limit leaves: `memory.max - memory.current` of
+/// this process's group, if it has a limit.
+fn cgroup_room() -> Option<u64> {
+    let group = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let rel = group.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = std::path::Path::new("/sys/fs/cgroup").join(rel.trim_start_matches('/'));
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).ok();
+    let max = read("memory.max")?.trim().parse::<u64>().ok()?; // "max": no limit
+    let current = read("memory.current")?.trim().parse::<u64>().unwrap_or(0);
+    Some(max.saturating_sub(current))
+}
+
+/// Checks that `bytes` more bytes can be had for `what`.
+pub fn check(bytes: u64, what: &str) -> Result<(), MemoryError> {
+    let fail = |available| MemoryError {
+        what: what.to_string(),
+        bytes,
+        available,
+    };
+    if bytes > isize::MAX as u64 {
+        return Err(fail(available()));
+    }
+    match available() {
+        Some(free) if bytes > free => Err(fail(Some(free))),
+        _ => Ok(()),
+    }
+}
+
+/// An empty vector with room for `n` elements, checked (see [`check`]) and
+/// reserved without aborting.
+pub fn vec_for<T>(n: u64, what: &str) -> Result<Vec<T>, MemoryError> {
+    let bytes = n.saturating_mul(std::mem::size_of::<T>() as u64);
+    check(bytes, what)?;
+    let mut v = Vec::new();
+    let n = usize::try_from(n).map_err(|_| MemoryError {
+        what: what.to_string(),
+        bytes,
+        available: None,
+    })?;
+    v.try_reserve_exact(n).map_err(|_| MemoryError {
+        what: what.to_string(),
+        bytes,
+        available: None,
+    })?;
+    Ok(v)
+}
+
+/// A vector of `n` copies of `value`, taken as [`vec_for`] takes it.
+pub fn filled<T: Clone>(n: u64, value: T, what: &str) -> Result<Vec<T>, MemoryError> {
+    let mut v = vec_for(n, what)?;
+    v.resize(n as usize, value);
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_amounts_are_had_and_impossible_ones_refused() {
+        let v: Vec<u64> = filled(1000, 7, "a test").unwrap();
+        assert_eq!((v.len(), v[999]), (1000, 7));
+        let e = vec_for::<u8>(1 << 62, "the film").unwrap_err();
+        assert_eq!(e.bytes, 1 << 62);
+        assert!(e.to_string().starts_with("the film needs"), "{e}");
+        let e = vec_for::<[u64; 4]>(u64::MAX / 2, "x").unwrap_err();
+        assert_eq!(e.bytes, u64::MAX);
+        if let Some(free) = available() {
+            assert!(free > 0);
+            assert!(check(free + (1 << 30), "more than free").is_err());
+        }
+    }
+}
