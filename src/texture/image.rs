@@ -51,6 +51,20 @@ pub enum ImageError {
     },
 }
 
+/// Most texels read from an image file: 2^28, a 16384 × 16384 image (1 GiB
+/// as 8-bit RGBA, 3 GiB as floating-point RGB).
+pub const MAX_TEXELS: u64 = 1 << 28;
+
+/// Bytes a texel of a decoded image of `color` takes as lumen keeps it.
+fn kept_bytes(color: ::image::ColorType) -> u64 {
+    use ::image::ColorType as C;
+    match color {
+        C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => 4,
+        C::L16 | C::La16 | C::Rgb16 | C::Rgba16 => 8,
+        _ => 12,
+    }
+}
+
 /// The file extensions [`Image::read`] accepts.
 pub const IMAGE_EXTENSIONS: &[&str] = &["exr", "hdr", "png", "jpg", "jpeg"];
 
@@ -108,11 +122,28 @@ impl Image {
             path: shown.clone(),
             message,
         };
-        let decoded = ::image::ImageReader::new(std::io::Cursor::new(bytes))
+        let mut decoder = ::image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| fail(e.to_string()))?
-            .decode()
+            .into_decoder()
             .map_err(|e| fail(e.to_string()))?;
+        // What the image will take is known from its header: a file of a few
+        // hundred kilobytes can declare gigabytes of texels, so they are
+        // counted and checked before any is decoded.
+        let (w, h) = ::image::ImageDecoder::dimensions(&decoder);
+        let texels = u64::from(w) * u64::from(h);
+        if texels > MAX_TEXELS {
+            return Err(fail(format!(
+                "it declares {w}x{h} texels, more than the {MAX_TEXELS} (16384x16384) lumen reads from an image"
+            )));
+        }
+        let kept = texels * kept_bytes(::image::ImageDecoder::color_type(&decoder));
+        let peak = ::image::ImageDecoder::total_bytes(&decoder).saturating_add(2 * kept);
+        crate::memory::check(peak, "decoding it").map_err(|e| fail(e.to_string()))?;
+        let mut limits = ::image::Limits::no_limits();
+        limits.max_alloc = Some(peak);
+        ::image::ImageDecoder::set_limits(&mut decoder, limits).map_err(|e| fail(e.to_string()))?;
+        let decoded = D::from_decoder(decoder).map_err(|e| fail(e.to_string()))?;
         let (width, height) = (decoded.width() as usize, decoded.height() as usize);
         if width == 0 || height == 0 {
             return Err(fail("the image is empty".into()));
@@ -343,5 +374,55 @@ mod tests {
         assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
         assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
         assert!((srgb_to_linear(0.04) - 0.04 / 12.92).abs() < 1e-9);
+    }
+}
+
+#[cfg(test)]
+mod bomb_tests {
+    use super::*;
+
+    /// A PNG chunk: length, type, data, CRC.
+    fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(kind);
+        c.extend_from_slice(data);
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(kind);
+        crc.update(data);
+        c.extend_from_slice(&crc.finalize().to_be_bytes());
+        c
+    }
+
+    /// A PNG of a few dozen bytes declaring a `w × h` greyscale image.
+    fn png_declaring(w: u32, h: u32) -> Vec<u8> {
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut ihdr = w.to_be_bytes().to_vec();
+        ihdr.extend_from_slice(&h.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 0, 0, 0, 0]);
+        png.extend(chunk(b"IHDR", &ihdr));
+        // An empty zlib stream: the texels the header promises are missing.
+        png.extend(chunk(
+            b"IDAT",
+            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+        ));
+        png.extend(chunk(b"IEND", &[]));
+        png
+    }
+
+    #[test]
+    fn images_declaring_too_many_texels_are_refused_from_their_header() {
+        let e = Image::decode(&png_declaring(23000, 23000), "bomb.png").unwrap_err();
+        let e = e.to_string();
+        assert!(
+            e.contains("bomb.png") && e.contains("23000x23000 texels"),
+            "{e}"
+        );
+        let hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n";
+        let e = Image::decode(hdr, "sky.hdr").unwrap_err().to_string();
+        assert!(e.contains("30000x30000 texels"), "{e}");
+        // At the limit the header passes, and the missing texels are what
+        // is refused.
+        let e = Image::decode(&png_declaring(16384, 16384), "big.png").unwrap_err();
+        assert!(!e.to_string().contains("texels, more than"), "{e}");
     }
 }
