@@ -12,8 +12,9 @@ use crate::math::Color;
 /// (see `docs/distributed.md`). Each sample is exact down to 2⁻⁶⁴ ≈ 5.4e-20
 /// (every `f32` from about 4.5e-13 up is kept whole; smaller values are cut
 /// to a multiple of 2⁻⁶⁴), and a pixel's sum holds up to 2⁶³ ≈ 9.2e18: a
-/// sample of 2⁶³ or more is dropped, like a NaN, and sums wrap (still
-/// associatively) only past that bound.
+/// sample of 2⁶³ or more is dropped, like a NaN, and so is a sample that
+/// would take its pixel's sum past that bound ([`RowMut::add`]), so that a
+/// sum never wraps; `lumen merge` refuses parts whose sums would.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Sum(pub [i128; 3]);
 
@@ -46,6 +47,18 @@ impl Sum {
     #[inline]
     pub fn plus(self, other: Sum) -> Sum {
         Sum([0, 1, 2].map(|c| self.0[c].wrapping_add(other.0[c])))
+    }
+
+    /// This sum plus `other`, channel by channel, or `None` if a channel
+    /// would pass what a sum holds (±2⁶³ in value).
+    #[inline(always)]
+    pub fn checked_plus(self, other: Sum) -> Option<Sum> {
+        let (a, fa) = self.0[0].overflowing_add(other.0[0]);
+        let (b, fb) = self.0[1].overflowing_add(other.0[1]);
+        let (c, fc) = self.0[2].overflowing_add(other.0[2]);
+        // One branch for the three: overflow is rare, and never in a sane
+        // scene.
+        (!(fa | fb | fc)).then_some(Sum([a, b, c]))
     }
 
     /// This sum minus `other`, channel by channel.
@@ -127,19 +140,26 @@ pub struct RowMut<'a> {
 
 impl RowMut<'_> {
     /// Adds sample `index` of pixel `x`, of colour `c`, unless it is NaN,
-    /// infinite or beyond what a [`Sum`] holds: such a sample is left out and
-    /// `false` is returned so the caller can count it.
+    /// infinite, beyond what a [`Sum`] holds, or would take the pixel's sum
+    /// past it: such a sample is left out and `false` is returned so the
+    /// caller can count it.
     #[inline(always)]
     pub fn add(&mut self, x: usize, index: u32, c: Color) -> bool {
         let Some(c) = Sum::of_color(c) else {
             return false;
         };
-        self.sums[x] = self.sums[x].plus(c);
-        self.counts[x] += 1;
+        let Some(sum) = self.sums[x].checked_plus(c) else {
+            return false;
+        };
         if index % 2 == 1 && !self.odd_counts.is_empty() {
-            self.odd_sums[x] = self.odd_sums[x].plus(c);
+            let Some(odd) = self.odd_sums[x].checked_plus(c) else {
+                return false;
+            };
+            self.odd_sums[x] = odd;
             self.odd_counts[x] += 1;
         }
+        self.sums[x] = sum;
+        self.counts[x] += 1;
         true
     }
 }
@@ -222,8 +242,9 @@ impl Film {
 
     /// Adds the samples of `other`, a film of the same size: its pixels'
     /// sums and counts are added to this film's (exactly, see [`Sum`]).
-    /// `false`, and nothing added, if the sizes differ or either film keeps
-    /// the halves of adaptive sampling.
+    /// `false`, and nothing added, if the sizes differ, either film keeps
+    /// the halves of adaptive sampling, or a pixel's sum or count would pass
+    /// what it holds.
     pub fn add_film(&mut self, other: &Film) -> bool {
         if (self.width, self.height) != (other.width, other.height)
             || self.has_halves()
@@ -231,11 +252,16 @@ impl Film {
         {
             return false;
         }
-        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
-            *a = a.plus(*b);
-        }
-        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
-            *a = a.wrapping_add(*b);
+        let added: Option<Vec<(Sum, u32)>> = (self.sums.iter().zip(&other.sums))
+            .zip(self.counts.iter().zip(&other.counts))
+            .map(|((a, b), (m, n))| Some((a.checked_plus(*b)?, m.checked_add(*n)?)))
+            .collect();
+        let Some(added) = added else {
+            return false;
+        };
+        for (i, (sum, count)) in added.into_iter().enumerate() {
+            self.sums[i] = sum;
+            self.counts[i] = count;
         }
         true
     }

@@ -89,3 +89,88 @@ fn dropping_samples_warns_with_the_count() {
     assert!(dropped > 0);
     assert!(err.contains(&format!("{dropped} dropped samples")), "{err}");
 }
+
+/// A scene of nothing but a sky of `radiance`: every camera sample is it.
+fn sky_scene(dir: &std::path::Path, radiance: &str) -> std::path::PathBuf {
+    let scene = dir.join("sky.toml");
+    std::fs::write(
+        &scene,
+        format!("[background]\ntype = \"solid\"\ncolor = [{radiance}, {radiance}, {radiance}]\n"),
+    )
+    .unwrap();
+    scene
+}
+
+/// The values of a PFM file written by lumen (little-endian).
+fn pfm_values(bytes: &[u8]) -> Vec<f32> {
+    let mut lines = 0;
+    let start = bytes
+        .iter()
+        .position(|&b| {
+            lines += usize::from(b == b'\n');
+            lines == 3
+        })
+        .unwrap()
+        + 1;
+    bytes[start..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn samples_that_would_take_a_pixel_past_its_sum_are_dropped_not_wrapped() {
+    let dir = temp_dir("dropped-overflow");
+    // 5e18 is below what one sample may be, but two of them pass the 9.2e18
+    // a pixel's sum holds: the second of each pixel is dropped and counted.
+    let scene = sky_scene(&dir, "5e18");
+    let out_pfm = dir.join("out.pfm");
+    let out = lumen()
+        .args(["render", scene.to_str().unwrap(), "-o"])
+        .arg(&out_pfm)
+        .args(["--width", "8", "--spp", "2"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let pixels = 8 * 4;
+    assert!(err.contains(&format!("{pixels} dropped samples")), "{err}");
+    assert!(err.contains("lumen: warning:"), "{err}");
+    for v in pfm_values(&std::fs::read(&out_pfm).unwrap()) {
+        assert!((v / 5e18 - 1.0).abs() < 1e-6, "a pixel is {v}");
+    }
+}
+
+#[test]
+fn parts_whose_sums_would_pass_a_pixel_are_refused_by_the_merge() {
+    let dir = temp_dir("dropped-merge");
+    let scene = sky_scene(&dir, "5e18");
+    let mut parts = Vec::new();
+    for k in 0..2 {
+        let part = dir.join(format!("p{k}.lumen-part"));
+        let out = lumen()
+            .args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(&part)
+            .args(["--width", "8", "--spp", "2", "--part", &format!("{k}/2")])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        parts.push(part);
+    }
+    let merged = dir.join("merged.pfm");
+    let out = lumen()
+        .arg("merge")
+        .args(&parts)
+        .arg("-o")
+        .arg(&merged)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("would pass what a pixel's sum holds"), "{err}");
+    assert!(!merged.exists());
+}

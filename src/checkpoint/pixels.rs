@@ -188,8 +188,19 @@ impl<'a> Pixels<'a> {
                 super::consistency::check_pixel(&sum, count, most, "")
                     .map_err(|message| PixelError::Pixel { x, message })?;
             }
-            *sum_out = sum_out.plus(sum);
-            *count_out = count_out.wrapping_add(count);
+            // Parts whose sums together pass what a pixel holds are refused
+            // rather than wrapped into a wrong (often negative) pixel.
+            let (Some(total), Some(n)) = (sum_out.checked_plus(sum), count_out.checked_add(count))
+            else {
+                return Err(PixelError::Pixel {
+                    x,
+                    message: "would pass what a pixel's sum holds (about 9.2e18 a channel) \
+                              once added to the parts before it"
+                        .into(),
+                });
+            };
+            *sum_out = total;
+            *count_out = n;
             counted += u64::from(count);
         }
         if at != row.len() {
