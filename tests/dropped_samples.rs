@@ -174,3 +174,41 @@ fn parts_whose_sums_would_pass_a_pixel_are_refused_by_the_merge() {
     assert!(err.contains("would pass what a pixel's sum holds"), "{err}");
     assert!(!merged.exists());
 }
+
+#[test]
+fn a_render_whose_every_sample_is_dropped_leaves_the_old_output_alone() {
+    let dir = temp_dir("dropped-all");
+    let scene = sky_scene(&dir, "1e19");
+    // An image there stays as it was; a part file is not written (an old one
+    // is a checkpoint, guarded as such).
+    for name in ["old.png", "new.lumen-part"] {
+        let out_path = dir.join(name);
+        let before = b"what was there";
+        if name.ends_with("png") {
+            std::fs::write(&out_path, before).unwrap();
+        }
+        let mut cmd = lumen();
+        cmd.args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(&out_path)
+            .args(["--width", "8", "--spp", "4"]);
+        if name.ends_with("part") {
+            cmd.args(["--part", "0/2"]);
+        }
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("every sample came out NaN"), "{err}");
+        assert!(err.contains("was not written"), "{err}");
+        if name.ends_with("png") {
+            assert_eq!(std::fs::read(&out_path).unwrap(), before, "{name}");
+        } else {
+            assert!(!out_path.exists());
+        }
+        assert!(
+            lumen_process::temp_files(&dir).is_empty(),
+            "{:?}",
+            lumen_process::temp_files(&dir)
+        );
+    }
+    assert!(!dir.join("old.png.lumen-ckpt").exists());
+}

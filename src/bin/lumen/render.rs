@@ -189,6 +189,11 @@ pub(crate) fn render_command(
     // Saves the image, and the checkpoint unless the render is complete, as
     // one step that a second interrupt lets finish (see `signals`).
     let save = |session: &Session| -> Result<()> {
+        // An image of nothing but dropped samples is black, and replacing the
+        // file there with it would lose what it held for no image at all.
+        if session.stats().all_dropped() {
+            return Ok(());
+        }
         let _saving = saving();
         if let Some(image) = image {
             output::write_image(image, session.film(), s.gamma)?;
@@ -244,6 +249,15 @@ pub(crate) fn render_command(
     let elapsed = start.elapsed();
     bar.finish_and_clear();
     let (held, total) = (session.spp_done(), session.spp_total());
+    if session.stats().all_dropped() {
+        errln!("{}", summary(&run.stats, &session.stats(), elapsed));
+        errln!(
+            "lumen: error: every sample came out NaN, infinite or beyond 9.2e18 (more than a \
+             pixel's sum holds); {} was not written, and what was there is as it was",
+            out.display()
+        );
+        return Ok(ExitCode::FAILURE);
+    }
     let code = match (run.reason, is_part) {
         (StopReason::Complete, true) => {
             save(&session)?;
@@ -305,9 +319,6 @@ pub(crate) fn render_command(
     let all = session.stats();
     if let Some(warning) = all.dropped_warning() {
         errln!("lumen: warning: {warning}");
-    }
-    if all.all_dropped() {
-        return Ok(ExitCode::FAILURE);
     }
     Ok(code)
 }
