@@ -13,6 +13,7 @@ use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -395,6 +396,10 @@ pub fn trace_path(
     colour.unwrap_or(path.radiance)
 }
 
+/// How many rounds of bounces [`trace_paths`] runs between looks at its
+/// `halted` flag.
+const HALT_CHECK_ROUNDS: u32 = 256;
+
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
 /// each with its own sampler: `colours[i]` gets exactly what
 /// `trace_path(scene, rays[i], &mut samplers[i], ..)` returns.
@@ -405,7 +410,9 @@ pub fn trace_path(
 /// waits on one test after another, while a bundle keeps the processor busy
 /// with eight (in scenes of spheres only: [`Scene::bundles_pay_off`]).
 /// `reference` (the pixel's central ray) orders the visit of the first
-/// round's bundles; later rounds use a ray of the bundle.
+/// round's bundles; later rounds use a ray of the bundle. Once `halted` is
+/// set the paths are left where they are within a few hundred bounces, and
+/// `colours` are not to be used.
 #[inline(always)]
 pub fn trace_paths<S: Sampler>(
     scene: &Scene,
@@ -414,6 +421,7 @@ pub fn trace_paths<S: Sampler>(
     reference: &Ray,
     colours: &mut [Color],
     traced: &mut u64,
+    halted: &AtomicBool,
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
@@ -442,6 +450,11 @@ pub fn trace_paths<S: Sampler>(
         }
         n_live = still;
         if n_live == 0 {
+            break;
+        }
+        // A render asked to stop abandons its pass, and with it these
+        // paths, which could run for minutes at a great depth.
+        if round % HALT_CHECK_ROUNDS == HALT_CHECK_ROUNDS - 1 && halted.load(Ordering::Relaxed) {
             break;
         }
     }
@@ -550,6 +563,7 @@ mod tests {
                         &reference,
                         &mut together,
                         &mut together_rays,
+                        &AtomicBool::new(false),
                     );
                     let bits = |c: &[Color]| {
                         c.iter()

@@ -9,6 +9,7 @@ use crate::sampler::{PixelSample, PixelSampler};
 use crate::scene::{Scene, Shading};
 use rayon::prelude::*;
 use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// The share of dropped samples above which a render warns: a few in a
@@ -130,28 +131,56 @@ pub fn render_pixels(
         assert_eq!(active.len(), film.len(), "one flag per pixel");
     }
     let isa = Isa::detect();
-    film.rows_mut()
-        .enumerate()
-        .map(|(y, row)| {
-            if should_stop() {
-                return None;
+    // Set once `should_stop` answers `true`, and looked at before every
+    // pixel and every few hundred bounces: a row of long paths (a white fog
+    // at a great depth) can take minutes, longer than the grace period a
+    // job engine gives after SIGTERM. A watcher asks `should_stop` while the
+    // rows run, so that the hot loops only read a flag.
+    let halted = AtomicBool::new(false);
+    let finished = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let watcher = scope.spawn(|| {
+            while !finished.load(Ordering::Acquire) {
+                if should_stop() {
+                    halted.store(true, Ordering::Relaxed);
+                    return;
+                }
+                std::thread::park_timeout(WATCH_EVERY);
             }
-            let active = active.map(|a| &a[y * width..(y + 1) * width]);
-            let at = (origin.0, origin.1 + y as u32);
-            let stats = render_row(isa, scene, at, samples.clone(), row, active);
-            let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
-            progress(pixels as u64 * per_pixel);
-            Some(stats)
-        })
-        .reduce(
-            || Some(RenderStats::default()),
-            |a, b| {
-                let (mut a, b) = (a?, b?);
-                a.add(b);
-                Some(a)
-            },
-        )
+        });
+        let stats = film
+            .rows_mut()
+            .enumerate()
+            .map(|(y, row)| {
+                if halted.load(Ordering::Relaxed) || should_stop() {
+                    halted.store(true, Ordering::Relaxed);
+                    return None;
+                }
+                let active = active.map(|a| &a[y * width..(y + 1) * width]);
+                let at = (origin.0, origin.1 + y as u32);
+                let stats = render_row(isa, scene, at, samples.clone(), row, active, &halted);
+                let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
+                progress(pixels as u64 * per_pixel);
+                Some(stats)
+            })
+            .reduce(
+                || Some(RenderStats::default()),
+                |a, b| {
+                    let (mut a, b) = (a?, b?);
+                    a.add(b);
+                    Some(a)
+                },
+            );
+        finished.store(true, Ordering::Release);
+        watcher.thread().unpark();
+        // A row cut short by the flag holds only some of its samples.
+        stats.filter(|_| !halted.load(Ordering::Relaxed))
+    })
 }
+
+/// How often a render in progress asks whether to stop, besides before
+/// every row.
+const WATCH_EVERY: Duration = Duration::from_millis(10);
 
 /// Renders samples `samples` of every pixel of `row`, which holds the
 /// pixels of image row `at.1` from column `at.0` on (of those whose `active`
@@ -164,6 +193,7 @@ fn render_row(
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
+    halted: &AtomicBool,
 ) -> RenderStats {
     match isa {
         #[cfg(target_arch = "x86_64")]
@@ -172,10 +202,10 @@ fn render_row(
             // processor has every feature `render_row_avx2` is compiled for.
             #[allow(unsafe_code)]
             unsafe {
-                render_row_avx2(scene, at, samples, row, active)
+                render_row_avx2(scene, at, samples, row, active, halted)
             }
         }
-        _ => render_row_generic(scene, at, samples, row, active),
+        _ => render_row_generic(scene, at, samples, row, active, halted),
     }
 }
 
@@ -188,8 +218,9 @@ unsafe fn render_row_avx2(
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
+    halted: &AtomicBool,
 ) -> RenderStats {
-    render_row_generic(scene, at, samples, row, active)
+    render_row_generic(scene, at, samples, row, active, halted)
 }
 
 /// The body of the row loop, inlined into each instruction-set version.
@@ -200,6 +231,7 @@ fn render_row_generic(
     samples: Range<u32>,
     mut row: RowMut,
     active: Option<&[bool]>,
+    halted: &AtomicBool,
 ) -> RenderStats {
     let s = &scene.settings;
     let mut stats = RenderStats::default();
@@ -215,6 +247,9 @@ fn render_row_generic(
     for x in 0..width {
         if active.is_some_and(|a| !a[x]) {
             continue;
+        }
+        if halted.load(Ordering::Relaxed) {
+            break;
         }
         // The pixel's column in the image, which addresses its samples.
         let column = x0 + x as u32;
@@ -243,6 +278,7 @@ fn render_row_generic(
                 &reference,
                 &mut colours[..n],
                 &mut stats.rays,
+                halted,
             );
             // In sample order, as one at a time would add them.
             for (i, &c) in colours[..n].iter().enumerate() {
@@ -314,7 +350,15 @@ mod tests {
             let render_with = |isa| {
                 let mut film = Film::with_halves(width, 1);
                 let row = film.rows_mut().collect::<Vec<_>>().pop().unwrap();
-                let stats = render_row(isa, scene, (0, y), 0..37, row, None);
+                let stats = render_row(
+                    isa,
+                    scene,
+                    (0, y),
+                    0..37,
+                    row,
+                    None,
+                    &AtomicBool::new(false),
+                );
                 (film, stats)
             };
             let (base, a) = render_with(Isa::Baseline);
