@@ -324,3 +324,45 @@ fn the_integrator_flag_chooses_how_light_is_found() {
     let err = stderr(&out);
     assert!(err.contains("path") && err.contains("bsdf"), "{err}");
 }
+
+/// Options that cannot work, together or with the scene, exit with status 2
+/// as clap's own usage errors do (a job engine then fails the task at once
+/// instead of retrying it), naming the mistake, writing nothing.
+#[test]
+fn option_mistakes_exit_with_status_2() {
+    let dir = temp_dir("usage-exit");
+    let path = |name: &str| dir.join(name).display().to_string();
+    let part = path("a.lumen-part");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["--part", "0/1000", "--split", "tiles", "-o", &part],
+            "cannot be split into 1000 bands",
+        ),
+        (vec!["--tile", "0,0,1000,10", "-o", &part], "reaches beyond"),
+        (
+            vec!["--part", "0/2", "--noise-target", "0.1", "-o", &part],
+            "cannot sample adaptively",
+        ),
+        (vec!["--part", "0/2", "-o", &path("x.png")], "part file"),
+        (vec!["-o", &path("x.lumen-part")], "give --part"),
+        (vec!["-o", &path("out.jpg")], "unknown image format"),
+    ]
+    .into_iter()
+    .map(|(a, says)| (a.into_iter().map(String::from).collect(), says))
+    .collect();
+    for (args, says) in cases {
+        let out = lumen_process::lumen()
+            .args(["render", "cover", "--width", "64", "--spp", "1"])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_fails(&out, &[says]);
+        assert!(listing(&dir).is_empty(), "{args:?}: {:?}", listing(&dir));
+    }
+    let out = lumen_process::lumen()
+        .args(["merge", "nothing.lumen-part", "-o", &path("m.jpg")])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+}

@@ -234,20 +234,21 @@ fn the_command_line_splits_and_merges_to_the_bit() {
     );
     assert!(dir.join("some.png").exists());
 
-    // A part needs a part file, and a part file needs --part.
+    // A part needs a part file, and a part file needs --part: option mistakes,
+    // exit status 2.
     let out = lumen()
         .args(["render", "cover", "--part", "0/2", "-o"])
         .arg(dir.join("x.png"))
         .output()
         .unwrap();
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("-o NAME.lumen-part"));
     let out = lumen()
         .args(["render", "cover", "-o"])
         .arg(dir.join("x.lumen-part"))
         .output()
         .unwrap();
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("give --part K/N"));
     for bad in ["4/4", "1/0", "x"] {
         let out = lumen()

@@ -320,7 +320,7 @@ fn the_command_line_splits_by_tiles_and_merges_to_the_bit() {
         )),
         "{said}"
     );
-    // Refusals on the command line: exit 1 and the reason.
+    // Refusals on the command line: option mistakes, exit 2 and the reason.
     for (extra, expect) in [
         (
             &["--tile", "0,0,41,5"][..],
@@ -336,12 +336,12 @@ fn the_command_line_splits_by_tiles_and_merges_to_the_bit() {
         ),
     ] {
         let (code, said) = run(extra, "x.lumen-part");
-        assert_eq!(code, Some(1), "{extra:?}: {said}");
+        assert_eq!(code, Some(2), "{extra:?}: {said}");
         assert!(said.contains(expect), "{extra:?}: {said}");
     }
     // A tile is written to a part file; malformed values are usage errors.
     let (code, said) = run(&["--tile", "0,0,4,4"], "x.png");
-    assert_eq!(code, Some(1));
+    assert_eq!(code, Some(2));
     assert!(said.contains("-o NAME.lumen-part"), "{said}");
     for extra in [
         &["--tile", "4,0,4,4"][..],

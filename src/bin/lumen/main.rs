@@ -388,8 +388,41 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             errln!("lumen: error: {e:#}");
-            ExitCode::FAILURE
+            exit_code(&e)
         }
+    }
+}
+
+/// Exit status of options that cannot work together or with the scene, as
+/// clap's own usage errors: running again cannot mend them, and a job
+/// engine (a Kubernetes Indexed Job) fails such a task at once instead of
+/// retrying it.
+const EXIT_USAGE: u8 = 2;
+
+/// A mistake in the options given (see [`EXIT_USAGE`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct Usage(pub String);
+
+/// The exit status of a failed command: [`EXIT_USAGE`] for mistakes in the
+/// options, whether found here or by the library; 1 for anything else.
+fn exit_code(e: &anyhow::Error) -> ExitCode {
+    use lumen::output::OutputError;
+    use lumen::progressive::SessionError;
+    let usage = e.chain().any(|cause| {
+        cause.is::<Usage>()
+            || matches!(
+                cause.downcast_ref::<SessionError>(),
+                Some(SessionError::AdaptivePart { .. } | SessionError::Tile { .. })
+            )
+            || matches!(
+                cause.downcast_ref::<OutputError>(),
+                Some(OutputError::UnknownFormat { .. })
+            )
+    });
+    match usage {
+        true => ExitCode::from(EXIT_USAGE),
+        false => ExitCode::FAILURE,
     }
 }
 

@@ -2,7 +2,7 @@
 
 use crate::scenes::load_scene;
 use crate::signals::{install_stop_handler, quit_if_asked, saving, EXIT_INTERRUPTED};
-use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs};
+use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs, Usage};
 use anyhow::{bail, Context, Result};
 use lumen::checkpoint::{self, Checkpoint, Existing};
 use lumen::lock::RenderLock;
@@ -84,15 +84,21 @@ pub(crate) fn render_command(
     };
     let is_part = !share.is_whole();
     match is_part {
-        true if !is_part_file => bail!(
-            "{}: a part of a render is written to a part file: -o NAME.{}",
-            out.display(),
-            part::EXTENSION
-        ),
-        false if is_part_file => bail!(
-            "{}: a part file holds a part of a render: give --part K/N or --tile X0,Y0,X1,Y1",
-            out.display()
-        ),
+        true if !is_part_file => {
+            return Err(Usage(format!(
+                "{}: a part of a render is written to a part file: -o NAME.{}",
+                out.display(),
+                part::EXTENSION
+            ))
+            .into())
+        }
+        false if is_part_file => {
+            return Err(Usage(format!(
+                "{}: a part file holds a part of a render: give --part K/N or --tile X0,Y0,X1,Y1",
+                out.display()
+            ))
+            .into())
+        }
         true => {}
         false => {
             output::ImageFormat::from_path(out)?;
