@@ -141,16 +141,27 @@ impl Texture {
     /// Whether the texture depends on the surface's (u, v) (directly or
     /// through a texture it refers to).
     pub fn uses_uv(&self, table: &[Texture]) -> bool {
-        match self {
-            Texture::Map(_) => true,
-            Texture::Checker { even, odd, .. } => {
-                table[*even as usize].uses_uv(table) || table[*odd as usize].uses_uv(table)
+        // Each texture looked at once, without recursion: a checker whose
+        // squares are one texture, nested, would be visited 2^depth times
+        // by following both references of each.
+        let mut seen = std::collections::HashSet::new();
+        let mut todo = vec![self];
+        while let Some(t) = todo.pop() {
+            let refs = match t {
+                Texture::Map(_) => return true,
+                Texture::Checker { even, odd, .. } => [Some(*even), Some(*odd)],
+                Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
+                    [Some(*texture), None]
+                }
+                Texture::Solid(_) | Texture::Noise { .. } => [None, None],
+            };
+            for r in refs.into_iter().flatten() {
+                if seen.insert(r) {
+                    todo.push(&table[r as usize]);
+                }
             }
-            Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
-                table[*texture as usize].uses_uv(table)
-            }
-            Texture::Solid(_) | Texture::Noise { .. } => false,
         }
+        false
     }
 }
 

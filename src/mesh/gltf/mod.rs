@@ -262,7 +262,8 @@ fn percent_decode(uri: &str) -> String {
 
 /// Every node reachable from the roots with its composed object-to-model
 /// matrix, parents before children. A node reached twice (a cycle, or a node
-/// with two parents, which glTF forbids) is an error.
+/// with two parents, which glTF forbids), or, in a file without a scene, a
+/// node no root leads to (a cycle without a root), is an error.
 fn walk_nodes(document: &gltf::Document) -> Result<Vec<(gltf::Node<'_>, Mat4)>, String> {
     let n = document.nodes().len();
     let roots: Vec<gltf::Node> = match document.default_scene() {
@@ -302,6 +303,15 @@ fn walk_nodes(document: &gltf::Document) -> Result<Vec<(gltf::Node<'_>, Mat4)>, 
         let children: Vec<gltf::Node> = node.children().collect();
         stack.extend(children.into_iter().rev().map(|c| (c, world)));
         out.push((node, world));
+    }
+    // Without a scene every node is a root or some node's child, so a node
+    // no root leads to is in a cycle of parents (or below one).
+    if document.default_scene().is_none() {
+        if let Some(lost) = seen.iter().position(|s| !s) {
+            return Err(format!(
+                "node {lost} is in a cycle of parents (or below one): no root node leads to it"
+            ));
+        }
     }
     Ok(out)
 }

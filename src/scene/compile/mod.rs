@@ -101,7 +101,7 @@ impl Scene {
         compile_camera(&desc.camera, &settings, true)?;
         let mut materials = Vec::with_capacity(desc.materials.len());
         let mut material_index = HashMap::with_capacity(desc.materials.len());
-        let mut table = TextureTable::new(&desc.textures, base);
+        let mut table = TextureTable::new(&desc.textures, base)?;
         let mut sources = Vec::new();
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);

@@ -25,6 +25,99 @@ pub(crate) enum ColorRef {
     Texture(u32),
 }
 
+/// Most textures a chain of references may pass through (a checker of
+/// checkers of …): compiling a texture and looking it up at a hit follow
+/// the chain by recursion, whose depth an input must not set.
+pub const MAX_TEXTURE_DEPTH: usize = 64;
+
+/// The names of the textures `desc` refers to.
+fn references(desc: &TextureDesc) -> impl Iterator<Item = &str> {
+    let (even, odd) = match desc {
+        TextureDesc::Checker { even, odd, .. } => (Some(even), Some(odd)),
+        _ => (None, None),
+    };
+    [even, odd].into_iter().flatten().filter_map(|c| match c {
+        ColorDesc::Texture(name) => Some(name.as_str()),
+        ColorDesc::Rgb(_) => None,
+    })
+}
+
+/// Checks every texture, whether a material uses it or not: none refers to
+/// itself, directly or through others (the chain named), and no chain is
+/// more than [`MAX_TEXTURE_DEPTH`] textures long. Walked without recursion,
+/// each texture once, so that neither a long chain nor a long cycle can
+/// overflow the stack or take quadratic time.
+fn check_references(descs: &BTreeMap<String, TextureDesc>) -> Result<(), SceneError> {
+    // Each texture's depth once known: the longest chain it starts.
+    let mut depth: HashMap<&str, usize> = HashMap::with_capacity(descs.len());
+    let mut on_path: HashMap<&str, usize> = HashMap::new();
+    for start in descs.keys() {
+        if depth.contains_key(start.as_str()) {
+            continue;
+        }
+        // The path being walked: each texture with the references it has
+        // left to visit.
+        let mut path: Vec<(&str, Vec<&str>)> = Vec::new();
+        let children = |name: &str| -> Vec<&str> {
+            descs
+                .get(name)
+                .map(|d| references(d).filter(|r| descs.contains_key(*r)).collect())
+                .unwrap_or_default()
+        };
+        on_path.insert(start, 0);
+        path.push((start, children(start)));
+        while let Some((name, left)) = path.last_mut() {
+            let name = *name;
+            match left.pop() {
+                Some(next) if depth.contains_key(next) => {}
+                Some(next) => {
+                    if let Some(&at) = on_path.get(next) {
+                        let mut chain: Vec<&str> = path[at..].iter().map(|(n, _)| *n).collect();
+                        chain.push(next);
+                        return Err(invalid(
+                            format!("textures.{next}"),
+                            format!("refers to itself: {}", shown_chain(&chain)),
+                        ));
+                    }
+                    on_path.insert(next, path.len());
+                    path.push((next, children(next)));
+                }
+                None => {
+                    let d = 1 + children(name).iter().map(|c| depth[c]).max().unwrap_or(0);
+                    if d > MAX_TEXTURE_DEPTH {
+                        return Err(invalid(
+                            format!("textures.{name}"),
+                            format!(
+                                "starts a chain of {d} textures referring to each other, \
+                                 more than the {MAX_TEXTURE_DEPTH} lumen follows"
+                            ),
+                        ));
+                    }
+                    depth.insert(name, d);
+                    on_path.remove(name);
+                    path.pop();
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A chain of texture names as `a → b → a`; a long one by its ends and how
+/// many lie between.
+fn shown_chain(chain: &[&str]) -> String {
+    const ENDS: usize = 4;
+    if chain.len() <= 2 * ENDS + 1 {
+        return chain.join(" → ");
+    }
+    format!(
+        "{} → … ({} more) … → {}",
+        chain[..ENDS].join(" → "),
+        chain.len() - 2 * ENDS,
+        chain[chain.len() - ENDS..].join(" → ")
+    )
+}
+
 /// The textures compiled so far.
 pub(crate) struct TextureTable<'a> {
     descs: &'a BTreeMap<String, TextureDesc>,
@@ -38,15 +131,20 @@ pub(crate) struct TextureTable<'a> {
 
 impl<'a> TextureTable<'a> {
     /// An empty table for the textures `descs`, whose files are relative to
-    /// `base`.
-    pub(crate) fn new(descs: &'a BTreeMap<String, TextureDesc>, base: &'a Path) -> Self {
-        TextureTable {
+    /// `base`, once the references between them are checked (see
+    /// [`check_references`]).
+    pub(crate) fn new(
+        descs: &'a BTreeMap<String, TextureDesc>,
+        base: &'a Path,
+    ) -> Result<Self, SceneError> {
+        check_references(descs)?;
+        Ok(TextureTable {
             descs,
             base,
             textures: Vec::new(),
             index: HashMap::new(),
             images: HashMap::new(),
-        }
+        })
     }
 
     /// Adds `texture` to the table; its index.
@@ -66,12 +164,7 @@ impl<'a> TextureTable<'a> {
     ) -> Result<ColorRef, SceneError> {
         match c {
             ColorDesc::Rgb(rgb) => Ok(ColorRef::Rgb(check(field, *rgb)?)),
-            ColorDesc::Texture(name) => {
-                let mut chain = Vec::new();
-                Ok(ColorRef::Texture(
-                    self.named(field, name, &mut chain, sources)?,
-                ))
-            }
+            ColorDesc::Texture(name) => Ok(ColorRef::Texture(self.named(field, name, sources)?)),
         }
     }
 
@@ -81,7 +174,6 @@ impl<'a> TextureTable<'a> {
         &mut self,
         field: &str,
         c: &'a ColorDesc,
-        chain: &mut Vec<&'a str>,
         sources: &mut Vec<MeshSource>,
     ) -> Result<u32, SceneError> {
         match c {
@@ -90,17 +182,17 @@ impl<'a> TextureTable<'a> {
                 self.textures.push(Texture::Solid(colour));
                 Ok(self.textures.len() as u32 - 1)
             }
-            ColorDesc::Texture(name) => self.named(field, name, chain, sources),
+            ColorDesc::Texture(name) => self.named(field, name, sources),
         }
     }
 
-    /// The index of the texture `name`, compiled on first use; `chain`
-    /// holds the textures being compiled that led here (to refuse cycles).
+    /// The index of the texture `name`, compiled on first use (and its
+    /// references with it: `check_references` has refused cycles and chains
+    /// longer than [`MAX_TEXTURE_DEPTH`], so this recursion is bounded).
     fn named(
         &mut self,
         field: &str,
         name: &str,
-        chain: &mut Vec<&'a str>,
         sources: &mut Vec<MeshSource>,
     ) -> Result<u32, SceneError> {
         if let Some(&i) = self.index.get(name) {
@@ -119,20 +211,12 @@ impl<'a> TextureTable<'a> {
                 format!("no texture named \"{name}\" ({listed})"),
             ));
         };
-        if chain.contains(&name) {
-            chain.push(key);
-            return Err(invalid(
-                format!("textures.{name}"),
-                format!("refers to itself: {}", chain.join(" → ")),
-            ));
-        }
-        chain.push(key);
         let here = format!("textures.{name}");
         let texture = match desc {
             TextureDesc::Checker { scale, even, odd } => Texture::Checker {
                 inverse_scale: 1.0 / positive(&format!("{here}.scale"), *scale)?,
-                even: self.texture_of(&format!("{here}.even"), even, chain, sources)?,
-                odd: self.texture_of(&format!("{here}.odd"), odd, chain, sources)?,
+                even: self.texture_of(&format!("{here}.even"), even, sources)?,
+                odd: self.texture_of(&format!("{here}.odd"), odd, sources)?,
             },
             TextureDesc::Image {
                 file,
@@ -204,7 +288,6 @@ impl<'a> TextureTable<'a> {
                 },
             },
         };
-        chain.pop();
         self.textures.push(texture);
         let i = self.textures.len() as u32 - 1;
         self.index.insert(key, i);
