@@ -570,3 +570,60 @@ fn emissive_materials_are_checked_like_the_others() {
     let file = SceneFile::parse("s.toml", lamp("radiance = [15, 15, 15]"), Format::Toml).unwrap();
     file.compile(&Overrides::default()).unwrap();
 }
+
+/// serde would take an array for a table, its fields by position; the scene
+/// format has tables there, and says so, wherever the table is.
+#[test]
+fn json_arrays_are_refused_where_tables_belong() {
+    for (json, at) in [
+        (r#"{"render": [24, 8]}"#, "render"),
+        (r#"{"camera": [[0, 0, 5]]}"#, "camera"),
+        (r#"{"background": ["solid", [1, 1, 1]]}"#, "background"),
+        (
+            r#"{"materials": {"m": ["diffuse", [0.5, 0.5, 0.5]]}}"#,
+            "materials.m",
+        ),
+        (
+            r#"{"textures": {"t": ["checker", 1, [0, 0, 0], [1, 1, 1]]}}"#,
+            "textures.t",
+        ),
+        (
+            r#"{"objects": [["sphere", [0, 0, -1], 0.5, "m"]]}"#,
+            "objects[0]",
+        ),
+        (
+            r#"{"materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+"objects": [{"type": "sphere", "center": [0, 0, -1], "radius": 0.5, "material": "m",
+"transform": [[1, 2, 3]]}]}"#,
+            "objects[0].transform[0]",
+        ),
+        (
+            r#"{"materials": {"m": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+"objects": [{"type": "sphere", "center": [0, 0, -1], "radius": 0.5, "material": "m",
+"transform": [{"rotate": [[0, 1, 0], 90]}]}]}"#,
+            "objects[0].transform[0].rotate",
+        ),
+    ] {
+        let m = refused_as(json, Format::Json, "s.json");
+        assert_mentions(&m, &[&format!("{at}: expected"), "(a table), got an array"]);
+    }
+}
+
+/// A triple has three numbers: a fourth element is refused, not dropped,
+/// in every table and in both formats.
+#[test]
+fn triples_with_extra_elements_are_refused() {
+    for (from, to) in [
+        ("lookfrom = [0, 0, 0]", "lookfrom = [0, 0, 0, 7]"),
+        ("lookfrom = [0, 0, 0]", "lookfrom = [0, 0, 0, \"x\"]"),
+    ] {
+        let m = refused(&base_with(from, to));
+        assert_mentions(&m, &["camera.lookfrom", "got an array of 4 values"]);
+    }
+    let sphere = "[materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
+                  [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, -1, 9]\nradius = 0.5\nmaterial = \"m\"\n";
+    assert_mentions(
+        &refused(sphere),
+        &["objects[0].center", "got an array of 4 values"],
+    );
+}

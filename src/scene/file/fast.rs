@@ -36,30 +36,89 @@ pub(super) fn read(text: &str, format: Format) -> Option<SceneDesc> {
 
 /// JSON that serde reads as the precise reader does: nested no deeper than
 /// the precise reader allows, without `null` (which serde takes for an
-/// absent optional field, and the precise reader refuses) and without the
-/// integer `-0`.
+/// absent optional field, and the precise reader refuses), without the
+/// integer `-0`, and with a JSON object wherever the description has a
+/// table (serde also takes an array there, its fields by position:
+/// `{"render": [24, 8]}`).
 fn json(text: &str) -> Option<SceneDesc> {
-    let (mut depth, mut in_string, mut escaped) = (0usize, false, false);
+    /// What a container being scanned holds.
+    enum Frame {
+        /// An object; `tables` if each of its values must be an object (the
+        /// `materials` and `textures` maps).
+        Object { tables: bool },
+        /// An array; `tables` if each element must be an object (the
+        /// `objects` and `transform` lists).
+        Array { tables: bool },
+    }
+    // Keys whose value is a table, and those whose value is a list of
+    // tables or a map of them.
+    const TABLE: &[&[u8]] = &[b"render", b"camera", b"background", b"boundary", b"rotate"];
+    const LIST_OF_TABLES: &[&[u8]] = &[b"objects", b"transform"];
+    const MAP_OF_TABLES: &[&[u8]] = &[b"materials", b"textures"];
     let bytes = text.as_bytes();
+    let mut stack: Vec<Frame> = Vec::new();
+    // The last string read, and the key whose value comes next.
+    let (mut string, mut key): (Range<usize>, Option<Range<usize>>) = (0..0, None);
+    let (mut in_string, mut escaped) = (false, false);
     for (i, &b) in bytes.iter().enumerate() {
         if in_string {
             match b {
                 _ if escaped => escaped = false,
                 b'\\' => escaped = true,
-                b'"' => in_string = false,
+                b'"' => {
+                    in_string = false;
+                    string.end = i;
+                }
                 _ => {}
             }
             continue;
         }
-        match b {
-            b'"' => in_string = true,
-            b'[' | b'{' => {
-                depth += 1;
-                if depth > super::source::MAX_DEPTH {
-                    return None;
-                }
+        if matches!(b, b' ' | b'\t' | b'\n' | b'\r' | b',' | b']' | b'}') {
+            if matches!(b, b']' | b'}') {
+                stack.pop();
             }
-            b']' | b'}' => depth = depth.saturating_sub(1),
+            continue;
+        }
+        if b == b':' {
+            // A key with an escape could spell a table's name: not read here.
+            let k = &bytes[string.clone()];
+            if k.contains(&b'\\') {
+                return None;
+            }
+            key = Some(string.clone());
+            continue;
+        }
+        // A value starts (or a key, in an object, after `{` or `,`).
+        let in_object_key = matches!(stack.last(), Some(Frame::Object { .. })) && key.is_none();
+        if !in_object_key {
+            let named = key.take().map(|k| &bytes[k]);
+            let is = |list: &[&[u8]]| named.is_some_and(|k| list.contains(&k));
+            let must_be_table = match stack.last() {
+                Some(Frame::Object { tables }) => *tables || is(TABLE),
+                Some(Frame::Array { tables }) => *tables,
+                None => true,
+            };
+            if must_be_table && b != b'{' {
+                return None;
+            }
+            match b {
+                b'{' => stack.push(Frame::Object {
+                    tables: stack.len() == 1 && is(MAP_OF_TABLES),
+                }),
+                b'[' => stack.push(Frame::Array {
+                    tables: is(LIST_OF_TABLES),
+                }),
+                _ => {}
+            }
+            if stack.len() > super::source::MAX_DEPTH {
+                return None;
+            }
+        }
+        match b {
+            b'"' => {
+                in_string = true;
+                string = i + 1..i + 1;
+            }
             // Outside strings, only `null` has an `n`.
             b'n' => return None,
             // The integer `-0`: serde_json reads it as the float -0.0, the
