@@ -107,10 +107,14 @@ fn nested_checkers_of_one_texture_cost_one_look_each() {
         true => format!("\"t{}\"", i + 1),
         false => GREY.into(),
     };
-    let text = HEAD.to_string() + &checkers(n, below, below);
+    let text = "[render]\nwidth = 16\nsamples_per_pixel = 2\n".to_string()
+        + HEAD
+        + &checkers(n, below, below);
     let scene = within_30s(move || common::compile_file(&dir, "dag.toml", &text));
-    let (film, _) = lumen::render::render(&scene, &|_| {});
-    assert!(film.len() > 0);
+    // And a hit looks the nest up level by level.
+    let (film, stats) = lumen::render::render(&scene, &|_| {});
+    assert_eq!(stats.samples, film.len() as u64 * 2);
+    assert_eq!(stats.dropped, 0);
 }
 
 #[test]
