@@ -189,6 +189,30 @@ impl Film {
         Self::from_raw(width, height, sums, counts)
     }
 
+    /// Bytes of a `width`×`height` film, with `halves` if it keeps them
+    /// ([`Film::with_halves`]): 52 a pixel, 104 with the halves.
+    pub fn bytes(width: u32, height: u32, halves: bool) -> u64 {
+        let per_pixel = (std::mem::size_of::<Sum>() + std::mem::size_of::<u32>()) as u64;
+        u64::from(width) * u64::from(height) * per_pixel * if halves { 2 } else { 1 }
+    }
+
+    /// [`Film::with_halves`], or `None` if this machine's memory cannot
+    /// hold it.
+    pub fn try_with_halves(width: u32, height: u32) -> Option<Self> {
+        let whole = Self::try_new(width, height)?;
+        let n = whole.len();
+        let (mut odd_sums, mut odd_counts) = (Vec::new(), Vec::new());
+        odd_sums.try_reserve_exact(n).ok()?;
+        odd_counts.try_reserve_exact(n).ok()?;
+        odd_sums.resize(n, Sum::ZERO);
+        odd_counts.resize(n, 0);
+        Some(Self {
+            odd_sums,
+            odd_counts,
+            ..whole
+        })
+    }
+
     /// A black film that also keeps the sums of each pixel's samples of odd
     /// index, for adaptive sampling's error estimate ([`Film::halves`]).
     pub fn with_halves(width: u32, height: u32) -> Self {

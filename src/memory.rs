@@ -44,7 +44,8 @@ impl std::error::Error for MemoryError {}
 
 /// Bytes of memory this process can still take: the system's
 /// `MemAvailable`, or less when a control group (a container, a Slurm job)
-/// sets a lower limit. `None` where the system does not say (not Linux).
+/// or a limit on the address space (`ulimit -v`) leaves less. `None` where
+/// the system does not say (not Linux).
 pub fn available() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let kib = meminfo
@@ -56,10 +57,35 @@ pub fn available() -> Option<u64> {
         .parse::<u64>()
         .ok()?;
     let system = kib.saturating_mul(1024);
-    Some(match cgroup_room() {
-        Some(room) => system.min(room),
-        None => system,
-    })
+    Some(
+        [cgroup_room(), address_space_room()]
+            .into_iter()
+            .flatten()
+            .fold(system, u64::min),
+    )
+}
+
+/// What a limit on the process's address space (`ulimit -v`, RLIMIT_AS)
+/// leaves: the limit less the address space in use, if there is a limit.
+fn address_space_room() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let limit = limits
+        .lines()
+        .find_map(|l| l.strip_prefix("Max address space"))?
+        .split_whitespace()
+        .next()?
+        .parse::<u64>()
+        .ok()?; // "unlimited": no limit
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let used_kib = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmSize:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse::<u64>()
+        .ok()?;
+    Some(limit.saturating_sub(used_kib.saturating_mul(1024)))
 }
 
 /// What a cgroup v2 memory limit leaves: `memory.max - memory.current` of

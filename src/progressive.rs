@@ -160,6 +160,9 @@ pub enum SessionError {
         /// The share asked for.
         share: Share,
     },
+    /// This machine's memory cannot hold the film.
+    #[error(transparent)]
+    Memory(#[from] crate::memory::MemoryError),
     /// The share's pixels are not in the image.
     #[error("{message}")]
     Tile {
@@ -208,27 +211,45 @@ pub struct RunSummary {
 impl Session {
     /// A new render of `desc` with no samples yet.
     pub fn new(desc: &SceneDesc) -> Result<Self, SessionError> {
-        Ok(Self::with_scene(desc, Scene::from_desc(desc)?))
+        Self::with_scene(desc, Scene::from_desc(desc)?)
     }
 
     /// A new render of `desc` already compiled into `scene` (which must be
-    /// `Scene::from_desc(desc)`): spares building the scene twice.
-    pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Self {
+    /// `Scene::from_desc(desc)`): spares building the scene twice. Refused
+    /// when this machine's free memory cannot hold the film.
+    pub fn with_scene(desc: &SceneDesc, scene: Scene) -> Result<Self, SessionError> {
         let (w, h) = (scene.settings.width, scene.settings.height);
         let samples = 0..scene.settings.samples_per_pixel;
         Self::of_share(desc, scene, samples, Tile::whole(w, h))
     }
 
     /// A new render of samples `samples` of the pixels `tile` of `desc`,
-    /// compiled into `scene`: a film of the tile only.
-    fn of_share(desc: &SceneDesc, scene: Scene, samples: Range<u32>, tile: Tile) -> Self {
+    /// compiled into `scene`: a film of the tile only, whose memory (with
+    /// the copy a pass in flight keeps) is counted and taken without
+    /// aborting.
+    fn of_share(
+        desc: &SceneDesc,
+        scene: Scene,
+        samples: Range<u32>,
+        tile: Tile,
+    ) -> Result<Self, SessionError> {
         let (w, h) = (tile.width(), tile.height());
-        let film = match scene.settings.noise_target {
-            Some(_) => Film::with_halves(w, h),
-            None => Film::new(w, h),
-        };
+        let halves = scene.settings.noise_target.is_some();
+        crate::memory::check(
+            2 * Film::bytes(w, h, halves),
+            &format!("the {w}x{h} film (with the copy a pass keeps)"),
+        )?;
+        let film = match halves {
+            true => Film::try_with_halves(w, h),
+            false => Film::try_new(w, h),
+        }
+        .ok_or_else(|| crate::memory::MemoryError {
+            what: format!("the {w}x{h} film"),
+            bytes: Film::bytes(w, h, halves),
+            available: None,
+        })?;
         let active = scene.settings.noise_target.map(|_| vec![true; film.len()]);
-        Self {
+        Ok(Self {
             description: identity_text(desc, &scene.sources),
             tile,
             scene,
@@ -238,7 +259,7 @@ impl Session {
             spp_done: samples.start,
             share: samples,
             active,
-        }
+        })
     }
 
     /// A new render of `part` of the samples of `desc`, already compiled
@@ -257,7 +278,7 @@ impl Session {
     /// the whole render), and when the share's pixels are not in the image.
     pub fn with_share(desc: &SceneDesc, scene: Scene, share: Share) -> Result<Self, SessionError> {
         if share.is_whole() {
-            return Ok(Self::with_scene(desc, scene));
+            return Self::with_scene(desc, scene);
         }
         if scene.settings.noise_target.is_some() {
             return Err(SessionError::AdaptivePart { share });
@@ -267,7 +288,7 @@ impl Session {
             .tile(s.width, s.height)
             .map_err(|message| SessionError::Tile { share, message })?;
         let samples = share.samples(s.samples_per_pixel);
-        Ok(Self::of_share(desc, scene, samples, tile))
+        Self::of_share(desc, scene, samples, tile)
     }
 
     /// The sample indices this session renders in every pixel.
@@ -297,7 +318,7 @@ impl Session {
                 return Err(e.into());
             }
         };
-        Self::with_scene(desc, scene).restore(checkpoint, path)
+        Self::with_scene(desc, scene)?.restore(checkpoint, path)
     }
 
     /// Continues this new session from `checkpoint` (read from `path`, which

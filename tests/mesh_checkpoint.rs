@@ -57,7 +57,7 @@ transform = [{ translate = [1.5, -0.5, -3] }]
 fn make_checkpoint(scene: &Path, out: &Path, passes: u32) {
     let file = SceneFile::read(scene).unwrap();
     let (desc, compiled) = file.resolve(&Overrides::default()).unwrap();
-    let mut session = Session::with_scene(&desc, compiled);
+    let mut session = Session::with_scene(&desc, compiled).unwrap();
     let stop = AtomicBool::new(false);
     let summary = session
         .run(&stop, None, &|_| {}, &mut |_, pass| {

@@ -439,3 +439,29 @@ fn band_of_samples(index: u32, count: u32) -> Share {
         ..Share::default()
     }
 }
+
+/// A part file can declare any image size: the merge applies the render's
+/// pixel limit to it before taking memory for the film.
+#[test]
+fn a_part_declaring_an_image_past_the_pixel_limit_is_refused() {
+    let dir = temp_dir("tiles-huge");
+    let d = desc("cover", 16, 2, 1);
+    let t = write(&d, tile("4,3,12,9", None), &dir, "tile");
+    let mut c = Checkpoint::read(&t).unwrap();
+    let mut description: serde_json::Value = serde_json::from_str(&c.description).unwrap();
+    description["render"]["width"] = 9000.into();
+    description["render"]["height"] = 9000.into();
+    c.description = description.to_string();
+    c.image = (9000, 9000);
+    let huge = dir.join("huge.lumen-part");
+    c.view().write(&huge).unwrap();
+    for partial in [false, true] {
+        let e = part::merge(&[huge.clone()], partial)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("huge.lumen-part: its image of 9000x9000 pixels has more than the 67108864"),
+            "{e}"
+        );
+    }
+}

@@ -179,7 +179,12 @@ pub fn measure_adaptive(
     let mut points = Vec::new();
     for noise_target in [Some(target), None] {
         desc.render.noise_target = noise_target;
-        let mut session = Session::with_scene(&desc, Scene::from_desc(&desc)?);
+        let mut session = Session::with_scene(&desc, Scene::from_desc(&desc)?).map_err(|e| {
+            SceneError::Invalid {
+                field: "render".into(),
+                message: e.to_string(),
+            }
+        })?;
         let start = Instant::now();
         session
             .run(&AtomicBool::new(false), None, &|_| {}, &mut |_, _| {

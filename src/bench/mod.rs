@@ -348,8 +348,22 @@ pub struct ScalingPoint {
     pub measurement: Measurement,
 }
 
+/// Peak memory a sphere of a field takes while the field is described,
+/// built and rendered (about 400 bytes measured at 10⁶ spheres, with room).
+const FIELD_BYTES_PER_SPHERE: u64 = 512;
+
 /// Builds and renders the field of about `n` spheres (400×225, `spp`, depth 50).
 pub fn measure_field(n: usize, spp: u32, runs: usize) -> Result<ScalingPoint, SceneError> {
+    // Counted before the field is made: its description alone would take
+    // more than the machine has for a large `n`.
+    crate::memory::check(
+        n as u64 * FIELD_BYTES_PER_SPHERE,
+        &format!("a field of {n} spheres"),
+    )
+    .map_err(|e| SceneError::Invalid {
+        field: "--field".into(),
+        message: e.to_string(),
+    })?;
     let mut desc = sphere_field(n);
     desc.render.samples_per_pixel = spp;
     desc.render.max_depth = 50;

@@ -91,6 +91,14 @@ pub enum MergeError {
     /// A part's description has no render settings that can be read.
     #[error("{}: its scene description has no render settings that can be read", .0.display())]
     NoRenderSettings(PathBuf),
+    /// The image has more pixels than lumen renders.
+    #[error("{}: its image of {}x{} pixels has more than the {} pixels lumen renders", .path.display(), .image.0, .image.1, crate::scene::MAX_PIXELS)]
+    TooManyPixels {
+        /// The first part.
+        path: PathBuf,
+        /// The image's size.
+        image: (u32, u32),
+    },
     /// The image is too large for this machine's memory.
     #[error("{}: its image of {}x{} pixels is too large to merge in this machine's memory", .path.display(), .image.0, .image.1)]
     TooLarge {
@@ -399,10 +407,20 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         }
         .into());
     }
-    let film = Film::try_new(w, h).ok_or_else(|| MergeError::TooLarge {
+    // A part file can declare any size: the render's own limit applies, and
+    // the film is counted against free memory before it is taken.
+    if u64::from(w) * u64::from(h) > crate::scene::MAX_PIXELS {
+        return Err(MergeError::TooManyPixels {
+            path: path.to_path_buf(),
+            image: part.image,
+        });
+    }
+    let too_large = || MergeError::TooLarge {
         path: path.to_path_buf(),
         image: part.image,
-    })?;
+    };
+    crate::memory::check(Film::bytes(w, h, false), "the film").map_err(|_| too_large())?;
+    let film = Film::try_new(w, h).ok_or_else(too_large)?;
     Ok(Merged {
         film,
         spp,

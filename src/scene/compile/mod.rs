@@ -283,6 +283,15 @@ struct LoadedModel {
     materials: Vec<Option<u32>>,
 }
 
+/// Most meshes a scene places (each mesh object once per node of its file
+/// that holds a mesh): 2^24.
+pub const MAX_INSTANCES: u64 = 1 << 24;
+
+/// Memory a placed mesh takes while the scene is built and rendered, at
+/// most: its placement, its instance and its share of the tree over the
+/// instances (about 420 bytes measured, with room).
+const BYTES_PER_PLACEMENT: u64 = 512;
+
 /// Which mesh: (file, mesh of the file, smooth).
 type MeshKey = (PathBuf, usize, bool);
 
@@ -538,6 +547,34 @@ impl<'a> Objects<'a> {
                 };
                 let path = self.load(i, file, options)?;
                 let model = &self.models[&path].model;
+                // Counted before they are taken: a file of many nodes placed
+                // by many objects multiplies.
+                let more = model.instances.len() as u64;
+                let total = self.placements.len() as u64 + more;
+                if total > MAX_INSTANCES {
+                    return Err(invalid(
+                        format!("objects[{i}].file"),
+                        format!(
+                            "{file}: with the objects before it, the scene places {total} meshes, \
+                             more than the {MAX_INSTANCES} lumen holds"
+                        ),
+                    ));
+                }
+                let room = crate::memory::check(more * BYTES_PER_PLACEMENT, "")
+                    .is_ok()
+                    .then(|| self.placements.try_reserve(more as usize).ok())
+                    .flatten();
+                if room.is_none() {
+                    let e = crate::memory::MemoryError {
+                        what: format!("placing {total} meshes"),
+                        bytes: total * BYTES_PER_PLACEMENT,
+                        available: crate::memory::available(),
+                    };
+                    return Err(invalid(
+                        format!("objects[{i}].file"),
+                        format!("{file}: {e}"),
+                    ));
+                }
                 for (mesh, node) in &model.instances {
                     let node = mat4_transform(node).ok_or_else(|| {
                         invalid(
