@@ -456,7 +456,7 @@ fn a_part_declaring_an_image_past_the_pixel_limit_is_refused() {
     let huge = dir.join("huge.lumen-part");
     c.view().write(&huge).unwrap();
     for partial in [false, true] {
-        let e = part::merge(&[huge.clone()], partial)
+        let e = part::merge(std::slice::from_ref(&huge), partial)
             .unwrap_err()
             .to_string();
         assert!(
