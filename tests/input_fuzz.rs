@@ -49,7 +49,7 @@ fn gltf_json(uri: Option<&str>) -> String {
 
 fn glb() -> Vec<u8> {
     let mut json = gltf_json(None).into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let bin = triangle();
