@@ -239,3 +239,62 @@ fn an_obj_model_reads_its_mtl_and_maps_only_in_its_folder() {
         assert!(ok, "{model}: {err}");
     }
 }
+
+/// The loaders to come (and those there are) read files through
+/// `lumen::input` only, which checks what a file is and bounds what is
+/// read: no other source file opens a file, except those that read the
+/// system's own (`/proc`), lumen's own files (checkpoints, locks, the
+/// temporary of an image being written), and tests.
+#[test]
+fn every_input_file_is_read_through_the_input_module() {
+    const OWN_FILES: &[&str] = &[
+        "input.rs",
+        "memory.rs",
+        "lock.rs",
+        "output.rs",
+        "checkpoint/header.rs",
+        "bench/mod.rs",
+    ];
+    const OPENS: &[&str] = &[
+        "fs::read(",
+        "fs::read_to_string(",
+        "File::open(",
+        "ImageReader::open(",
+        "image::open(",
+        "OpenOptions::new(",
+    ];
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut todo = vec![src.clone()];
+    let mut found = Vec::new();
+    while let Some(dir) = todo.pop() {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                todo.push(path);
+                continue;
+            }
+            let rel = path
+                .strip_prefix(&src)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            let is_test = rel.ends_with("tests.rs") || rel.contains("/tests/");
+            if !rel.ends_with(".rs") || is_test || OWN_FILES.contains(&rel.as_str()) {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            // Unit tests at the end of a file may read what they wrote.
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            for (n, line) in code.lines().enumerate() {
+                if OPENS.iter().any(|o| line.contains(o)) {
+                    found.push(format!("src/{rel}:{}: {}", n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "read without lumen::input:\n{}",
+        found.join("\n")
+    );
+}
