@@ -2,6 +2,9 @@
 //! statistics taken through the library's own render loop.
 #![allow(dead_code)]
 
+#[path = "stale.rs"]
+pub mod stale;
+
 use lumen::film::Film;
 use lumen::render::{render_samples, RenderStats};
 use lumen::scene::builtin;
@@ -232,6 +235,7 @@ pub fn read_exr_rgb(path: &std::path::Path) -> ((usize, usize), Vec<[f32; 3]>) {
 /// A fresh empty directory for one test (removed first if a previous run
 /// left it behind).
 pub fn scratch_dir(name: &str) -> std::path::PathBuf {
+    stale::remove_stale_dirs(&format!("lumen-{name}-"));
     let dir = std::env::temp_dir().join(format!("lumen-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();

@@ -1,6 +1,11 @@
 //! Helpers for the tests that run the `lumen` binary and signal it.
 #![allow(dead_code)]
 
+// Also a module of `common`, which some tests include beside this one.
+#[allow(clippy::duplicate_mod)]
+#[path = "../common/stale.rs"]
+mod stale;
+
 use lumen::checkpoint::default_path;
 use lumen::progressive::{Session, StopReason};
 use lumen::scene::{builtin, Overrides};
@@ -17,6 +22,7 @@ pub const RENDER: &[&str] = &["render", "cover", "--width", "160", "--spp", "64"
 
 /// A fresh empty directory for one test.
 pub fn temp_dir(name: &str) -> PathBuf {
+    stale::remove_stale_dirs(&format!("lumen-test-{name}-"));
     let dir = std::env::temp_dir().join(format!("lumen-test-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
