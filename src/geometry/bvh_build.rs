@@ -145,7 +145,7 @@ pub struct BinaryTree {
 /// The binary SAH tree over `primitives`.
 ///
 /// Large trees are built on several threads; the tree is the same, node
-/// for node, as the one [`build`] makes on one.
+/// for node, as the one built on one thread.
 pub fn build_binary<P: PrimitiveSet + ?Sized>(primitives: &P) -> BinaryTree {
     use rayon::prelude::*;
     let n = primitives.count();
