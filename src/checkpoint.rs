@@ -45,6 +45,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+mod canonical;
 mod consistency;
 mod format;
 mod header;

@@ -27,17 +27,24 @@ pub fn identity_text(desc: &SceneDesc, sources: &[MeshSource]) -> String {
         #[serde(skip_serializing_if = "<[MeshSource]>::is_empty")]
         mesh_sources: &'a [MeshSource],
     }
-    let mut value = serde_json::to_value(Identity {
-        desc,
-        mesh_sources: sources,
-    })
-    .expect("a scene description always serialises");
-    strip(&mut value);
-    value.to_string()
+    // Written as it goes, not through a `serde_json::Value` of the whole
+    // description: that took 700 MB for a million spheres.
+    super::canonical::sorted_json(
+        &Identity {
+            desc,
+            mesh_sources: sources,
+        },
+        &STRIPPED,
+    )
+    .expect("a scene description always serialises")
 }
 
-/// Removes from a description's JSON what does not change the samples.
-/// Checkpoints written before the identity left these out still hold them.
+/// The fields of a description that do not change the samples.
+const STRIPPED: [&[&str]; 2] = [&["caption"], &["render", "gamma"]];
+
+/// Removes from a description's JSON what does not change the samples
+/// ([`STRIPPED`]). Checkpoints written before the identity left these out
+/// still hold them.
 fn strip(value: &mut Value) {
     if let Value::Object(map) = value {
         map.remove("caption");
@@ -184,6 +191,42 @@ mod tests {
         assert!(!same_render(&old, &description_text(&desc)));
         let old = serde_json::to_string(&edited).unwrap();
         assert!(same_render(&old, &description_text(&desc)));
+    }
+
+    #[test]
+    fn the_identity_is_the_stripped_json_value_with_sorted_keys() {
+        // As the identity was made before it was written as it goes (and
+        // as checkpoints of that time hold it).
+        #[derive(serde::Serialize)]
+        struct Identity<'a> {
+            #[serde(flatten)]
+            desc: &'a SceneDesc,
+            #[serde(skip_serializing_if = "<[MeshSource]>::is_empty")]
+            mesh_sources: &'a [MeshSource],
+        }
+        let sources = [MeshSource {
+            file: "bunny \"1\".glb".into(),
+            crc: 0xdead_beef,
+            len: 1 << 40,
+        }];
+        for name in [
+            "cover",
+            "earth",
+            "materials",
+            "cornell-box",
+            "next-week-final",
+        ] {
+            let desc = builtin::find(name).unwrap().desc();
+            for sources in [&sources[..], &[]] {
+                let mut value = serde_json::to_value(Identity {
+                    desc: &desc,
+                    mesh_sources: sources,
+                })
+                .unwrap();
+                strip(&mut value);
+                assert_eq!(identity_text(&desc, sources), value.to_string(), "{name}");
+            }
+        }
     }
 
     #[test]

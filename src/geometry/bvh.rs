@@ -18,9 +18,9 @@
 //! The box tests use glam's [`Vec4`], which uses SSE2 on x86-64 and NEON on
 //! aarch64 (both always present there) and plain scalar code elsewhere.
 
-use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, MAX_LEAF};
+use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, BinaryTree, MAX_LEAF};
 use crate::geometry::instance::Instance;
-use crate::geometry::primitive::{Kind, Primitive};
+use crate::geometry::primitive::{Kind, Primitive, PrimitiveSet};
 use crate::geometry::quad::{self, QuadLanes};
 use crate::geometry::sphere::{self, SphereLanes};
 use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
@@ -234,19 +234,35 @@ impl Bvh {
     /// When an instance's tree itself holds instances, or an item names an
     /// instance that `instances` does not have.
     pub fn with_instances(primitives: &[Primitive], instances: Vec<Instance>) -> Self {
+        Self::over(primitives, instances)
+    }
+
+    /// [`Bvh::with_instances`] over items made when the build asks for them
+    /// (see [`PrimitiveSet`]).
+    ///
+    /// # Panics
+    /// As [`Bvh::with_instances`].
+    pub fn over<P: PrimitiveSet + ?Sized>(primitives: &P, instances: Vec<Instance>) -> Self {
         assert!(
             instances.iter().all(|i| i.bvh.instances.is_empty()),
             "instances hold no instances"
         );
-        let (binary, order) = build_binary(primitives);
+        let BinaryTree {
+            nodes: binary,
+            order,
+            leaves,
+        } = build_binary(primitives);
+        // A packet a leaf, reserved at once: grown by doubling, the packets
+        // of a large mesh took twice their size, and as much again to
+        // shrink them.
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(binary.len() / 3 + 1),
-            spheres: Vec::new(),
-            triangles: Vec::new(),
-            quads: Vec::new(),
-            instance_packets: Vec::new(),
+            nodes: Vec::new(),
+            spheres: Vec::with_capacity(leaves[Kind::Sphere as usize]),
+            triangles: Vec::with_capacity(leaves[Kind::Triangle as usize]),
+            quads: Vec::with_capacity(leaves[Kind::Quad as usize]),
+            instance_packets: Vec::with_capacity(leaves[Kind::Instance as usize]),
             instances,
-            bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
+            bounds: binary.first().map_or(Aabb::EMPTY, BinaryNode::bounds),
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
             spheres_only: true,
         };
@@ -259,10 +275,13 @@ impl Bvh {
             primitives,
         };
         let roots = if binary[0].is_leaf() {
-            vec![0]
+            Opened([0; 4], 1)
         } else {
             collapse.open(0)
         };
+        // Reserved at its size: an estimate took twice the nodes' memory
+        // when it was shrunk (a copy).
+        bvh.nodes = Vec::with_capacity(collapse.count_nodes(&roots));
         collapse.emit_node(&roots, &mut bvh);
         bvh.nodes.shrink_to_fit();
         bvh.spheres.shrink_to_fit();
@@ -834,20 +853,32 @@ pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], 
 pub(crate) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
 const SLACK4: Vec4 = Vec4::splat(SLACK);
 
-/// Turns the binary tree into 4-wide nodes and packets.
-struct Collapse<'a> {
-    binary: &'a [BinaryNode],
-    order: &'a [u32],
-    primitives: &'a [Primitive],
+/// The two to four binary nodes that become a wide node's children (in
+/// place: a vector each cost an allocation a node).
+struct Opened([usize; 4], usize);
+
+impl std::ops::Deref for Opened {
+    type Target = [usize];
+
+    fn deref(&self) -> &[usize] {
+        &self.0[..self.1]
+    }
 }
 
-impl Collapse<'_> {
+/// Turns the binary tree into 4-wide nodes and packets.
+struct Collapse<'a, P: ?Sized> {
+    binary: &'a [BinaryNode],
+    order: &'a [u32],
+    primitives: &'a P,
+}
+
+impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
     /// The up to four binary nodes that become the children of the wide node
     /// replacing interior node `i`: its two children, then repeatedly the
     /// interior one of largest surface area replaced by its own two children.
-    fn open(&self, i: usize) -> Vec<usize> {
+    fn open(&self, i: usize) -> Opened {
         let b = self.binary;
-        let mut list = vec![i + 1, b[i].offset as usize];
+        let mut list = Opened([i + 1, b[i].offset as usize, 0, 0], 2);
         while list.len() < 4 {
             let widest = list
                 .iter()
@@ -855,15 +886,26 @@ impl Collapse<'_> {
                 .filter(|(_, &n)| !b[n].is_leaf())
                 .max_by(|x, y| {
                     b[*x.1]
-                        .bounds
+                        .bounds()
                         .surface_area()
-                        .total_cmp(&b[*y.1].bounds.surface_area())
+                        .total_cmp(&b[*y.1].bounds().surface_area())
                 });
             let Some((pos, &n)) = widest else { break };
-            list[pos] = n + 1;
-            list.push(b[n].offset as usize);
+            list.0[pos] = n + 1;
+            list.0[list.1] = b[n].offset as usize;
+            list.1 += 1;
         }
         list
+    }
+
+    /// The number of wide nodes [`Collapse::emit_node`] emits for
+    /// `children`.
+    fn count_nodes(&self, children: &[usize]) -> usize {
+        1 + children
+            .iter()
+            .filter(|&&c| !self.binary[c].is_leaf())
+            .map(|&c| self.count_nodes(&self.open(c)))
+            .sum::<usize>()
     }
 
     /// Emits the wide node whose children are the binary nodes `children`.
@@ -878,7 +920,7 @@ impl Collapse<'_> {
                 let grandchildren = self.open(c);
                 self.emit_node(&grandchildren, bvh)
             };
-            bvh.nodes[index].set_child(lane, &node.bounds, child);
+            bvh.nodes[index].set_child(lane, &node.bounds(), child);
         }
         index as u32
     }
@@ -889,7 +931,7 @@ impl Collapse<'_> {
         let members = &self.order[first..first + leaf.count as usize];
         let mut index = [NO_CHILD; 8];
         index[..members.len()].copy_from_slice(members);
-        let primitive = |lane: usize| &self.primitives[members[lane] as usize];
+        let primitive = |lane: usize| self.primitives.primitive(members[lane] as usize);
         let kind = primitive(0).kind();
         // Fills lane `lane` of each field; unused lanes keep their filler.
         fn fill<const N: usize>(fields: &mut [Lane8; N], lane: usize, values: [f32; N]) {
@@ -965,11 +1007,11 @@ impl Collapse<'_> {
                         unreachable!("a leaf holds one kind")
                     };
                     assert!(
-                        (*index as usize) < bvh.instances.len(),
+                        (index as usize) < bvh.instances.len(),
                         "instance {index} is not among the {} given",
                         bvh.instances.len()
                     );
-                    p.instance[lane] = *index;
+                    p.instance[lane] = index;
                 }
                 bvh.instance_packets.push(p);
                 bvh.instance_packets.len() - 1

@@ -16,7 +16,7 @@ pub use bvh::Bvh;
 pub use bvh_bundle::RayBundle;
 pub use hit::HitRecord;
 pub use instance::Instance;
-pub use primitive::{Kind, Primitive};
+pub use primitive::{Kind, Primitive, PrimitiveSet};
 pub use quad::Quad;
 pub use sphere::Sphere;
 pub use triangle::Triangle;

@@ -34,6 +34,27 @@ impl Kind {
     }
 }
 
+/// The items a BVH is built over, numbered from 0, each made when the
+/// build asks for it: a slice of primitives, or shapes stored otherwise (a
+/// scene's meshes), which then need not be copied into a [`Primitive`] each
+/// (112 bytes, five times a mesh's own triangle) for the build.
+pub trait PrimitiveSet: Sync {
+    /// How many items there are.
+    fn count(&self) -> usize;
+    /// Item `i`, for `i < self.count()`.
+    fn primitive(&self, i: usize) -> Primitive;
+}
+
+impl PrimitiveSet for [Primitive] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn primitive(&self, i: usize) -> Primitive {
+        self[i]
+    }
+}
+
 /// One primitive, as a BVH is built from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {

@@ -100,21 +100,7 @@ impl TriangleMesh {
     /// area (a repeated index, or vertices on one line); returns whether it
     /// was kept. The indices must be in range.
     fn push_triangle(&mut self, tri: [u32; 3], material: u32) -> bool {
-        let [a, b, c] = tri;
-        if a == b || b == c || a == c {
-            return false;
-        }
-        // In f64 so that small but valid triangles do not round to zero area.
-        let p = |i: u32| self.positions[i as usize].map(f64::from);
-        let (pa, pb, pc) = (p(a), p(b), p(c));
-        let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-        let v = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
-        let cross = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        if cross == [0.0; 3] {
+        if !has_area(&self.positions, tri) {
             return false;
         }
         self.triangles.push(tri);
@@ -143,6 +129,26 @@ impl TriangleMesh {
         self.triangles.shrink_to_fit();
         self.material.shrink_to_fit();
     }
+}
+
+/// Whether triangle `tri` of vertices `positions` has an area: no repeated
+/// index, vertices not on one line. The indices must be in range.
+fn has_area(positions: &[[f32; 3]], tri: [u32; 3]) -> bool {
+    let [a, b, c] = tri;
+    if a == b || b == c || a == c {
+        return false;
+    }
+    // In f64 so that small but valid triangles do not round to zero area.
+    let p = |i: u32| positions[i as usize].map(f64::from);
+    let (pa, pb, pc) = (p(a), p(b), p(c));
+    let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+    let v = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
+    let cross = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    cross != [0.0; 3]
 }
 
 /// The triangles of a convex polygon (or a glTF triangle fan) fanned from

@@ -31,9 +31,10 @@ use world::{LightIds, World};
 /// squares lengths of this order in `f32` (whose maximum is about 3.4e38).
 pub const MAX_COORDINATE: f64 = 1e18;
 
-/// Largest accepted image, in pixels (e.g. 8192×8192). The film needs 28
-/// bytes a pixel and a pass in flight keeps a copy, so this caps the render's
-/// memory near 3.8 GB: larger images are refused, not attempted.
+/// Largest accepted image, in pixels (e.g. 8192×8192). The film needs 52
+/// bytes a pixel (104 with adaptive sampling) and a pass in flight keeps a
+/// copy, so this caps the film's memory near 7.0 GB (14 GB adaptive):
+/// larger images are refused, not attempted.
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// A scene description that cannot be rendered.

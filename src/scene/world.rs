@@ -11,7 +11,7 @@
 use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
-use crate::geometry::{Bvh, HitRecord, Instance, Primitive, Quad, Sphere, Triangle};
+use crate::geometry::{Bvh, HitRecord, Instance, Primitive, PrimitiveSet, Quad, Sphere, Triangle};
 use crate::light::{Light, LightTexture, Shape as LightShape};
 use crate::material::{Emissive, Material};
 use crate::math::{Color, Point3, Vec3};
@@ -104,20 +104,22 @@ impl Shapes {
         self.meshes.push(mesh);
     }
 
-    /// The tree's items, in their numbering.
-    pub(crate) fn primitives(&self) -> Vec<Primitive> {
-        let mut items: Vec<Primitive> = self
-            .spheres
-            .iter()
-            .map(|s| Primitive::Sphere(Sphere::new(s.center, s.radius)))
-            .collect();
-        items.extend(self.quads.iter().map(|(q, _)| Primitive::Quad(*q)));
-        for mesh in &self.meshes {
-            items.extend(
-                (0..mesh.data.triangles.len()).map(|k| Primitive::Triangle(mesh.triangle(k))),
-            );
+    /// How many of the tree's items are shapes (the instances come after).
+    fn shape_count(&self) -> usize {
+        self.spheres.len() + self.quads.len() + self.mesh_end.last().copied().unwrap_or(0)
+    }
+
+    /// Shape item `index` as the tree is built from it.
+    fn shape_primitive(&self, index: usize) -> Primitive {
+        match self.locate(index) {
+            Ok(Shape::Sphere(k)) => {
+                let s = &self.spheres[k];
+                Primitive::Sphere(Sphere::new(s.center, s.radius))
+            }
+            Ok(Shape::Quad(k)) => Primitive::Quad(self.quads[k].0),
+            Ok(Shape::Triangle(m, k)) => Primitive::Triangle(self.meshes[m].triangle(k)),
+            Err(_) => panic!("shape {index} of {}", self.shape_count()),
         }
-        items
     }
 
     /// The shape item `index` is, or the number of the instance it is.
@@ -213,6 +215,37 @@ impl Shapes {
                 let mesh = &self.meshes[m];
                 triangle_record(ray, t, mesh, k, index, error_scale)
             }
+        }
+    }
+}
+
+/// The items of a group's tree: its shapes, each made when the build asks
+/// for it (a mesh's triangles are not copied into primitives first).
+impl PrimitiveSet for Shapes {
+    fn count(&self) -> usize {
+        self.shape_count()
+    }
+
+    fn primitive(&self, i: usize) -> Primitive {
+        self.shape_primitive(i)
+    }
+}
+
+/// The items of the world's tree: the shapes, then the instances.
+struct WorldItems<'a> {
+    shapes: &'a Shapes,
+    instances: Vec<Primitive>,
+}
+
+impl PrimitiveSet for WorldItems<'_> {
+    fn count(&self) -> usize {
+        self.shapes.shape_count() + self.instances.len()
+    }
+
+    fn primitive(&self, i: usize) -> Primitive {
+        match i.checked_sub(self.shapes.shape_count()) {
+            Some(k) => self.instances[k],
+            None => self.shapes.shape_primitive(i),
         }
     }
 }
@@ -371,7 +404,7 @@ pub(crate) struct Group {
 impl Group {
     /// The shapes with their tree.
     pub(crate) fn new(shapes: Shapes) -> Group {
-        let bvh = Arc::new(Bvh::new(&shapes.primitives()));
+        let bvh = Arc::new(Bvh::over(&shapes, Vec::new()));
         Group { shapes, bvh }
     }
 }
@@ -432,7 +465,6 @@ impl World {
         instances: &[PlacedGroup],
         rounding: Rounding,
     ) -> World {
-        let mut items = top.primitives();
         let trees: Vec<Instance> = instances
             .iter()
             .map(|p| {
@@ -440,15 +472,19 @@ impl World {
                 Instance::moving(p.transform, p.motion, bvh)
             })
             .collect();
-        items.extend(
-            trees
+        let items = WorldItems {
+            shapes: &top,
+            instances: trees
                 .iter()
                 .enumerate()
                 .map(|(i, inst)| Primitive::Instance {
                     bounds: inst.bounds(),
                     index: i as u32,
-                }),
-        );
+                })
+                .collect(),
+        };
+        let bvh = Bvh::over(&items, trees);
+        drop(items);
         let placed = instances
             .iter()
             .map(|p| Placed {
@@ -462,7 +498,7 @@ impl World {
             })
             .collect();
         World {
-            bvh: Bvh::with_instances(&items, trees),
+            bvh,
             top,
             groups,
             placed,

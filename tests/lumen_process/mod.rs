@@ -211,3 +211,42 @@ pub fn make_checkpoint(out: &Path, passes: u32) -> Vec<u8> {
     session.checkpoint().write(&path).unwrap();
     std::fs::read(path).unwrap()
 }
+
+/// Runs `cmd` to the end; returns its output and its peak resident memory
+/// in MB (`ru_maxrss` of this child alone, from `wait4`: unlike
+/// `RUSAGE_CHILDREN`, not the largest of every child waited for so far).
+#[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes, reason = "reaped by wait4, not by std")]
+pub fn output_and_peak_mb(mut cmd: Command) -> (Output, f64) {
+    use std::io::Read;
+    use std::os::unix::process::ExitStatusExt;
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the lumen binary runs");
+    let mut out = child.stdout.take().unwrap();
+    let mut err = child.stderr.take().unwrap();
+    let stdout = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        out.read_to_end(&mut v).unwrap();
+        v
+    });
+    let mut stderr = Vec::new();
+    err.read_to_end(&mut stderr).unwrap();
+    let stdout = stdout.join().unwrap();
+    let mut status = 0;
+    // SAFETY: an all-zero rusage is valid (integers only); wait4 fills it
+    // and the status for the child it reaps, which std has not waited for.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let pid = child.id() as libc::pid_t;
+    assert_eq!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) }, pid);
+    let output = Output {
+        status: ExitStatus::from_raw(status),
+        stdout,
+        stderr,
+    };
+    // ru_maxrss is in kilobytes on Linux.
+    (output, usage.ru_maxrss as f64 / 1024.0)
+}

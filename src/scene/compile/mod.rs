@@ -143,8 +143,12 @@ impl Scene {
             sources,
             mut stats,
             reports,
+            models,
             ..
         } = objects;
+        // What the scene did not take of the files' meshes is freed before
+        // the tree is built, whose peak it would add to.
+        drop(models);
         let moves = instances.iter().any(|p| p.motion != Vec3::ZERO);
         let camera = compile_camera(
             gltf_camera.as_ref().unwrap_or(&desc.camera),
@@ -664,14 +668,26 @@ impl<'a> Objects<'a> {
             }
             list.push(p);
         }
+        // How many keys use each mesh of a file: the last to place it takes
+        // the file's arrays instead of a copy (the file's meshes are not
+        // needed after, and a large mesh was held twice).
+        let mut uses: HashMap<(&Path, usize), usize> = HashMap::new();
+        for (path, mesh_index, _) in &order {
+            *uses.entry((path.as_path(), *mesh_index)).or_default() += 1;
+        }
         for key in order {
             let placed = &by_key[key];
             let (path, mesh_index, smooth) = key;
+            let left = uses
+                .get_mut(&(path.as_path(), *mesh_index))
+                .expect("counted");
+            *left -= 1;
+            let last = *left == 0;
             // A mesh placed once and still goes into the scene's tree; a
             // moving one is carried by an instance.
             let still = placed.len() == 1 && placed[0].motion == Vec3::ZERO;
             if let (true, [only]) = (still, placed.as_slice()) {
-                let mesh = self.scene_mesh(path, *mesh_index, only.material, *smooth);
+                let mesh = self.scene_mesh(path, *mesh_index, only.material, *smooth, last);
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n;
@@ -680,7 +696,7 @@ impl<'a> Objects<'a> {
             } else {
                 // Stored once with the file's materials; an instance whose
                 // object names a material uses it instead.
-                let mesh = self.scene_mesh(path, *mesh_index, None, *smooth);
+                let mesh = self.scene_mesh(path, *mesh_index, None, *smooth, last);
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n * placed.len() as u64;
@@ -706,30 +722,31 @@ impl<'a> Objects<'a> {
         Ok(())
     }
 
-    /// Mesh `mesh_index` of the file at `path` with scene materials.
+    /// Mesh `mesh_index` of the file at `path` with scene materials; `last`:
+    /// no other placement uses the file's mesh after this one, whose arrays
+    /// it takes.
     fn scene_mesh(
         &mut self,
         path: &Path,
         mesh_index: usize,
         override_material: Option<u32>,
         smooth: bool,
+        last: bool,
     ) -> Mesh {
-        let source = &self.models[path].model.meshes[mesh_index];
-        let mut data = TriangleMesh {
-            positions: source.positions.clone(),
-            normals: if smooth { source.normals.clone() } else { None },
-            uvs: source.uvs.clone(),
-            uvs1: source.uvs1.clone(),
-            colors: source.colors.clone(),
-            tangents: if smooth {
-                source.tangents.clone()
-            } else {
-                None
-            },
-            triangles: source.triangles.clone(),
-            material: Vec::new(),
+        let loaded = self.models.get_mut(path).expect("loaded");
+        let source = &mut loaded.model.meshes[mesh_index];
+        let source = if last {
+            std::mem::take(source)
+        } else {
+            source.clone()
         };
-        let file_materials = source.material.clone();
+        let file_materials = source.material;
+        let mut data = TriangleMesh {
+            normals: if smooth { source.normals } else { None },
+            tangents: if smooth { source.tangents } else { None },
+            material: Vec::new(),
+            ..source
+        };
         data.material = match override_material {
             Some(m) => vec![m],
             None => {
