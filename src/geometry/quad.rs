@@ -15,6 +15,10 @@ use crate::ray::{Ray, RayLanes};
 /// direction) miss: the book's threshold.
 const PARALLEL: f32 = 1e-8;
 
+/// How much a quad grows on every side as it is traced, relative to the
+/// size of its coordinates (see [`Quad::grown`]).
+const GROWTH: f32 = 1.0 / (1u32 << 20) as f32;
+
 /// A parallelogram with corners Q, Q + u, Q + u + v, Q + v.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quad {
@@ -61,6 +65,31 @@ impl Quad {
             normal: -self.normal,
             d: -self.d,
             ..self
+        }
+    }
+
+    /// The quad as it is traced: grown on every side by a bound on the
+    /// rounding of its corners and edges (2⁻²⁰ of their size). Two quads
+    /// placed to share an edge (two faces of a turned box) are each
+    /// rounded apart, and a ray could pass between them; grown, they
+    /// overlap instead. The plane is kept to the bit, so that every hit
+    /// distance is the quad's own; only hits this close outside an edge
+    /// are added.
+    pub fn grown(&self) -> Quad {
+        let (min, max) = self.bounds();
+        let size = min.abs().max(max.abs()).max_element()
+            + self.u.abs().max_element()
+            + self.v.abs().max_element();
+        // The margin in α is margin·|v|/|u × v|, and |u × v| = 1/|w|.
+        let scale = size * GROWTH * self.w.length();
+        let (da, db) = (scale * self.v.length(), scale * self.u.length());
+        let (ka, kb) = (1.0 + 2.0 * da, 1.0 + 2.0 * db);
+        Quad {
+            corner: self.corner - da * self.u - db * self.v,
+            u: ka * self.u,
+            v: kb * self.v,
+            w: self.w / (ka * kb),
+            ..*self
         }
     }
 

@@ -111,7 +111,7 @@ impl Shapes {
             .iter()
             .map(|s| Primitive::Sphere(Sphere::new(s.center, s.radius)))
             .collect();
-        items.extend(self.quads.iter().map(|(q, _)| Primitive::Quad(*q)));
+        items.extend(self.quads.iter().map(|(q, _)| Primitive::Quad(q.grown())));
         for mesh in &self.meshes {
             items.extend(
                 (0..mesh.data.triangles.len()).map(|k| Primitive::Triangle(mesh.triangle(k))),
