@@ -33,18 +33,16 @@ pub fn radiance(scene: &Scene, ray: Ray, sampler: &mut impl Sampler, rays: &mut 
     }
 }
 
-/// The interval of hits counted: hits closer than epsilon are the surface the
-/// ray leaves from, seen again through rounding error, and counting them is
-/// what causes shadow acne.
-#[inline(always)]
-pub fn hit_range(scene: &Scene) -> Interval {
-    Interval::new(scene.settings.epsilon, f32::INFINITY)
-}
+/// Every distance along a ray: hits count from 0 (but see
+/// [`Scene::intersect_leaving`]).
+const ALL: Interval = Interval::new(0.0, f32::INFINITY);
 
 /// What becomes of a path at the end of one segment.
 enum Step {
-    /// It goes on along this ray.
-    Continue(Ray),
+    /// It goes on along this ray, leaving the surface of this hit (none
+    /// where it left a particle of a medium): closer than the epsilon, that
+    /// surface is not met again (see [`Scene::intersect_leaving`]).
+    Continue(Ray, Option<Hit>),
     /// It ends, carrying this colour back.
     Done(Color),
 }
@@ -138,7 +136,8 @@ fn step(
     sampler.start_bounce(depth);
     let nee = samples_lights(scene, depth) && bsdf.has_density();
     if nee {
-        let (light, traced) = light_at_surface(scene, &record, &bsdf, wo, ray.time(), sampler);
+        let (light, traced) =
+            light_at_surface(scene, &record, &hit, &bsdf, wo, ray.time(), sampler);
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
@@ -150,11 +149,10 @@ fn step(
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);
     }
-    Step::Continue(Ray::timed(
-        record.spawn_origin(sample.wi),
-        sample.wi,
-        ray.time(),
-    ))
+    Step::Continue(
+        Ray::timed(record.spawn_origin(sample.wi), sample.wi, ray.time()),
+        Some(hit),
+    )
 }
 
 /// The light a path brings back from an emitter it met at `record` (`hit`):
@@ -180,12 +178,13 @@ fn emission(
     }
 }
 
-/// [`direct_light`] at a surface point `record` scattering by `bsdf`,
-/// seen from `wo` (pointing back along the ray).
+/// [`direct_light`] at a surface point `record` (of `hit`) scattering by
+/// `bsdf`, seen from `wo` (pointing back along the ray).
 #[inline(never)]
 fn light_at_surface(
     scene: &Scene,
     record: &HitRecord,
+    hit: &Hit,
     bsdf: &Bsdf,
     wo: Vec3,
     time: f32,
@@ -197,6 +196,7 @@ fn light_at_surface(
         time,
         |wi| bsdf.eval_and_pdf(wo, wi),
         |wi| record.spawn_origin(wi),
+        Some(hit),
         sampler,
     )
 }
@@ -249,6 +249,7 @@ fn scatter_in_medium(
             ray.time(),
             |_| (medium.albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
             |_| point,
+            None,
             sampler,
         );
         path.radiance += path.throughput * light;
@@ -260,7 +261,7 @@ fn scatter_in_medium(
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);
     }
-    Step::Continue(Ray::timed(point, direction, ray.time()))
+    Step::Continue(Ray::timed(point, direction, ray.time()), None)
 }
 
 /// Whether the path, its throughput updated by the scattering at the end
@@ -316,7 +317,8 @@ fn samples_lights(scene: &Scene, depth: u32) -> bool {
 /// particle's) sends towards the path per unit light arriving from it
 /// (f · |cos θ| for a surface) and the density with which it would scatter
 /// there itself (0 where it cannot); `spawn` where a ray leaving along a
-/// direction starts (a surface's rounding bound off it).
+/// direction starts (a surface's rounding bound off it); `from` the
+/// surface's hit (none at a particle).
 #[inline(never)]
 fn direct_light(
     scene: &Scene,
@@ -324,6 +326,7 @@ fn direct_light(
     time: f32,
     scatter: impl Fn(Vec3) -> (Color, f32),
     spawn: impl Fn(Vec3) -> Point3,
+    from: Option<&Hit>,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
     let Some(sample) = scene.lights.sample(point, sampler) else {
@@ -349,11 +352,11 @@ fn direct_light(
         let end = length * (1.0 - 1e-4) - sample.point.abs().max_element() * 1e-6;
         (Ray::timed(origin, to / length, time), end)
     };
-    if !(end > scene.settings.epsilon) {
-        // Closer than the nearest hit a bounce can make: out of reach.
+    if !(end > 0.0) {
+        // At the start: out of reach.
         return (Color::ZERO, false);
     }
-    if scene.occluded(&shadow, Interval::new(scene.settings.epsilon, end)) {
+    if scene.occluded_leaving(&shadow, from, end) {
         return (Color::ZERO, true);
     }
     let weight = power_heuristic(sample.pdf, scatter_pdf);
@@ -377,15 +380,15 @@ pub fn trace_path(
     sampler: &mut impl Sampler,
     rays: &mut u64,
 ) -> Color {
-    let range = hit_range(scene);
     let mut path = PathState::START;
+    let mut from = None;
     // A path still going after `max_depth` segments keeps what it gathered.
     let mut colour = None;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
-        let hit = scene.intersect(&ray, range);
+        let hit = scene.intersect_leaving(&ray, from.as_ref(), f32::INFINITY);
         match step(scene, &ray, hit, depth, &mut path, sampler) {
-            Step::Continue(next) => ray = next,
+            Step::Continue(next, left) => (ray, from) = (next, left),
             Step::Done(c) => {
                 colour = Some(c);
                 break;
@@ -425,23 +428,24 @@ pub fn trace_paths<S: Sampler>(
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
-    let range = hit_range(scene);
     let mut paths = [PathState::START; PATHS];
     let mut hits = [None; PATHS];
+    // The surface each path's ray leaves.
+    let mut from: [Option<Hit>; PATHS] = [None; PATHS];
     // The paths still going, in order.
     let mut live: [u8; PATHS] = std::array::from_fn(|i| i as u8);
     let mut n_live = n;
     for round in 0..scene.settings.max_depth {
         *traced += n_live as u64;
         let reference = (round == 0).then_some(reference);
-        find_hits(scene, rays, &live[..n_live], reference, range, &mut hits);
+        find_hits(scene, rays, &from, &live[..n_live], reference, &mut hits);
         let mut still = 0;
         for k in 0..n_live {
             let i = live[k] as usize;
             let sampler = &mut samplers[i];
             match step(scene, &rays[i], hits[i], round, &mut paths[i], sampler) {
-                Step::Continue(next) => {
-                    rays[i] = next;
+                Step::Continue(next, left) => {
+                    (rays[i], from[i]) = (next, left);
                     live[still] = i as u8;
                     still += 1;
                 }
@@ -465,16 +469,17 @@ pub fn trace_paths<S: Sampler>(
     *traced += paths[..n].iter().map(|p| p.shadow_rays).sum::<u64>();
 }
 
-/// Sets `hits[i]` to the hit of `rays[i]` for every path `i` of `live`:
-/// eight at a time as bundles where they pay off, the few left over (and
-/// every ray elsewhere) one by one.
+/// Sets `hits[i]` to the hit of `rays[i]`, which leaves the surface of hit
+/// `from[i]`, for every path `i` of `live`: eight at a time as bundles
+/// where they pay off, the few left over (and every ray elsewhere) one by
+/// one.
 #[inline(always)]
 fn find_hits(
     scene: &Scene,
     rays: &[Ray],
+    from: &[Option<Hit>; PATHS],
     live: &[u8],
     reference: Option<&Ray>,
-    range: Interval,
     hits: &mut [Option<Hit>; PATHS],
 ) {
     // Where bundles do not pay off, no group is large enough for one.
@@ -486,14 +491,16 @@ fn find_hits(
     for group in live.chunks(LANES) {
         if group.len() < min_bundle {
             for &i in group {
-                hits[i as usize] = scene.intersect(&rays[i as usize], range);
+                let i = i as usize;
+                hits[i] = scene.intersect_leaving(&rays[i], from[i].as_ref(), f32::INFINITY);
             }
             continue;
         }
         let reference = reference.unwrap_or(&rays[group[0] as usize]);
-        let found = scene.hit_bundle(rays, group, reference, range);
+        let found = scene.hit_bundle(rays, group, reference, ALL);
         for (&i, hit) in group.iter().zip(found) {
-            hits[i as usize] = hit;
+            let i = i as usize;
+            hits[i] = scene.counted(&rays[i], hit, from[i].as_ref(), f32::INFINITY);
         }
     }
 }
@@ -502,7 +509,7 @@ fn find_hits(
 /// first, shown as a flat colour or as its normal.
 pub(crate) fn first_hit_view(scene: &Scene, ray: Ray, shading: Shading, rays: &mut u64) -> Color {
     *rays += 1;
-    let Some(hit) = scene.hit(&ray, hit_range(scene)) else {
+    let Some(hit) = scene.hit(&ray, ALL) else {
         return scene.background.color(ray.direction);
     };
     let outward = hit.outward_normal();

@@ -335,12 +335,19 @@ impl Bvh {
     /// not the nearest: a shadow ray's question).
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
-        let (t, ..) = if self.spheres_only() {
+        self.any_hit(ray, interval).is_some()
+    }
+
+    /// The first hit of `ray` within `interval` that the traversal finds,
+    /// not necessarily the nearest.
+    #[inline(always)]
+    pub fn any_hit(&self, ray: &Ray, interval: Interval) -> Option<Hit> {
+        let (t, index, sub) = if self.spheres_only() {
             self.single::<AnyHit, true>(ray, interval)
         } else {
             self.single::<AnyHit, false>(ray, interval)
         };
-        t < interval.max
+        (t < interval.max).then_some(Hit { t, index, sub })
     }
 
     /// Traverses for one ray asking `Q`; `SPHERES` when the tree holds
@@ -619,7 +626,12 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
         if Q::ANY {
             let hit = valid & t.lt(closest);
             if hit.any() {
-                self.closest = R::select(hit, t, closest).min_lane();
+                // Which primitive, with its distance: a ray leaving a
+                // surface asks whether it only found that surface again.
+                let nearest = R::select(hit, t, closest);
+                self.closest = nearest.min_lane();
+                let at = R::bits(hit & nearest.eq(R::splat(self.closest)));
+                self.best = index[at.trailing_zeros() as usize];
                 return true;
             }
             return false;
@@ -671,9 +683,11 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             let instance = &bvh.instances[p.instance[lane] as usize];
             if Q::ANY {
                 let within = Interval::new(self.t_min, self.closest);
-                if instance.occluded(&self.ray, within) {
-                    // Any distance below the interval's end says "hit".
-                    self.closest = self.t_min;
+                if let Some((t, sub)) = instance.any_hit(&self.ray, within) {
+                    // Any distance below the interval's end says "hit"; the
+                    // world distance may round to the end.
+                    self.closest = if t < self.closest { t } else { self.t_min };
+                    (self.best, self.sub) = (index, sub);
                     return true;
                 }
                 continue;

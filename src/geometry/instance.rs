@@ -123,8 +123,18 @@ impl Instance {
     /// Whether the world ray hits the instance strictly inside `interval`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, interval: Interval) -> bool {
+        self.any_hit(ray, interval).is_some()
+    }
+
+    /// The first hit the traversal finds of the world ray strictly inside
+    /// `interval` (in the instance's space), not necessarily the nearest:
+    /// its world distance and the index of the primitive in the
+    /// instance's tree.
+    #[inline]
+    pub fn any_hit(&self, ray: &Ray, interval: Interval) -> Option<(f32, u32)> {
         let (object_ray, scale) = self.object_ray(ray);
         let within = Interval::new(interval.min * scale, interval.max * scale);
-        self.bvh.occluded(&object_ray, within)
+        let hit = self.bvh.any_hit(&object_ray, within)?;
+        Some((hit.t / scale, hit.index))
     }
 }

@@ -15,6 +15,10 @@ use crate::ray::{Ray, RayLanes};
 /// direction) miss: the book's threshold.
 const PARALLEL: f32 = 1e-8;
 
+/// How much a quad grows on every side as it is traced, relative to the
+/// size of its coordinates (see [`Quad::grown`]).
+const GROWTH: f32 = 1.0 / (1u32 << 20) as f32;
+
 /// A parallelogram with corners Q, Q + u, Q + u + v, Q + v.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quad {
@@ -64,6 +68,31 @@ impl Quad {
         }
     }
 
+    /// The quad as it is traced: grown on every side by a bound on the
+    /// rounding of its corners and edges (2⁻²⁰ of their size). Two quads
+    /// placed to share an edge (two faces of a turned box) are each
+    /// rounded apart, and a ray could pass between them; grown, they
+    /// overlap instead. The plane is kept to the bit, so that every hit
+    /// distance is the quad's own; only hits this close outside an edge
+    /// are added.
+    pub fn grown(&self) -> Quad {
+        let (min, max) = self.bounds();
+        let size = min.abs().max(max.abs()).max_element()
+            + self.u.abs().max_element()
+            + self.v.abs().max_element();
+        // The margin in α is margin·|v|/|u × v|, and |u × v| = 1/|w|.
+        let scale = size * GROWTH * self.w.length();
+        let (da, db) = (scale * self.v.length(), scale * self.u.length());
+        let (ka, kb) = (1.0 + 2.0 * da, 1.0 + 2.0 * db);
+        Quad {
+            corner: self.corner - da * self.u - db * self.v,
+            u: ka * self.u,
+            v: kb * self.v,
+            w: self.w / (ka * kb),
+            ..*self
+        }
+    }
+
     /// Whether its outside is against u × v (see [`Quad::flipped`]).
     pub fn is_flipped(&self) -> bool {
         self.normal.dot(self.u.cross(self.v)) < 0.0
@@ -93,6 +122,42 @@ impl Quad {
     pub fn coordinates(&self, point: Point3) -> (f32, f32) {
         let p = point - self.corner;
         (self.w.dot(p.cross(self.v)), self.w.dot(self.u.cross(p)))
+    }
+
+    /// `point`, a point of the quad's plane at coordinates `(alpha,
+    /// beta)`, moved into the quad (from outside too, as it is traced
+    /// grown) until it is at least `margin` from every edge (onto the
+    /// middle line where the quad is narrower than twice that), with its
+    /// coordinates there. A hit a rounding away from an
+    /// edge may lie on the plane of a wall meeting the quad there, or past
+    /// it, and a ray leaving from it would not meet that wall.
+    #[inline]
+    pub fn within(
+        &self,
+        point: Point3,
+        (alpha, beta): (f32, f32),
+        margin: f32,
+    ) -> (Point3, [f32; 2]) {
+        // α is α·|u × v|/|v| from the edges along v, and |u × v| = 1/|w|:
+        // the margin is margin·|v|·|w| in α (squared here, to leave the
+        // square roots to the rare points that are that close).
+        let scale = margin * margin * self.w.length_squared();
+        let (alpha2, beta2) = (
+            scale * self.v.length_squared(),
+            scale * self.u.length_squared(),
+        );
+        // Outside too: the quad is traced grown (see `Quad::grown`).
+        let near =
+            |x: f32, m2: f32| x * x < m2 || (1.0 - x) * (1.0 - x) < m2 || !(0.0..=1.0).contains(&x);
+        if !(near(alpha, alpha2) || near(beta, beta2)) {
+            return (point, [alpha, beta]);
+        }
+        let inside = |x: f32, m2: f32| {
+            let m = m2.sqrt().min(0.5);
+            x.clamp(m, 1.0 - m)
+        };
+        let (a, b) = (inside(alpha, alpha2), inside(beta, beta2));
+        (point + (a - alpha) * self.u + (b - beta) * self.v, [a, b])
     }
 
     /// The quad as one lane of [`intersect`].
@@ -217,6 +282,47 @@ mod tests {
         let ray = Ray::new(Vec3::new(0.0, 3.0, 0.0), -Vec3::Y);
         assert_eq!(q.hit(&ray, Interval::new(0.0, 2.5)), None);
         assert_eq!(q.hit(&ray, Interval::new(3.0, 5.0)), None);
+    }
+
+    #[test]
+    fn grown_quads_keep_their_plane_and_reach_past_their_edges() {
+        let q = Quad::new(
+            Vec3::new(0.3, 1.7, -2.1),
+            Vec3::new(1.1, 0.4, 0.2),
+            Vec3::new(-0.3, 0.9, 0.6),
+        )
+        .expect("a real quad");
+        let g = q.grown();
+        assert_eq!((g.normal, g.d), (q.normal, q.d));
+        // Just outside the edge α = 1, by far less than the growth.
+        let p = q.corner + (1.0 + 1e-6) * q.u + 0.5 * q.v;
+        let ray = Ray::new(p + q.normal, -q.normal);
+        let all = Interval::new(0.0, f32::INFINITY);
+        assert_eq!(q.hit(&ray, all), None);
+        assert!(g.hit(&ray, all).is_some());
+        // And not much further.
+        let far = q.corner + 1.001 * q.u + 0.5 * q.v;
+        assert_eq!(g.hit(&Ray::new(far + q.normal, -q.normal), all), None);
+    }
+
+    #[test]
+    fn points_at_an_edge_are_moved_in_by_the_margin() {
+        let q = floor();
+        let margin = 1e-3;
+        // (α, β) = (1, 0.25): on the edge x = 1.
+        let edge = Vec3::new(1.0, 0.0, -0.5);
+        let (p, [a, b]) = q.within(edge, q.coordinates(edge), margin);
+        assert!((1.0 - p.x - margin).abs() < 1e-6, "{p}");
+        assert_eq!((p.y, p.z), (0.0, -0.5));
+        assert_eq!(q.coordinates(p), (a, b));
+        // Outside (a hit on the grown quad) too.
+        let outside = Vec3::new(-1.0 - 1e-5, 0.0, 0.0);
+        let (p, _) = q.within(outside, q.coordinates(outside), margin);
+        assert!((p.x + 1.0 - margin).abs() < 1e-6, "{p}");
+        // Inside the margin, nothing moves; without one, nothing inside.
+        let inner = Vec3::new(0.3, 0.0, 0.2);
+        assert_eq!(q.within(inner, q.coordinates(inner), margin).0, inner);
+        assert_eq!(q.within(edge, q.coordinates(edge), 0.0).0, edge);
     }
 
     #[test]

@@ -150,8 +150,9 @@ pub struct Settings {
     pub noise_target: Option<f32>,
     /// Display gamma.
     pub gamma: f32,
-    /// Shadow-acne epsilon: smallest accepted hit distance (0 when the
-    /// scene gives none).
+    /// Shadow-acne epsilon: how far along a ray leaving a surface that
+    /// surface is not met again (0 when the scene gives none); see
+    /// [`Scene::intersect_leaving`].
     pub epsilon: f32,
     /// Whether rays leave surfaces offset by the hit's rounding error (all
     /// but the notes' epsilon 0).
@@ -199,6 +200,19 @@ pub struct Scene {
 /// stops at the next, whatever that one's opacity (a bound on the work
 /// of a ray through foliage).
 const MAX_CUTOUTS: u32 = 64;
+
+/// The most times a ray looks past the surface it leaves, met again closer
+/// than the epsilon, before it falls back on ignoring every hit that close
+/// (a sphere is met at most twice; more is rounding gone astray).
+const MAX_REHITS: u32 = 4;
+
+/// The smallest distance beyond a hit at `t` that is surely past it: a
+/// little more than the rounding of its distance (an instance's hit is
+/// found again in its own space, and its distance rounded twice).
+#[inline]
+fn beyond(t: f32) -> f32 {
+    t + t.abs() * 4.0 * f32::EPSILON + f32::MIN_POSITIVE
+}
 
 /// A number in [0, 1) made from the ray and the distance of a hit on it:
 /// whether a partly present surface stops the ray is decided by it, the
@@ -322,11 +336,91 @@ impl Scene {
             if self.stops(ray, hit) {
                 return Some(hit);
             }
-            // Past it, by a little more than the rounding of its distance
-            // (an instance's hit is found again in its own space).
-            interval.min = hit.t + hit.t.abs() * 4.0 * f32::EPSILON + f32::MIN_POSITIVE;
+            interval.min = beyond(hit.t);
         }
         self.world.bvh.hit(ray, interval)
+    }
+
+    /// Whether `hit` is the surface `from`, which the ray leaves, met again
+    /// closer than the epsilon: the hit the epsilon is there to ignore.
+    #[inline(always)]
+    fn rehit(&self, hit: &Hit, from: Option<&Hit>) -> bool {
+        hit.t <= self.settings.epsilon
+            && from.is_some_and(|f| f.index == hit.index && f.sub == hit.sub)
+    }
+
+    /// The nearest hit of `ray` before `t_max` that counts, for a ray
+    /// leaving the surface of hit `from` (`None`: a ray from the camera or
+    /// from a particle of a medium). Every surface counts from distance 0
+    /// except the one the ray leaves, which counts only beyond the
+    /// epsilon: an epsilon applied to every surface would also pass over a
+    /// wall meeting the one left at a corner, closer than it, and let the
+    /// ray out of a closed room. The ray's direction must have unit length.
+    #[inline(always)]
+    pub fn intersect_leaving(&self, ray: &Ray, from: Option<&Hit>, t_max: f32) -> Option<Hit> {
+        let hit = self.intersect(ray, Interval::new(0.0, t_max));
+        self.counted(ray, hit, from, t_max)
+    }
+
+    /// Of `hit`, the nearest hit of `ray` from distance 0 to `t_max` (as
+    /// [`Scene::hit_bundle`] finds it), the hit that counts for a ray
+    /// leaving the surface of hit `from`: `hit` itself, or when it is that
+    /// surface met again closer than the epsilon, the nearest beyond it
+    /// that counts (see [`Scene::intersect_leaving`]).
+    #[inline(always)]
+    pub fn counted(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        from: Option<&Hit>,
+        t_max: f32,
+    ) -> Option<Hit> {
+        match hit {
+            Some(h) if self.rehit(&h, from) => self.intersect_past(ray, h, from, t_max),
+            hit => hit,
+        }
+    }
+
+    /// [`Scene::intersect_leaving`] after it met the surface left at
+    /// `hit`: the nearest hit that counts beyond it (rays leave surfaces
+    /// offset by their rounding, so that this is rare).
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn intersect_past(
+        &self,
+        ray: &Ray,
+        mut hit: Hit,
+        from: Option<&Hit>,
+        t_max: f32,
+    ) -> Option<Hit> {
+        for _ in 0..MAX_REHITS {
+            hit = self.intersect(ray, Interval::new(beyond(hit.t), t_max))?;
+            if !self.rehit(&hit, from) {
+                return Some(hit);
+            }
+        }
+        self.intersect(ray, Interval::new(self.settings.epsilon, t_max))
+    }
+
+    /// Whether `ray`, leaving the surface of hit `from` (see
+    /// [`Scene::intersect_leaving`]), hits anything that counts before
+    /// `t_max`: a shadow ray's question.
+    #[inline(always)]
+    pub fn occluded_leaving(&self, ray: &Ray, from: Option<&Hit>, t_max: f32) -> bool {
+        let interval = Interval::new(0.0, t_max);
+        let any = if self.cutouts {
+            self.intersect_solid(ray, interval)
+        } else {
+            self.world.bvh.any_hit(ray, interval)
+        };
+        match any {
+            None => false,
+            // Found first, not nearest: something else may lie before it.
+            Some(hit) if self.rehit(&hit, from) => {
+                self.intersect_leaving(ray, from, t_max).is_some()
+            }
+            Some(_) => true,
+        }
     }
 
     /// Whether the surface `ray` meets at `hit` is there.

@@ -116,7 +116,7 @@ impl Shapes {
                 let s = &self.spheres[k];
                 Primitive::Sphere(Sphere::new(s.center, s.radius))
             }
-            Ok(Shape::Quad(k)) => Primitive::Quad(self.quads[k].0),
+            Ok(Shape::Quad(k)) => Primitive::Quad(self.quads[k].0.grown()),
             Ok(Shape::Triangle(m, k)) => Primitive::Triangle(self.meshes[m].triangle(k)),
             Err(_) => panic!("shape {index} of {}", self.shape_count()),
         }
@@ -145,9 +145,19 @@ impl Shapes {
     }
 
     /// The record of a hit on `shape` (item `index`) at distance `t` of
-    /// `ray`, in the space the shapes are stored in.
+    /// `ray`, in the space the shapes are stored in. A quad's or a
+    /// triangle's hit point is kept at least its error bound, and at least
+    /// `margin`, inside its edges.
     #[inline(always)]
-    fn record(&self, ray: &Ray, t: f32, shape: Shape, index: u32, rounding: Rounding) -> HitRecord {
+    fn record(
+        &self,
+        ray: &Ray,
+        t: f32,
+        shape: Shape,
+        index: u32,
+        rounding: Rounding,
+        margin: f32,
+    ) -> HitRecord {
         let error_scale = rounding.scale;
         match shape {
             Shape::Sphere(k) => {
@@ -193,27 +203,30 @@ impl Shapes {
                 // On the plane: the ray's rounding along its length removed.
                 let p = ray.at(t);
                 let point = p - (quad.normal.dot(p) - quad.d) * quad.normal;
+                let error = (point.abs().max_element() + quad.d.abs()) * error_scale;
+                // Kept a rounding bound inside the edges, where a wall
+                // meeting the quad is surely ahead of a ray leaving it.
+                let (point, uv) = quad.within(point, quad.coordinates(point), error.max(margin));
                 let (normal, front_face) = face_normal(ray, quad.normal);
-                let (alpha, beta) = quad.coordinates(point);
                 HitRecord {
                     point,
                     normal,
                     shading_normal: normal,
-                    uv: [alpha, beta],
+                    uv,
                     t,
                     front_face,
                     material: *material,
                     object: index,
-                    uv1: [alpha, beta],
+                    uv1: uv,
                     dpdu: quad.u,
                     dpdv: quad.v,
                     color: glam::Vec4::ONE,
-                    error: (point.abs().max_element() + quad.d.abs()) * error_scale,
+                    error,
                 }
             }
             Shape::Triangle(m, k) => {
                 let mesh = &self.meshes[m];
-                triangle_record(ray, t, mesh, k, index, error_scale)
+                triangle_record(ray, t, mesh, k, index, error_scale, margin)
             }
         }
     }
@@ -266,7 +279,8 @@ fn sphere_derivatives(n: Vec3, r: f32) -> (Vec3, Vec3) {
 
 /// The record of a hit on triangle `k` of `mesh`. The point is rebuilt
 /// from its barycentric coordinates, so that it lies on the triangle to
-/// within the rounding of the vertices, whatever the ray's length.
+/// within the rounding of the vertices, whatever the ray's length, and at
+/// least its error bound and `margin` inside the edges.
 fn triangle_record(
     ray: &Ray,
     t: f32,
@@ -274,12 +288,18 @@ fn triangle_record(
     k: usize,
     index: u32,
     error_scale: f32,
+    margin: f32,
 ) -> HitRecord {
     let tri = mesh.triangle(k);
     let [a, b, c] = tri.vertices;
     let area_normal = tri.area_normal();
     let geometric = area_normal.normalize();
     let b_ = barycentrics(&tri, area_normal, ray.at(t));
+    let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
+    let error = extent.max_element() * error_scale;
+    // Kept a rounding bound inside the edges, where a triangle meeting
+    // this one at a crease is surely ahead of a ray leaving it.
+    let b_ = within(&tri, area_normal, b_, error.max(margin));
     let point = b_[0] * a + b_[1] * b + b_[2] * c;
     let (normal, front_face) = face_normal(ray, geometric);
     let idx = mesh.data.triangles[k].map(|i| i as usize);
@@ -333,7 +353,6 @@ fn triangle_record(
             dpdv = bitangent * dpdv.length();
         }
     }
-    let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
     HitRecord {
         point,
         normal,
@@ -347,7 +366,7 @@ fn triangle_record(
         dpdu,
         dpdv,
         color,
-        error: extent.max_element() * error_scale,
+        error,
     }
 }
 
@@ -394,6 +413,34 @@ fn barycentrics(tri: &Triangle, n: Vec3, p: Point3) -> [f32; 3] {
     [1.0 - b1 - b2, b1, b2]
 }
 
+/// Barycentric coordinates `b` in `tri` (of area normal `n`) moved into
+/// the triangle until the point is at least `margin` from every edge (to
+/// the centroid where the triangle is narrower than that): a point a
+/// rounding away from an edge may lie on the plane of a triangle meeting
+/// this one at a crease, or past it, and a ray leaving from it would not
+/// meet that triangle.
+fn within(tri: &Triangle, n: Vec3, b: [f32; 3], margin: f32) -> [f32; 3] {
+    let [p, q, r] = tri.vertices;
+    // bᵢ is bᵢ·|n|/|eᵢ| from the edge eᵢ opposite vertex i: the margin is
+    // margin·|eᵢ|/|n| in bᵢ (squared here, to leave the square roots to the
+    // rare points that are that close).
+    let scale = margin * margin / n.length_squared();
+    let m2 = [r - q, p - r, q - p].map(|e| scale * e.length_squared());
+    if (0..3).all(|i| b[i] * b[i] >= m2[i]) {
+        return b;
+    }
+    let m = m2.map(f32::sqrt);
+    let total = m[0] + m[1] + m[2];
+    if !(total < 1.0) {
+        return [1.0 / 3.0; 3];
+    }
+    // Those too close raised to their margin; the others' excess over
+    // theirs shrunk to make up the sum of 1.
+    let raised = [0, 1, 2].map(|i| b[i].max(m[i]) - m[i]);
+    let k = (1.0 - total) / (raised[0] + raised[1] + raised[2]);
+    [0, 1, 2].map(|i| m[i] + raised[i] * k)
+}
+
 /// Shapes shared by instances, with their own tree.
 #[derive(Clone, Debug)]
 pub(crate) struct Group {
@@ -432,6 +479,9 @@ struct Placed {
     /// The transform's linear part's Frobenius norm: at most how much it
     /// stretches the object's rounding.
     stretch: f32,
+    /// The same of its inverse: a length of `shrink` × ℓ in the object is
+    /// at least ℓ in the world.
+    shrink: f32,
 }
 
 /// The compiled shapes of a scene.
@@ -485,16 +535,20 @@ impl World {
         };
         let bvh = Bvh::over(&items, trees);
         drop(items);
+        let norm = |t: &Transform| {
+            [Vec3::X, Vec3::Y, Vec3::Z]
+                .map(|e| t.vector(e).length_squared())
+                .iter()
+                .sum::<f32>()
+                .sqrt()
+        };
         let placed = instances
             .iter()
             .map(|p| Placed {
                 group: p.group,
                 material: p.material,
-                stretch: [Vec3::X, Vec3::Y, Vec3::Z]
-                    .map(|e| p.transform.vector(e).length_squared())
-                    .iter()
-                    .sum::<f32>()
-                    .sqrt(),
+                stretch: norm(&p.transform),
+                shrink: norm(&p.transform.inverse()),
             })
             .collect();
         World {
@@ -542,7 +596,9 @@ impl World {
     #[inline(always)]
     pub(crate) fn record(&self, ray: &Ray, hit: Hit) -> HitRecord {
         match self.top.locate(hit.index as usize) {
-            Ok(shape) => self.top.record(ray, hit.t, shape, hit.index, self.rounding),
+            Ok(shape) => self
+                .top
+                .record(ray, hit.t, shape, hit.index, self.rounding, 0.0),
             Err(i) => self.instance_record(ray, hit, i),
         }
     }
@@ -558,9 +614,18 @@ impl World {
             .shapes
             .locate(hit.sub as usize)
             .expect("instances hold no instances");
-        let inner = group
-            .shapes
-            .record(&object_ray, hit.t * scale, shape, hit.sub, self.rounding);
+        // Kept inside its edges by the world's rounding too: the point is
+        // placed in the world with it, which could undo a margin of the
+        // object's own (an instance far from the origin).
+        let margin = ray.at(hit.t).abs().max_element() * self.rounding.scale * placed.shrink;
+        let inner = group.shapes.record(
+            &object_ray,
+            hit.t * scale,
+            shape,
+            hit.sub,
+            self.rounding,
+            margin,
+        );
         let point = instance.world_point(inner.point, ray.time());
         let (normal, front_face) = face_normal(ray, transform.normal(inner.outward_normal()));
         let shading_normal = if inner.is_smooth() {
@@ -743,5 +808,34 @@ impl World {
             ids = LightIds::default();
         }
         (lights, ids)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_at_a_triangles_edge_are_moved_in_by_the_margin() {
+        // The right triangle (0,0), (2,0), (0,2) in z = 0.
+        let tri = Triangle::new(Vec3::ZERO, 2.0 * Vec3::X, 2.0 * Vec3::Y);
+        let n = tri.area_normal();
+        let point =
+            |b: [f32; 3]| b[0] * tri.vertices[0] + b[1] * tri.vertices[1] + b[2] * tri.vertices[2];
+        let margin = 1e-3;
+        // On the edge y = 0: moved to y = margin.
+        let b = within(&tri, n, [0.5, 0.5, 0.0], margin);
+        assert!((b.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert!((point(b).y - margin).abs() < 1e-6, "{b:?}");
+        // On the hypotenuse x + y = 2, at a corner of it: at least the
+        // margin from all three edges.
+        let b = within(&tri, n, [0.0, 1.0, 0.0], margin);
+        let p = point(b);
+        assert!(p.y >= margin * 0.999 && (2.0 - p.x - p.y) / 2f32.sqrt() >= margin * 0.999);
+        // Inside the margin nothing moves, and nothing without one.
+        assert_eq!(within(&tri, n, [0.2, 0.3, 0.5], margin), [0.2, 0.3, 0.5]);
+        assert_eq!(within(&tri, n, [0.5, 0.5, 0.0], 0.0), [0.5, 0.5, 0.0]);
+        // Narrower than the margin: the centroid.
+        assert_eq!(within(&tri, n, [1.0, 0.0, 0.0], 1.0), [1.0 / 3.0; 3]);
     }
 }

@@ -141,8 +141,9 @@ pub struct RenderDesc {
     pub noise_target: Option<f64>,
     /// Display gamma: output = linear^(1/gamma). 1 disables the correction.
     pub gamma: f64,
-    /// Smallest ray parameter accepted as a hit (the notes' fix for shadow
-    /// acne; 0 shows the acne); absent, rays leave each surface by its
+    /// How far along a ray leaving a surface that surface is not met again
+    /// (the notes' fix for shadow acne; 0 shows the acne); other surfaces
+    /// count at any distance. Absent, rays leave each surface by its
     /// rounding error alone, which holds at any scale.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub epsilon: Option<f64>,
