@@ -35,6 +35,9 @@ pub struct Quad {
     pub w: Vec3,
     /// D = n·Q: the plane's offset.
     pub d: f32,
+    /// 1/|u × v| times |v| and |u|: how far a step of 1 in α and in β
+    /// takes a point from an edge, inverted (see [`Quad::within`]).
+    pub inverse_widths: [f32; 2],
 }
 
 impl Quad {
@@ -46,7 +49,8 @@ impl Quad {
         if !(n2 > 0.0) || !n2.is_finite() {
             return None;
         }
-        let normal = n / n2.sqrt();
+        let length = n2.sqrt();
+        let normal = n / length;
         Some(Quad {
             corner,
             u,
@@ -54,6 +58,7 @@ impl Quad {
             normal,
             w: n / n2,
             d: normal.dot(corner),
+            inverse_widths: [v.length() / length, u.length() / length],
         })
     }
 
@@ -84,11 +89,13 @@ impl Quad {
         let scale = size * GROWTH * self.w.length();
         let (da, db) = (scale * self.v.length(), scale * self.u.length());
         let (ka, kb) = (1.0 + 2.0 * da, 1.0 + 2.0 * db);
+        let [wa, wb] = self.inverse_widths;
         Quad {
             corner: self.corner - da * self.u - db * self.v,
             u: ka * self.u,
             v: kb * self.v,
             w: self.w / (ka * kb),
+            inverse_widths: [wa / ka, wb / kb],
             ..*self
         }
     }
@@ -138,25 +145,16 @@ impl Quad {
         (alpha, beta): (f32, f32),
         margin: f32,
     ) -> (Point3, [f32; 2]) {
-        // α is α·|u × v|/|v| from the edges along v, and |u × v| = 1/|w|:
-        // the margin is margin·|v|·|w| in α (squared here, to leave the
-        // square roots to the rare points that are that close).
-        let scale = margin * margin * self.w.length_squared();
-        let (alpha2, beta2) = (
-            scale * self.v.length_squared(),
-            scale * self.u.length_squared(),
-        );
+        // A point at α is α·|u × v|/|v| from the edges along v: the margin
+        // is margin·|v|/|u × v| in α.
+        let [wa, wb] = self.inverse_widths;
+        let (ma, mb) = ((margin * wa).min(0.5), (margin * wb).min(0.5));
         // Outside too: the quad is traced grown (see `Quad::grown`).
-        let near =
-            |x: f32, m2: f32| x * x < m2 || (1.0 - x) * (1.0 - x) < m2 || !(0.0..=1.0).contains(&x);
-        if !(near(alpha, alpha2) || near(beta, beta2)) {
+        let inside = |x: f32, m: f32| m <= x && x <= 1.0 - m;
+        if inside(alpha, ma) && inside(beta, mb) {
             return (point, [alpha, beta]);
         }
-        let inside = |x: f32, m2: f32| {
-            let m = m2.sqrt().min(0.5);
-            x.clamp(m, 1.0 - m)
-        };
-        let (a, b) = (inside(alpha, alpha2), inside(beta, beta2));
+        let (a, b) = (alpha.clamp(ma, 1.0 - ma), beta.clamp(mb, 1.0 - mb));
         (point + (a - alpha) * self.u + (b - beta) * self.v, [a, b])
     }
 

@@ -419,23 +419,38 @@ fn barycentrics(tri: &Triangle, n: Vec3, p: Point3) -> [f32; 3] {
 /// rounding away from an edge may lie on the plane of a triangle meeting
 /// this one at a crease, or past it, and a ray leaving from it would not
 /// meet that triangle.
+#[inline(always)]
 fn within(tri: &Triangle, n: Vec3, b: [f32; 3], margin: f32) -> [f32; 3] {
     let [p, q, r] = tri.vertices;
     // bᵢ is bᵢ·|n|/|eᵢ| from the edge eᵢ opposite vertex i: the margin is
-    // margin·|eᵢ|/|n| in bᵢ (squared here, to leave the square roots to the
-    // rare points that are that close).
-    let scale = margin * margin / n.length_squared();
-    let m2 = [r - q, p - r, q - p].map(|e| scale * e.length_squared());
-    if (0..3).all(|i| b[i] * b[i] >= m2[i]) {
+    // margin·|eᵢ|/|n| in bᵢ (compared squared and multiplied out, to leave
+    // the square roots and the division to the rare points that close).
+    let (n2, margin2) = (n.length_squared(), margin * margin);
+    let e2 = [r - q, p - r, q - p].map(|e| e.length_squared());
+    if (0..3).all(|i| b[i] * b[i] * n2 >= margin2 * e2[i]) {
         return b;
     }
-    let m = m2.map(f32::sqrt);
+    raise(
+        b,
+        e2.map(|e2| (f64::from(margin2 * e2) / f64::from(n2)).sqrt()),
+    )
+}
+
+/// [`within`] for a point closer than the margins `m` to an edge.
+#[cold]
+#[inline(never)]
+fn raise(b: [f32; 3], m: [f64; 3]) -> [f32; 3] {
+    lift(b.map(f64::from), m).map(|b| b as f32)
+}
+
+/// Barycentric coordinates `b` with every `bᵢ` at least `m[i]`: those
+/// below raised to it, the others' excess over theirs shrunk to make up
+/// the sum of 1 (the centroid where the margins leave no room).
+fn lift(b: [f64; 3], m: [f64; 3]) -> [f64; 3] {
     let total = m[0] + m[1] + m[2];
     if !(total < 1.0) {
         return [1.0 / 3.0; 3];
     }
-    // Those too close raised to their margin; the others' excess over
-    // theirs shrunk to make up the sum of 1.
     let raised = [0, 1, 2].map(|i| b[i].max(m[i]) - m[i]);
     let k = (1.0 - total) / (raised[0] + raised[1] + raised[2]);
     [0, 1, 2].map(|i| m[i] + raised[i] * k)
