@@ -272,6 +272,65 @@ fn cases() -> Vec<Case> {
             "[[objects]]\ntype = \"quad\"",
             &["objects[1]", "parallel or zero"],
         ),
+        // What a scene may not write, its transforms may not make: every
+        // coordinate and radius at most 1e18, the true reason given.
+        case(
+            "quad-too-large",
+            QUAD.replace("corner = [0, 0, -2]", "corner = [2e18, 0, -2]"),
+            "[[objects]]\ntype = \"quad\"",
+            &["objects[1]", "corner and edges", "at most 1e18"],
+        ),
+        case(
+            "quad-too-small",
+            QUAD.replace("u = [1, 0, 0]", "u = [1e-20, 0, 0]")
+                .replace("v = [0, 1, 0]", "v = [0, 1e-20, 0]"),
+            "[[objects]]\ntype = \"quad\"",
+            &["objects[1]", "too small for f32"],
+        ),
+        case(
+            "box-too-large",
+            BOX.replace("max = [1, 1, -2]", "max = [1, 2e18, -2]"),
+            "[[objects]]\ntype = \"box\"",
+            &["objects[1]", "min and max", "at most 1e18"],
+        ),
+        case(
+            "sphere-scaled-too-large",
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\ntransform = [{ scale = 1e25 }]\n",
+            "transform = [{ scale = 1e25 }]",
+            &["objects[1].transform", "the sphere", "1.00e25", "1e18"],
+        ),
+        case(
+            "sphere-stretched-too-large",
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\ntransform = [{ scale = [1e19, 2e19, 1e19] }]\n",
+            "transform = [{ scale = [1e19",
+            &["objects[1].transform", "the sphere", "1e18"],
+        ),
+        case(
+            "quad-placed-too-large",
+            transformed("{ translate = [5e18, 0, 0] }"),
+            "transform = [{ scale = 2 }",
+            &["objects[1].transform", "the quad", "1e18"],
+        ),
+        case(
+            "box-placed-too-large",
+            BOX.to_string() + "transform = [{ scale = 1e19 }]\n",
+            "transform = [{ scale = 1e19 }]",
+            &["objects[1].transform", "the box", "1e18"],
+        ),
+        case(
+            "mesh-placed-too-large",
+            mesh("tri.obj") + "transform = [{ scale = 1e19 }]\n",
+            "[[objects]]\ntype = \"mesh\"",
+            &["objects[1]", "mesh's vertices", "1e18"],
+        )
+        .with("tri.obj", TRI),
+        case(
+            "instanced-too-large",
+            mesh("tri.obj") + &mesh("tri.obj") + "transform = [{ translate = [0, 3e18, 0] }]\n",
+            "[[objects]]\ntype = \"mesh\"\nfile = \"tri.obj\"\ntransform",
+            &["objects[2]", "mesh's vertices", "1e18"],
+        )
+        .with("tri.obj", TRI),
         case(
             "flat-box",
             BOX.replace("max = [1, 1, -2]", "max = [1, 0, -2]"),

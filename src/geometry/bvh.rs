@@ -595,6 +595,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
                 origin: [0.0; 3],
                 shear: [0.0; 3],
                 t_min: 0.0,
+                origin2: 0.0,
             };
             ([0, 1, 2], none)
         };
@@ -745,6 +746,7 @@ fn splat_triangle_ray<R: Real>(r: &TriangleRay<f32>) -> TriangleRay<R> {
         origin: map3(&r.origin, R::splat),
         shear: map3(&r.shear, R::splat),
         t_min: R::splat(r.t_min),
+        origin2: R::splat(r.origin2),
     }
 }
 

@@ -218,6 +218,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             origin: [[0.0; LANES]; 3],
             shear: [[0.0; LANES]; 3],
             t_min: [interval.min; LANES],
+            origin2: [0.0; LANES],
         };
         let mut is_axis = [[0; 2]; 3];
         if !SPHERES && bvh.has_triangles() {
@@ -225,6 +226,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
                 let ray = rays.ray(lane);
                 let axes = TriangleRay::axes_of(ray.direction);
                 let r = TriangleRay::new(&ray, axes, interval.min);
+                triangle.origin2[lane] = r.origin2;
                 for k in 0..3 {
                     triangle.origin[k][lane] = r.origin[k];
                     triangle.shear[k][lane] = r.shear[k];
@@ -346,6 +348,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             origin: map3(&self.triangle.origin, R::from_array),
             shear: map3(&self.triangle.shear, R::from_array),
             t_min: R::from_array(self.triangle.t_min),
+            origin2: R::from_array(self.triangle.origin2),
         };
         let is_axis = map3(&self.is_axis, |[x, y]| {
             (R::mask_from_bits(x), R::mask_from_bits(y))
@@ -603,6 +606,18 @@ mod tests {
                     Quad::new(c, u, v).expect("edges not parallel"),
                 ));
             }
+            // Below it all a floor far larger than the view, whose hits'
+            // distances are worked out again in f64, lane by lane.
+            let s = 1e8;
+            let corner = |x: f32, z: f32| Vec3::new(x * s, -0.5, z * s);
+            let (a, b, c, d) = (
+                corner(-1.0, -1.0),
+                corner(1.0, -1.0),
+                corner(1.0, 1.0),
+                corner(-1.0, 1.0),
+            );
+            prims.push(Primitive::Triangle(Triangle::new(a, d, c)));
+            prims.push(Primitive::Triangle(Triangle::new(a, c, b)));
         }
         let bvh = Bvh::new(&prims);
         let interval = Interval::new(0.001, f32::INFINITY);

@@ -40,26 +40,76 @@ pub struct Quad {
     pub inverse_widths: [f32; 2],
 }
 
+/// Edges closer to parallel than this (the sine of their angle) make no
+/// quad: their cross product, the quad's normal, is then as much rounding
+/// as direction.
+const PARALLEL_EDGES: f32 = 1.0 / (1u32 << 20) as f32;
+
 impl Quad {
     /// The quad at `corner` with edges `u` and `v`, or `None` when the edges
-    /// are parallel or zero (the quad has no area).
+    /// are parallel or zero (the quad has no area; see
+    /// [`Quad::parallel`]) or too small for its `f32` arithmetic (|u × v|
+    /// below about 1e-38).
     pub fn new(corner: Point3, u: Vec3, v: Vec3) -> Option<Quad> {
-        let n = u.cross(v);
-        let n2 = n.length_squared();
-        if !(n2 > 0.0) || !n2.is_finite() {
+        if Quad::parallel(u, v) {
             return None;
         }
-        let length = n2.sqrt();
-        let normal = n / length;
+        let n = u.cross(v);
+        let n2 = n.length_squared();
+        let (normal, w, length) = if n2.is_normal() {
+            let length = n2.sqrt();
+            (n / length, n / n2, length)
+        } else {
+            // |u × v|² overflows (edges of 6e9) or underflows: worked out
+            // in f64, where it does not.
+            let n = u.as_dvec3().cross(v.as_dvec3());
+            let length = n.length();
+            let normal = n / length;
+            (
+                Vec3::from(normal.as_vec3()),
+                Vec3::from((normal / length).as_vec3()),
+                length as f32,
+            )
+        };
+        if !(w.is_finite() && length.is_finite() && w != Vec3::ZERO) {
+            return None;
+        }
+        // Where the plane passes much nearer the origin than the corner
+        // lies (a turned floor of 1e9 under a camera at the origin), the
+        // terms of n·Q cancel, and in f32 what is left is their rounding
+        // (to 16 times nearer, that rounding is within about 2⁻²⁰ of D).
+        // There D is the distance of the true plane (of u × v in f64) from
+        // the origin: the plane of the rounded normal then passes through
+        // the true plane's point nearest the origin, where the rays are,
+        // and strays from it only in proportion to the distance from there.
+        let d = normal.dot(corner);
+        let terms = (normal * corner).abs().element_sum();
+        let d = if terms > 16.0 * d.abs() {
+            let n = u.as_dvec3().cross(v.as_dvec3());
+            (n.dot(corner.as_dvec3()) / n.length()) as f32
+        } else {
+            d
+        };
         Some(Quad {
             corner,
             u,
             v,
             normal,
-            w: n / n2,
-            d: normal.dot(corner),
+            w,
+            d,
             inverse_widths: [v.length() / length, u.length() / length],
         })
+    }
+
+    /// Whether edges `u` and `v` are zero or parallel (or so nearly that
+    /// their sine is below 2⁻²⁰): relative to their lengths, so that a
+    /// quad is one at any size.
+    pub fn parallel(u: Vec3, v: Vec3) -> bool {
+        // In f64, where neither the product of the lengths nor the cross
+        // product's square overflows or underflows.
+        let (u, v) = (u.as_dvec3(), v.as_dvec3());
+        let sine = u.cross(v).length() / (u.length() * v.length());
+        !(sine > f64::from(PARALLEL_EDGES))
     }
 
     /// The same parallelogram with its outside on the other side: what a
@@ -328,5 +378,33 @@ mod tests {
         assert!(Quad::new(Vec3::ZERO, Vec3::X, 2.0 * Vec3::X).is_none());
         assert!(Quad::new(Vec3::ZERO, Vec3::ZERO, Vec3::Y).is_none());
         assert!(Quad::new(Vec3::ZERO, Vec3::X, Vec3::Y).is_some());
+        // Nearly parallel: the cross product is rounding.
+        let nearly = Vec3::new(1.0, 1e-7, 0.0);
+        assert!(Quad::new(Vec3::ZERO, Vec3::X, nearly).is_none());
+    }
+
+    #[test]
+    fn perpendicular_edges_make_a_quad_at_any_size() {
+        // |u × v|² overflows f32 from edges of about 4e9.
+        for size in [1e-3f32, 1.0, 6e9, 1e12, 1e18] {
+            let q = Quad::new(
+                Vec3::new(-size, 0.0, -size),
+                2.0 * size * Vec3::Z,
+                2.0 * size * Vec3::X,
+            )
+            .unwrap_or_else(|| panic!("no quad of size {size}"));
+            assert_eq!(q.normal, Vec3::Y, "size {size}");
+            let ray = Ray::new(Vec3::new(0.3 * size, 1.0, 0.2 * size), -Vec3::Y);
+            assert_eq!(
+                q.hit(&ray, Interval::new(0.0, f32::INFINITY)),
+                Some(1.0),
+                "size {size}"
+            );
+            assert_eq!(
+                q.coordinates(Vec3::new(-size, 0.0, size)),
+                (1.0, 0.0),
+                "size {size}"
+            );
+        }
     }
 }

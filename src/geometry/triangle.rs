@@ -67,6 +67,18 @@ impl Triangle {
         (valid && t < interval.max).then_some(t)
     }
 
+    /// The distance along `ray` (unit or not) to the triangle's plane,
+    /// worked out in `f64` (see [`plane_distance`]); `None` when the ray
+    /// runs along the plane.
+    pub fn plane_distance(&self, ray: &Ray) -> Option<f32> {
+        let t = plane_distance(
+            ray.origin().to_array(),
+            ray.direction.to_array().map(f64::from),
+            self.vertices.map(|v| v.to_array()),
+        )? as f32;
+        t.is_finite().then_some(t)
+    }
+
     /// The triangle as one lane of [`intersect`], in the ray's axes.
     pub fn lanes(&self, axes: &[usize; 3]) -> TriangleLanes<f32> {
         TriangleLanes {
@@ -85,6 +97,9 @@ pub struct TriangleRay<R> {
     pub shear: [R; 3],
     /// Hits at or before this distance are not counted.
     pub t_min: R,
+    /// The origin's squared length: how far from the world's origin the
+    /// ray's rounding is measured (see [`intersect`]).
+    pub origin2: R,
 }
 
 impl TriangleRay<f32> {
@@ -96,6 +111,7 @@ impl TriangleRay<f32> {
             origin: axes.map(|k| ray.origin()[k]),
             shear: [d[0] / d[2], d[1] / d[2], 1.0 / d[2]],
             t_min,
+            origin2: ray.origin().length_squared(),
         }
     }
 
@@ -167,7 +183,98 @@ pub fn intersect<R: Real>(ray: &TriangleRay<R>, tri: &TriangleLanes<R>) -> (R, R
             }
         }
     }
+    // The distance is a weighted mean of the vertices' distances along z,
+    // and is off by a few roundings of the farthest: where a vertex lies
+    // much farther along the ray than the hit and the ray's origin are
+    // from the world's origin (a large floor seen from near it), that is
+    // more than the rounding of the ray itself, the hit may even fall
+    // behind the ray, and it is worked out again in f64. Sure where
+    // z² ≤ REACH²·(|o|² + t²) for every vertex, and t is finite (the
+    // products overflow beyond about 1e12).
+    let tt = t * t;
+    let bound = R::splat(REACH * REACH) * (ray.origin2 + tt);
+    let near = |z: R| (z * z).le(bound);
+    let sure = near(a[2]) & near(b[2]) & near(c[2]) & tt.lt(R::splat(f32::INFINITY));
+    let unsure = hit & !sure;
+    if unsure.any() {
+        t = precise_lanes(ray, tri, unsure, t);
+    }
     (t, hit & ray.t_min.lt(t))
+}
+
+/// `t` with the lanes of `unsure` replaced by their distances worked out
+/// in f64 ([`precise_distance`]).
+#[cold]
+#[inline(never)]
+fn precise_lanes<R: Real>(
+    ray: &TriangleRay<R>,
+    tri: &TriangleLanes<R>,
+    unsure: R::Mask,
+    mut t: R,
+) -> R {
+    for lane in 0..R::LANES {
+        if unsure.lane(lane) {
+            let pick = |p: &[R; 3]| [p[0].lane(lane), p[1].lane(lane), p[2].lane(lane)];
+            let [p, q, r] = &tri.vertices;
+            let precise = precise_distance(
+                pick(&ray.origin),
+                pick(&ray.shear),
+                [pick(p), pick(q), pick(r)],
+            );
+            t = t.with_lane(lane, precise.unwrap_or(t.lane(lane)));
+        }
+    }
+    t
+}
+
+/// How much farther along the ray than the ray's origin and the hit are
+/// from the world's origin a triangle's vertices may lie before the hit's
+/// distance is worked out again in `f64`: the `f32` distance is off by
+/// about 8 roundings (2⁻²⁰) of the farthest vertex's, so by about 2⁻¹⁸ of
+/// the ray's size, as its hit point is rounded.
+const REACH: f32 = 4.0;
+
+/// The distance along the ray to the plane of the triangle `vertices`
+/// (in the ray's axes), worked out in `f64` (see [`plane_distance`]).
+/// `origin` and `shear` are the prepared ray's ([`TriangleRay`]).
+#[cold]
+#[inline(never)]
+fn precise_distance(origin: [f32; 3], shear: [f32; 3], vertices: [[f32; 3]; 3]) -> Option<f32> {
+    let [sx, sy, sz] = shear.map(f64::from);
+    // The direction scaled to 1 along z, whose distances are the z
+    // distances: the ray's are 1/dz (`sz`) times those.
+    let t = plane_distance(origin, [sx, sy, 1.0], vertices)? * sz;
+    let t = t as f32;
+    t.is_finite().then_some(t)
+}
+
+/// The distance from `origin` along `direction` to the plane of the
+/// triangle `vertices`, in `f64`, as n·(a − o)/(n·d) with n the normal
+/// (b − a) × (c − a): exact where the triangle is axis-aligned (a floor),
+/// and otherwise off by about 2⁻⁵³ of the vertices' distance from the
+/// origin, where the `f32` test's weighted mean of the vertices' distances
+/// can keep nothing of a hit near the origin of a ray. `None` when the ray
+/// runs along the plane.
+pub(crate) fn plane_distance(
+    origin: [f32; 3],
+    direction: [f64; 3],
+    vertices: [[f32; 3]; 3],
+) -> Option<f64> {
+    let [a, b, c] = vertices.map(|v| v.map(f64::from));
+    let o = origin.map(f64::from);
+    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    let (e1, e2) = (sub(b, a), sub(c, a));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let along = dot(n, direction);
+    if along == 0.0 {
+        return None;
+    }
+    Some(dot(n, sub(a, o)) / along)
 }
 
 /// The test of one ray whose `f32` edge functions have a zero: they are

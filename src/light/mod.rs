@@ -55,12 +55,22 @@ pub enum Shape {
 impl Shape {
     /// The surface area.
     pub fn area(&self) -> f32 {
+        // The length of a cross product, in f64 where its square overflows
+        // f32 (edges beyond about 4e9).
+        let length = |n: Vec3, p: Vec3, q: Vec3| {
+            let l = n.length();
+            if l.is_finite() {
+                l
+            } else {
+                p.as_dvec3().cross(q.as_dvec3()).length() as f32
+            }
+        };
         match *self {
             Shape::Sphere { radius, .. } => 4.0 * PI * radius * radius,
-            Shape::Quad { u, v, .. } => u.cross(v).length(),
+            Shape::Quad { u, v, .. } => length(u.cross(v), u, v),
             Shape::Triangle {
                 vertices: [a, b, c],
-            } => 0.5 * (b - a).cross(c - a).length(),
+            } => 0.5 * length((b - a).cross(c - a), b - a, c - a),
         }
     }
 }

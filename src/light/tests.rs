@@ -363,3 +363,19 @@ fn a_sky_sample_is_infinitely_far_and_weighted_by_its_chance() {
         "{seen_sky} of 1000 from the sky"
     );
 }
+
+#[test]
+fn areas_of_quads_and_triangles_whose_squares_overflow_f32() {
+    // |u × v|² overflows f32 from edges of about 4e9.
+    let (u, v) = (Vec3::new(6e9, 0.0, 0.0), Vec3::new(0.0, 0.0, 6e9));
+    let quad = Shape::Quad {
+        corner: Vec3::ZERO,
+        u,
+        v,
+    };
+    assert_eq!(quad.area(), 3.6e19);
+    let triangle = Shape::Triangle {
+        vertices: [Vec3::ZERO, u, v],
+    };
+    assert_eq!(triangle.area(), 1.8e19);
+}

@@ -293,14 +293,27 @@ fn triangle_record(
     let tri = mesh.triangle(k);
     let [a, b, c] = tri.vertices;
     let area_normal = tri.area_normal();
-    let geometric = area_normal.normalize();
     let b_ = barycentrics(&tri, area_normal, ray.at(t));
-    let extent = (b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs();
-    let error = extent.max_element() * error_scale;
-    // Kept a rounding bound inside the edges, where a triangle meeting
-    // this one at a crease is surely ahead of a ray leaving it.
-    let b_ = within(&tri, area_normal, b_, error.max(margin));
-    let point = b_[0] * a + b_[1] * b + b_[2] * c;
+    let extent = ((b_[0] * a).abs() + (b_[1] * b).abs() + (b_[2] * c).abs()).max_element();
+    // Rebuilt from its barycentric coordinates, the point is rounded to
+    // the size of the vertices; on a triangle much larger than the ray (a
+    // floor of 1e8 seen from 1 above it) that is more than the ray's own
+    // rounding, and the point is taken along the ray instead (see
+    // `large_hit`), as it is where the normal's square overflows f32 (a
+    // triangle beyond about 1e9).
+    let reach = ray.origin().abs().max_element() + t.abs();
+    let (geometric, point, b_, error) =
+        if area_normal.length_squared().is_normal() && extent <= ALONG * reach {
+            let error = extent * error_scale;
+            // Kept a rounding bound inside the edges, where a triangle
+            // meeting this one at a crease is surely ahead of a ray
+            // leaving it.
+            let b_ = within(&tri, area_normal, b_, error.max(margin));
+            let point = b_[0] * a + b_[1] * b + b_[2] * c;
+            (area_normal.normalize(), point, b_, error)
+        } else {
+            large_hit(&tri, ray, t, error_scale, margin)
+        };
     let (normal, front_face) = face_normal(ray, geometric);
     let idx = mesh.data.triangles[k].map(|i| i as usize);
     let shading_normal = match &mesh.data.normals {
@@ -413,6 +426,12 @@ fn barycentrics(tri: &Triangle, n: Vec3, p: Point3) -> [f32; 3] {
     [1.0 - b1 - b2, b1, b2]
 }
 
+/// How much larger than the ray's origin and length a triangle's hit point
+/// (by the size of its coordinates) may be before the point is taken along
+/// the ray rather than rebuilt from the vertices: 16 times less rounded
+/// there.
+const ALONG: f32 = 16.0;
+
 /// Barycentric coordinates `b` in `tri` (of area normal `n`) moved into
 /// the triangle until the point is at least `margin` from every edge (to
 /// the centroid where the triangle is narrower than that): a point a
@@ -441,6 +460,69 @@ fn within(tri: &Triangle, n: Vec3, b: [f32; 3], margin: f32) -> [f32; 3] {
 #[inline(never)]
 fn raise(b: [f32; 3], m: [f64; 3]) -> [f32; 3] {
     lift(b.map(f64::from), m).map(|b| b as f32)
+}
+
+/// The geometric normal, point, barycentric coordinates and error bound of
+/// a hit at distance `t` along `ray` on `tri`, a triangle far larger than
+/// the ray (see `triangle_record`): the distance worked out again in f64
+/// (the test's may be off by 2⁻¹² of it), the point taken along the ray
+/// there, and its coordinates and margin from the edges in f64.
+#[cold]
+#[inline(never)]
+fn large_hit(
+    tri: &Triangle,
+    ray: &Ray,
+    t: f32,
+    error_scale: f32,
+    margin: f32,
+) -> (Vec3, Point3, [f32; 3], f32) {
+    let geometric = Vec3::from(tri.area_normal().as_dvec3().normalize().as_vec3());
+    let p = ray.at(tri.plane_distance(ray).unwrap_or(t));
+    let origin = ray.origin().abs().max_element();
+    let error = (origin + (p - ray.origin()).abs().max_element()) * error_scale;
+    let (point, b) = within_large(tri, p, error.max(margin));
+    (geometric, point, b, error)
+}
+
+/// [`within`] for a point `p` of the plane of `tri` far smaller than the
+/// triangle (see [`ALONG`]), and its barycentric coordinates, worked out
+/// in f64: in f32 they are rounded to the size of the triangle, which is
+/// more than the point's distance from an edge can tell.
+fn within_large(tri: &Triangle, p: Point3, margin: f32) -> (Point3, [f32; 3]) {
+    let [a, b, c] = tri.vertices.map(|v| v.as_dvec3());
+    let q = p.as_dvec3();
+    let n = (b - a).cross(c - a);
+    let n2 = n.length_squared();
+    // Each from the triangle the point spans with the opposite edge (not 1
+    // minus the others, which cancels near that edge).
+    let part = |s: glam::DVec3, t: glam::DVec3| (s - q).cross(t - q).dot(n) / n2;
+    let bary = [part(b, c), part(c, a), part(a, b)];
+    let scale = f64::from(margin) / n2.sqrt();
+    let m = [c - b, a - c, b - a].map(|e| scale * e.length());
+    if (0..3).all(|i| bary[i] >= m[i]) {
+        return (p, bary.map(|x| x as f32));
+    }
+    if (0..3).any(|i| bary[i] < -m[i]) {
+        // Outside by more than the margin: the test's edges are rounded to
+        // the size of the vertices, and the ray met the plane by the
+        // neighbour's side of an edge it shares; the point stays there.
+        return (p, lift(bary, [0.0; 3]).map(|x| x as f32));
+    }
+    if !(m[0] + m[1] + m[2] < 1.0) {
+        let centre = (a + b + c) / 3.0;
+        return (centre.as_vec3().into(), [1.0 / 3.0; 3]);
+    }
+    // Those short of their margin (by s) raised to it, the others' excess
+    // over theirs (r) shrunk to pay for it: the point moves by Σ (sᵢ −
+    // rᵢ·S/R)·vᵢ, whose weights sum to 0, worked out along the edges
+    // (adding the vertices themselves would round the point to their size).
+    let s = [0, 1, 2].map(|i| (m[i] - bary[i]).max(0.0));
+    let r = [0, 1, 2].map(|i| (bary[i] - m[i]).max(0.0));
+    let (short, excess) = (s[0] + s[1] + s[2], r[0] + r[1] + r[2]);
+    let shift = [0, 1, 2].map(|i| s[i] - r[i] * short / excess);
+    let point = q + shift[1] * (b - a) + shift[2] * (c - a);
+    let lifted = [0, 1, 2].map(|i| (bary[i] + shift[i]) as f32);
+    (point.as_vec3().into(), lifted)
 }
 
 /// Barycentric coordinates `b` with every `bᵢ` at least `m[i]`: those

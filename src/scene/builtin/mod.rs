@@ -89,7 +89,7 @@ scenes! {
     "diffuse-zero-bounces", "Zero bounces (max depth 1): only the background lights anything" => || diffuse_grey(2.0, true, 1);
     "diffuse-recursive", "Bounces traced recursively up to depth 50, each halving the colour: contact shadows appear" => || diffuse_grey(2.0, true, 50);
     "shadow-acne", "Shadow acne: with epsilon 0 bounce rays hit their own surface" => || acne(0.0);
-    "shadow-acne-fixed", "Shadow acne fixed by ignoring hits closer than 0.001" => || acne(0.001);
+    "shadow-acne-fixed", "Shadow acne fixed by ignoring the surface a ray leaves within 0.001" => || acne(0.001);
     "bounce-cube", "Bounce towards a random point on a cube around p + N" => || bounce(BounceDesc::Cube);
     "bounce-sphere-volume", "Bounce towards a random point inside the tangent unit sphere" => || bounce(BounceDesc::SphereVolume);
     "bounce-lambertian", "Bounce towards a random point on the tangent unit sphere: true Lambertian" => || bounce(BounceDesc::Lambertian);

@@ -12,6 +12,7 @@ use super::{
     MAX_COORDINATE, MAX_PIXELS,
 };
 use crate::camera::{Camera, CameraError, CameraSettings};
+use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
@@ -435,6 +436,8 @@ impl<'a> Objects<'a> {
                         if !placed.center.is_finite() || !(placed.radius.is_finite()) {
                             return Err(out_of_range(i));
                         }
+                        let extent = placed.center.abs().max_element().max(placed.radius);
+                        placed_within(i, "the sphere", extent)?;
                         self.top.spheres.push(Surface::new(&placed, m, uv));
                         self.spheres.push(placed);
                     }
@@ -442,6 +445,13 @@ impl<'a> Objects<'a> {
                         // Stretched unevenly (an ellipsoid) or turned with
                         // its texture: traced as the sphere in its own
                         // space.
+                        let (min, max) = sphere.bounds();
+                        let placed = transform.bounds(&Aabb { min, max });
+                        if !(placed.min.is_finite() && placed.max.is_finite()) {
+                            return Err(out_of_range(i));
+                        }
+                        let extent = placed.min.abs().max(placed.max.abs()).max_element();
+                        placed_within(i, "the sphere", extent)?;
                         let mut shapes = Shapes::default();
                         // Placed by an instance, whose material may be
                         // another: (u, v) always.
@@ -466,8 +476,24 @@ impl<'a> Objects<'a> {
                 for (name, value) in [("corner", corner), ("u", u), ("v", v)] {
                     finite(format_args!("objects[{i}].{name}"), value)?;
                 }
+                let extent = (0..3)
+                    .map(|k| {
+                        let far = corner[k] + u[k].min(0.0) + v[k].min(0.0);
+                        let near = corner[k] + u[k].max(0.0) + v[k].max(0.0);
+                        far.abs().max(near.abs()).max(u[k].abs()).max(v[k].abs())
+                    })
+                    .fold(0.0, f64::max);
+                if extent > MAX_COORDINATE {
+                    return Err(invalid(
+                        format!("objects[{i}]"),
+                        format!(
+                            "corner and edges must be at most {MAX_COORDINATE:e} in size, so that products of two coordinates fit in f32"
+                        ),
+                    ));
+                }
                 let m = self.material(i, material)?;
-                let quad = place_quad(i, &transform, vec3(*corner), vec3(*u), vec3(*v))?;
+                let quad =
+                    place_quad(i, "the quad", &transform, vec3(*corner), vec3(*u), vec3(*v))?;
                 self.top.quads.push((quad, m));
             }
             ObjectDesc::Box {
@@ -481,9 +507,17 @@ impl<'a> Objects<'a> {
                         format!("must be greater than min on every axis, got min {min:?} and max {max:?}"),
                     ));
                 }
+                if min.iter().chain(max).any(|c| c.abs() > MAX_COORDINATE) {
+                    return Err(invalid(
+                        format!("objects[{i}]"),
+                        format!(
+                            "min and max must be at most {MAX_COORDINATE:e} in size, so that products of two coordinates fit in f32"
+                        ),
+                    ));
+                }
                 let m = self.material(i, material)?;
                 for (q, u, v) in box_faces(vec3(*min), vec3(*max)) {
-                    let quad = place_quad(i, &transform, q, u, v)?;
+                    let quad = place_quad(i, "the box", &transform, q, u, v)?;
                     self.top.quads.push((quad, m));
                 }
             }
@@ -708,6 +742,8 @@ impl<'a> Objects<'a> {
                     if !(placed_box.min.is_finite() && placed_box.max.is_finite()) {
                         return Err(out_of_range(p.object));
                     }
+                    let extent = placed_box.min.abs().max(placed_box.max.abs());
+                    mesh_within(p.object, extent.max_element())?;
                 }
                 self.groups.push(group);
                 let group = self.groups.len() as u32 - 1;
@@ -856,15 +892,46 @@ fn out_of_range(i: usize) -> SceneError {
     )
 }
 
-/// The quad at `corner` with edges `u`, `v`, placed by `transform`.
+/// Refuses object `i` when its transform makes `what` `extent` in size
+/// (its largest coordinate or radius): the limit on what a scene writes
+/// holds for what its transforms make of it too.
+fn placed_within(i: usize, what: &str, extent: f32) -> Result<(), SceneError> {
+    if f64::from(extent) <= MAX_COORDINATE {
+        return Ok(());
+    }
+    Err(invalid(
+        format!("objects[{i}].transform"),
+        format!(
+            "makes {what} {extent:.2e} in size, more than the {MAX_COORDINATE:e} an object may reach, so that products of two coordinates fit in f32"
+        ),
+    ))
+}
+
+/// Refuses the mesh of object `i` when its vertices, placed (by the
+/// object's transform and the file's own), reach `extent` in size.
+fn mesh_within(i: usize, extent: f32) -> Result<(), SceneError> {
+    if f64::from(extent) <= MAX_COORDINATE {
+        return Ok(());
+    }
+    Err(invalid(
+        format!("objects[{i}]"),
+        format!(
+            "the mesh's vertices, as placed, reach {extent:.2e} in size, more than the {MAX_COORDINATE:e} an object may reach, so that products of two coordinates fit in f32"
+        ),
+    ))
+}
+
+/// The quad at `corner` with edges `u`, `v`, placed by `transform`: of
+/// object `i`, `what` it is a part of (a quad, a box).
 fn place_quad(
     i: usize,
+    what: &str,
     transform: &Transform,
     corner: Vec3,
     u: Vec3,
     v: Vec3,
 ) -> Result<Quad, SceneError> {
-    if Quad::new(corner, u, v).is_none() {
+    if Quad::parallel(u, v) {
         return Err(invalid(
             format!("objects[{i}]"),
             format!("edges u {u} and v {v} are parallel or zero: the quad has no area"),
@@ -878,7 +945,30 @@ fn place_quad(
     if !(q.is_finite() && u.is_finite() && v.is_finite()) {
         return Err(out_of_range(i));
     }
-    let quad = Quad::new(q, u, v).ok_or_else(|| out_of_range(i))?;
+    let corners = [q, q + u, q + v, q + u + v];
+    let extent = corners
+        .iter()
+        .fold(u.abs().max(v.abs()), |m, c| m.max(c.abs()))
+        .max_element();
+    placed_within(i, what, extent)?;
+    let quad = Quad::new(q, u, v).ok_or_else(|| {
+        if transform.is_identity() {
+            invalid(
+                format!("objects[{i}]"),
+                format!("edges u {u} and v {v} are too small for f32 arithmetic"),
+            )
+        } else if Quad::parallel(u, v) {
+            invalid(
+                format!("objects[{i}].transform"),
+                format!("turns the edges into u {u} and v {v}, so nearly parallel that the quad has no area"),
+            )
+        } else {
+            invalid(
+                format!("objects[{i}].transform"),
+                format!("makes the edges u {u} and v {v} too small for f32 arithmetic"),
+            )
+        }
+    })?;
     // A mirroring transform reverses u × v: the outside stays the outside.
     let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
     Ok(if x.cross(y).dot(z) < 0.0 {
@@ -931,6 +1021,13 @@ fn place_mesh(mut mesh: Mesh, transform: &Transform, object: usize) -> Result<Me
     if mesh.data.positions.iter().flatten().any(|c| !c.is_finite()) {
         return Err(out_of_range(object));
     }
+    let extent = mesh
+        .data
+        .positions
+        .iter()
+        .flatten()
+        .fold(0f32, |m, c| m.max(c.abs()));
+    mesh_within(object, extent)?;
     Ok(mesh)
 }
 
