@@ -252,15 +252,12 @@ impl Bvh {
             order,
             leaves,
         } = build_binary(primitives);
-        // A packet a leaf, reserved at once: grown by doubling, the packets
-        // of a large mesh took twice their size, and as much again to
-        // shrink them.
         let mut bvh = Bvh {
             nodes: Vec::new(),
-            spheres: Vec::with_capacity(leaves[Kind::Sphere as usize]),
-            triangles: Vec::with_capacity(leaves[Kind::Triangle as usize]),
-            quads: Vec::with_capacity(leaves[Kind::Quad as usize]),
-            instance_packets: Vec::with_capacity(leaves[Kind::Instance as usize]),
+            spheres: Vec::new(),
+            triangles: Vec::new(),
+            quads: Vec::new(),
+            instance_packets: Vec::new(),
             instances,
             bounds: binary.first().map_or(Aabb::EMPTY, BinaryNode::bounds),
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
@@ -282,7 +279,12 @@ impl Bvh {
         // Reserved at its size: an estimate took twice the nodes' memory
         // when it was shrunk (a copy).
         bvh.nodes = Vec::with_capacity(collapse.count_nodes(&roots));
-        collapse.emit_node(&roots, &mut bvh);
+        // The nodes in one pass, which numbers the packets; the packets
+        // then on every core (making them reads the primitives: most of
+        // the time of a large mesh's collapse).
+        let mut packet_leaves = leaves.map(Vec::with_capacity);
+        collapse.emit_node(&roots, &mut bvh, &mut packet_leaves);
+        collapse.fill_packets(&packet_leaves, &mut bvh);
         bvh.nodes.shrink_to_fit();
         bvh.spheres.shrink_to_fit();
         bvh.triangles.shrink_to_fit();
@@ -925,116 +927,144 @@ impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
     }
 
     /// Emits the wide node whose children are the binary nodes `children`.
-    fn emit_node(&self, children: &[usize], bvh: &mut Bvh) -> u32 {
+    /// A leaf child is given the next packet of its kind, made afterwards
+    /// ([`Collapse::fill_packets`]): `leaves[kind]` gets its binary node.
+    fn emit_node(&self, children: &[usize], bvh: &mut Bvh, leaves: &mut [Vec<u32>; 4]) -> u32 {
         let index = bvh.nodes.len();
         bvh.nodes.push(Node::EMPTY);
         for (lane, &c) in children.iter().enumerate() {
             let node = &self.binary[c];
             let child = if node.is_leaf() {
-                self.emit_packet(node, bvh)
+                let kind = self
+                    .primitives
+                    .kind(self.order[node.offset as usize] as usize);
+                let packets = &mut leaves[kind as usize];
+                packets.push(c as u32);
+                let packet = packets.len() - 1;
+                debug_assert!(packet <= INDEX_MASK as usize);
+                LEAF_BIT | (kind as u32) << KIND_SHIFT | packet as u32
             } else {
                 let grandchildren = self.open(c);
-                self.emit_node(&grandchildren, bvh)
+                self.emit_node(&grandchildren, bvh, leaves)
             };
             bvh.nodes[index].set_child(lane, &node.bounds(), child);
         }
         index as u32
     }
 
-    fn emit_packet(&self, leaf: &BinaryNode, bvh: &mut Bvh) -> u32 {
+    /// The primitives of binary leaf `leaf`, and their indices as a
+    /// packet's lanes hold them (`NO_CHILD` in unused lanes).
+    fn members(&self, leaf: u32) -> (&[u32], [u32; 8]) {
+        let leaf = &self.binary[leaf as usize];
         debug_assert!(leaf.count as usize <= MAX_LEAF);
         let first = leaf.offset as usize;
         let members = &self.order[first..first + leaf.count as usize];
         let mut index = [NO_CHILD; 8];
         index[..members.len()].copy_from_slice(members);
-        let primitive = |lane: usize| self.primitives.primitive(members[lane] as usize);
-        let kind = primitive(0).kind();
+        (members, index)
+    }
+
+    /// The packets of binary leaves `leaves`, in order, made by `make` from
+    /// each leaf's primitives on every core.
+    fn packets<T: Send>(
+        &self,
+        leaves: &[u32],
+        make: impl Fn(&mut dyn Iterator<Item = Primitive>, [u32; 8]) -> T + Sync,
+    ) -> Vec<T> {
+        use rayon::prelude::*;
+        leaves
+            .par_iter()
+            .map(|&leaf| {
+                let (members, index) = self.members(leaf);
+                let mut primitives = members
+                    .iter()
+                    .map(|&m| self.primitives.primitive(m as usize));
+                make(&mut primitives, index)
+            })
+            .collect()
+    }
+
+    /// Makes the packets of the leaves [`Collapse::emit_node`] numbered:
+    /// `leaves[kind]` lists the binary leaf of each packet of that kind.
+    fn fill_packets(&self, leaves: &[Vec<u32>; 4], bvh: &mut Bvh) {
         // Fills lane `lane` of each field; unused lanes keep their filler.
         fn fill<const N: usize>(fields: &mut [Lane8; N], lane: usize, values: [f32; N]) {
             for (field, v) in fields.iter_mut().zip(values) {
                 field[lane] = v;
             }
         }
-        let packet = match kind {
-            Kind::Sphere => {
-                let mut p = SpherePacket {
-                    center: [[0.0; 8]; 3],
-                    radius2: [f32::NEG_INFINITY; 8],
-                    index,
+        bvh.spheres = self.packets(&leaves[Kind::Sphere as usize], |members, index| {
+            let mut p = SpherePacket {
+                center: [[0.0; 8]; 3],
+                radius2: [f32::NEG_INFINITY; 8],
+                index,
+            };
+            for (lane, primitive) in members.enumerate() {
+                let Primitive::Sphere(s) = primitive else {
+                    unreachable!("a leaf holds one kind")
                 };
-                for lane in 0..members.len() {
-                    let Primitive::Sphere(s) = primitive(lane) else {
-                        unreachable!("a leaf holds one kind")
-                    };
-                    fill(&mut p.center, lane, s.center.to_array());
-                    p.radius2[lane] = s.radius * s.radius;
-                }
-                bvh.spheres.push(p);
-                bvh.spheres.len() - 1
+                fill(&mut p.center, lane, s.center.to_array());
+                p.radius2[lane] = s.radius * s.radius;
             }
-            Kind::Triangle => {
-                let mut p = TrianglePacket {
-                    vertices: [[[f32::NAN; 8]; 3]; 3],
-                    index,
+            p
+        });
+        bvh.triangles = self.packets(&leaves[Kind::Triangle as usize], |members, index| {
+            let mut p = TrianglePacket {
+                vertices: [[[f32::NAN; 8]; 3]; 3],
+                index,
+            };
+            for (lane, primitive) in members.enumerate() {
+                let Primitive::Triangle(t) = primitive else {
+                    unreachable!("a leaf holds one kind")
                 };
-                for lane in 0..members.len() {
-                    let Primitive::Triangle(t) = primitive(lane) else {
-                        unreachable!("a leaf holds one kind")
-                    };
-                    for (v, x) in p.vertices.iter_mut().zip(t.vertices) {
-                        fill(v, lane, x.to_array());
-                    }
+                for (v, x) in p.vertices.iter_mut().zip(t.vertices) {
+                    fill(v, lane, x.to_array());
                 }
-                bvh.triangles.push(p);
-                bvh.triangles.len() - 1
             }
-            Kind::Quad => {
-                let nan = [[f32::NAN; 8]; 3];
-                let mut p = QuadPacket {
-                    corner: nan,
-                    u: nan,
-                    v: nan,
-                    normal: nan,
-                    w: nan,
-                    d: [f32::NAN; 8],
-                    index,
+            p
+        });
+        bvh.quads = self.packets(&leaves[Kind::Quad as usize], |members, index| {
+            let nan = [[f32::NAN; 8]; 3];
+            let mut p = QuadPacket {
+                corner: nan,
+                u: nan,
+                v: nan,
+                normal: nan,
+                w: nan,
+                d: [f32::NAN; 8],
+                index,
+            };
+            for (lane, primitive) in members.enumerate() {
+                let Primitive::Quad(q) = primitive else {
+                    unreachable!("a leaf holds one kind")
                 };
-                for lane in 0..members.len() {
-                    let Primitive::Quad(q) = primitive(lane) else {
-                        unreachable!("a leaf holds one kind")
-                    };
-                    fill(&mut p.corner, lane, q.corner.to_array());
-                    fill(&mut p.u, lane, q.u.to_array());
-                    fill(&mut p.v, lane, q.v.to_array());
-                    fill(&mut p.normal, lane, q.normal.to_array());
-                    fill(&mut p.w, lane, q.w.to_array());
-                    p.d[lane] = q.d;
-                }
-                bvh.quads.push(p);
-                bvh.quads.len() - 1
+                fill(&mut p.corner, lane, q.corner.to_array());
+                fill(&mut p.u, lane, q.u.to_array());
+                fill(&mut p.v, lane, q.v.to_array());
+                fill(&mut p.normal, lane, q.normal.to_array());
+                fill(&mut p.w, lane, q.w.to_array());
+                p.d[lane] = q.d;
             }
-            Kind::Instance => {
-                let mut p = InstancePacket {
-                    instance: [NO_CHILD; 8],
-                    index,
+            p
+        });
+        let instances = bvh.instances.len();
+        bvh.instance_packets = self.packets(&leaves[Kind::Instance as usize], |members, index| {
+            let mut p = InstancePacket {
+                instance: [NO_CHILD; 8],
+                index,
+            };
+            for (lane, primitive) in members.enumerate() {
+                let Primitive::Instance { index, .. } = primitive else {
+                    unreachable!("a leaf holds one kind")
                 };
-                for lane in 0..members.len() {
-                    let Primitive::Instance { index, .. } = primitive(lane) else {
-                        unreachable!("a leaf holds one kind")
-                    };
-                    assert!(
-                        (index as usize) < bvh.instances.len(),
-                        "instance {index} is not among the {} given",
-                        bvh.instances.len()
-                    );
-                    p.instance[lane] = index;
-                }
-                bvh.instance_packets.push(p);
-                bvh.instance_packets.len() - 1
+                assert!(
+                    (index as usize) < instances,
+                    "instance {index} is not among the {instances} given"
+                );
+                p.instance[lane] = index;
             }
-        };
-        debug_assert!(packet <= INDEX_MASK as usize);
-        LEAF_BIT | (kind as u32) << KIND_SHIFT | packet as u32
+            p
+        });
     }
 }
 

@@ -43,6 +43,11 @@ pub trait PrimitiveSet: Sync {
     fn count(&self) -> usize;
     /// Item `i`, for `i < self.count()`.
     fn primitive(&self, i: usize) -> Primitive;
+
+    /// The kind of item `i` (which a set may know without making it).
+    fn kind(&self, i: usize) -> Kind {
+        self.primitive(i).kind()
+    }
 }
 
 impl PrimitiveSet for [Primitive] {

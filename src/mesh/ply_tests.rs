@@ -382,7 +382,8 @@ fn elements_that_cannot_fit_in_the_file_are_refused_before_reading() {
             ),
             &["`face`", "50000000", "bytes"],
         );
-        // The count of the issue, with no properties: refused at once.
+        // 2^40 records and no properties (it looped, or allocated 9.6 GB
+        // and aborted): refused at once.
         refused(
             "no-properties.ply",
             &ply_file(format, "element vertex 1099511627776\n", &one_triangle_le()),

@@ -11,7 +11,9 @@
 use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
-use crate::geometry::{Bvh, HitRecord, Instance, Primitive, PrimitiveSet, Quad, Sphere, Triangle};
+use crate::geometry::{
+    Bvh, HitRecord, Instance, Kind, Primitive, PrimitiveSet, Quad, Sphere, Triangle,
+};
 use crate::light::{Light, LightTexture, Shape as LightShape};
 use crate::material::{Emissive, Material};
 use crate::math::{Color, Point3, Vec3};
@@ -107,6 +109,16 @@ impl Shapes {
     /// How many of the tree's items are shapes (the instances come after).
     fn shape_count(&self) -> usize {
         self.spheres.len() + self.quads.len() + self.mesh_end.last().copied().unwrap_or(0)
+    }
+
+    /// The kind of shape item `index`.
+    fn shape_kind(&self, index: usize) -> Kind {
+        match self.locate(index) {
+            Ok(Shape::Sphere(_)) => Kind::Sphere,
+            Ok(Shape::Quad(_)) => Kind::Quad,
+            Ok(Shape::Triangle(..)) => Kind::Triangle,
+            Err(_) => panic!("shape {index} of {}", self.shape_count()),
+        }
     }
 
     /// Shape item `index` as the tree is built from it.
@@ -242,6 +254,10 @@ impl PrimitiveSet for Shapes {
     fn primitive(&self, i: usize) -> Primitive {
         self.shape_primitive(i)
     }
+
+    fn kind(&self, i: usize) -> Kind {
+        self.shape_kind(i)
+    }
 }
 
 /// The items of the world's tree: the shapes, then the instances.
@@ -259,6 +275,13 @@ impl PrimitiveSet for WorldItems<'_> {
         match i.checked_sub(self.shapes.shape_count()) {
             Some(k) => self.instances[k],
             None => self.shapes.shape_primitive(i),
+        }
+    }
+
+    fn kind(&self, i: usize) -> Kind {
+        match i.checked_sub(self.shapes.shape_count()) {
+            Some(_) => Kind::Instance,
+            None => self.shapes.shape_kind(i),
         }
     }
 }
