@@ -500,7 +500,8 @@ fn find_hits(
         let found = scene.hit_bundle(rays, group, reference, ALL);
         for (&i, hit) in group.iter().zip(found) {
             let i = i as usize;
-            hits[i] = scene.counted(&rays[i], hit, from[i].as_ref(), f32::INFINITY);
+            hits[i] = hit;
+            scene.keep_counted(&rays[i], &mut hits[i], from[i].as_ref(), f32::INFINITY);
         }
     }
 }

@@ -358,26 +358,24 @@ impl Scene {
     /// ray out of a closed room. The ray's direction must have unit length.
     #[inline(always)]
     pub fn intersect_leaving(&self, ray: &Ray, from: Option<&Hit>, t_max: f32) -> Option<Hit> {
-        let hit = self.intersect(ray, Interval::new(0.0, t_max));
-        self.counted(ray, hit, from, t_max)
+        let mut hit = self.intersect(ray, Interval::new(0.0, t_max));
+        self.keep_counted(ray, &mut hit, from, t_max);
+        hit
     }
 
-    /// Of `hit`, the nearest hit of `ray` from distance 0 to `t_max` (as
+    /// Makes `hit`, the nearest hit of `ray` from distance 0 to `t_max` (as
     /// [`Scene::hit_bundle`] finds it), the hit that counts for a ray
-    /// leaving the surface of hit `from`: `hit` itself, or when it is that
-    /// surface met again closer than the epsilon, the nearest beyond it
-    /// that counts (see [`Scene::intersect_leaving`]).
+    /// leaving the surface of hit `from`: it stays as it is, or when it is
+    /// that surface met again closer than the epsilon, becomes the nearest
+    /// beyond it that counts (see [`Scene::intersect_leaving`]). In place,
+    /// so that a hit just stored whole is not rebuilt field by field and
+    /// read back whole, which stalls the processor.
     #[inline(always)]
-    pub fn counted(
-        &self,
-        ray: &Ray,
-        hit: Option<Hit>,
-        from: Option<&Hit>,
-        t_max: f32,
-    ) -> Option<Hit> {
-        match hit {
-            Some(h) if self.rehit(&h, from) => self.intersect_past(ray, h, from, t_max),
-            hit => hit,
+    pub fn keep_counted(&self, ray: &Ray, hit: &mut Option<Hit>, from: Option<&Hit>, t_max: f32) {
+        if let Some(h) = *hit {
+            if self.rehit(&h, from) {
+                *hit = self.intersect_past(ray, h, from, t_max);
+            }
         }
     }
 
