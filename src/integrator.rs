@@ -6,6 +6,7 @@ use crate::bsdf::Bsdf;
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
+use crate::halt::Halt;
 use crate::material::Material;
 use crate::math::{Color, Interval, Point3, Vec3};
 use crate::medium::{Medium, ISOTROPIC_PDF};
@@ -13,7 +14,6 @@ use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -400,7 +400,7 @@ pub fn trace_path(
 }
 
 /// How many rounds of bounces [`trace_paths`] runs between looks at its
-/// `halted` flag.
+/// `halt`.
 const HALT_CHECK_ROUNDS: u32 = 256;
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
@@ -413,9 +413,9 @@ const HALT_CHECK_ROUNDS: u32 = 256;
 /// waits on one test after another, while a bundle keeps the processor busy
 /// with eight (in scenes of spheres only: [`Scene::bundles_pay_off`]).
 /// `reference` (the pixel's central ray) orders the visit of the first
-/// round's bundles; later rounds use a ray of the bundle. Once `halted` is
-/// set the paths are left where they are within a few hundred bounces, and
-/// `colours` are not to be used.
+/// round's bundles; later rounds use a ray of the bundle. Once `halt`
+/// says to stop, the paths are left where they are within a few hundred
+/// bounces, and `colours` are not to be used.
 #[inline(always)]
 pub fn trace_paths<S: Sampler>(
     scene: &Scene,
@@ -424,7 +424,7 @@ pub fn trace_paths<S: Sampler>(
     reference: &Ray,
     colours: &mut [Color],
     traced: &mut u64,
-    halted: &AtomicBool,
+    halt: &Halt,
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
@@ -458,7 +458,7 @@ pub fn trace_paths<S: Sampler>(
         }
         // A render asked to stop abandons its pass, and with it these
         // paths, which could run for minutes at a great depth.
-        if round % HALT_CHECK_ROUNDS == HALT_CHECK_ROUNDS - 1 && halted.load(Ordering::Relaxed) {
+        if round % HALT_CHECK_ROUNDS == HALT_CHECK_ROUNDS - 1 && halt.asked() {
             break;
         }
     }
@@ -571,7 +571,7 @@ mod tests {
                         &reference,
                         &mut together,
                         &mut together_rays,
-                        &AtomicBool::new(false),
+                        &Halt::never(),
                     );
                     let bits = |c: &[Color]| {
                         c.iter()

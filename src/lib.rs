@@ -61,6 +61,7 @@ pub mod files;
 pub mod film;
 pub mod gallery;
 pub mod geometry;
+pub mod halt;
 pub mod hint;
 pub mod input;
 pub mod integrator;

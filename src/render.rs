@@ -1,6 +1,7 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::film::{Film, RowMut};
+use crate::halt::Halt;
 use crate::integrator::{first_hit_view, trace_paths, PATHS};
 use crate::isa::Isa;
 use crate::math::{Color, Vec3};
@@ -9,7 +10,6 @@ use crate::sampler::{PixelSample, PixelSampler};
 use crate::scene::{Scene, Shading};
 use rayon::prelude::*;
 use std::ops::Range;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// The share of dropped samples above which a render warns: a few in a
@@ -131,56 +131,39 @@ pub fn render_pixels(
         assert_eq!(active.len(), film.len(), "one flag per pixel");
     }
     let isa = Isa::detect();
-    // Set once `should_stop` answers `true`, and looked at before every
-    // pixel and every few hundred bounces: a row of long paths (a white fog
-    // at a great depth) can take minutes, longer than the grace period a
-    // job engine gives after SIGTERM. A watcher asks `should_stop` while the
-    // rows run, so that the hot loops only read a flag.
-    let halted = AtomicBool::new(false);
-    let finished = AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        let watcher = scope.spawn(|| {
-            while !finished.load(Ordering::Acquire) {
-                if should_stop() {
-                    halted.store(true, Ordering::Relaxed);
-                    return;
-                }
-                std::thread::park_timeout(WATCH_EVERY);
+    // Asked before every row, every few pixels and every few hundred
+    // bounces: see `Halt`.
+    let halt = Halt::new(should_stop);
+    let stats = film
+        .rows_mut()
+        .enumerate()
+        .map(|(y, row)| {
+            if halt.asked() {
+                return None;
             }
-        });
-        let stats = film
-            .rows_mut()
-            .enumerate()
-            .map(|(y, row)| {
-                if halted.load(Ordering::Relaxed) || should_stop() {
-                    halted.store(true, Ordering::Relaxed);
-                    return None;
-                }
-                let active = active.map(|a| &a[y * width..(y + 1) * width]);
-                let at = (origin.0, origin.1 + y as u32);
-                let stats = render_row(isa, scene, at, samples.clone(), row, active, &halted);
-                let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
-                progress(pixels as u64 * per_pixel);
-                Some(stats)
-            })
-            .reduce(
-                || Some(RenderStats::default()),
-                |a, b| {
-                    let (mut a, b) = (a?, b?);
-                    a.add(b);
-                    Some(a)
-                },
-            );
-        finished.store(true, Ordering::Release);
-        watcher.thread().unpark();
-        // A row cut short by the flag holds only some of its samples.
-        stats.filter(|_| !halted.load(Ordering::Relaxed))
-    })
+            let active = active.map(|a| &a[y * width..(y + 1) * width]);
+            let at = (origin.0, origin.1 + y as u32);
+            let stats = render_row(isa, scene, at, samples.clone(), row, active, &halt);
+            let pixels = active.map_or(width, |a| a.iter().filter(|&&on| on).count());
+            progress(pixels as u64 * per_pixel);
+            Some(stats)
+        })
+        .reduce(
+            || Some(RenderStats::default()),
+            |a, b| {
+                let (mut a, b) = (a?, b?);
+                a.add(b);
+                Some(a)
+            },
+        );
+    // A row cut short by the stop holds only some of its samples.
+    stats.filter(|_| !halt.halted())
 }
 
-/// How often a render in progress asks whether to stop, besides before
-/// every row.
-const WATCH_EVERY: Duration = Duration::from_millis(10);
+/// How many pixels a row renders between asks whether to stop: a pixel of
+/// a single sample takes about a microsecond, an ask (a look at the clock)
+/// a few tens of nanoseconds.
+const ASK_EVERY_PIXELS: usize = 8;
 
 /// Renders samples `samples` of every pixel of `row`, which holds the
 /// pixels of image row `at.1` from column `at.0` on (of those whose `active`
@@ -193,7 +176,7 @@ fn render_row(
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
-    halted: &AtomicBool,
+    halt: &Halt,
 ) -> RenderStats {
     match isa {
         #[cfg(target_arch = "x86_64")]
@@ -202,10 +185,10 @@ fn render_row(
             // processor has every feature `render_row_avx2` is compiled for.
             #[allow(unsafe_code)]
             unsafe {
-                render_row_avx2(scene, at, samples, row, active, halted)
+                render_row_avx2(scene, at, samples, row, active, halt)
             }
         }
-        _ => render_row_generic(scene, at, samples, row, active, halted),
+        _ => render_row_generic(scene, at, samples, row, active, halt),
     }
 }
 
@@ -218,9 +201,9 @@ unsafe fn render_row_avx2(
     samples: Range<u32>,
     row: RowMut,
     active: Option<&[bool]>,
-    halted: &AtomicBool,
+    halt: &Halt,
 ) -> RenderStats {
-    render_row_generic(scene, at, samples, row, active, halted)
+    render_row_generic(scene, at, samples, row, active, halt)
 }
 
 /// The body of the row loop, inlined into each instruction-set version.
@@ -231,7 +214,7 @@ fn render_row_generic(
     samples: Range<u32>,
     mut row: RowMut,
     active: Option<&[bool]>,
-    halted: &AtomicBool,
+    halt: &Halt,
 ) -> RenderStats {
     let s = &scene.settings;
     let mut stats = RenderStats::default();
@@ -248,7 +231,7 @@ fn render_row_generic(
         if active.is_some_and(|a| !a[x]) {
             continue;
         }
-        if halted.load(Ordering::Relaxed) {
+        if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
             break;
         }
         // The pixel's column in the image, which addresses its samples.
@@ -278,7 +261,7 @@ fn render_row_generic(
                 &reference,
                 &mut colours[..n],
                 &mut stats.rays,
-                halted,
+                halt,
             );
             // In sample order, as one at a time would add them.
             for (i, &c) in colours[..n].iter().enumerate() {
@@ -350,15 +333,7 @@ mod tests {
             let render_with = |isa| {
                 let mut film = Film::with_halves(width, 1);
                 let row = film.rows_mut().collect::<Vec<_>>().pop().unwrap();
-                let stats = render_row(
-                    isa,
-                    scene,
-                    (0, y),
-                    0..37,
-                    row,
-                    None,
-                    &AtomicBool::new(false),
-                );
+                let stats = render_row(isa, scene, (0, y), 0..37, row, None, &Halt::never());
                 (film, stats)
             };
             let (base, a) = render_with(Isa::Baseline);
