@@ -1,5 +1,5 @@
 #!/bin/sh
-# Compares the cover throughput of two lumen binaries on a machine whose
+# Compares the throughput of two lumen binaries on a machine whose
 # speed drifts: in each round both run `lumen bench --threads 1` at the same
 # time, one per core (swapping cores every round), so that drift slows both
 # alike; prints each round's B/A ratio and their median.
@@ -23,9 +23,10 @@ bench() {
     taskset -c "$2" "$1" bench --threads 1 --runs 3 --spp 64 $workload >"$3" 2>&1 &
 }
 
-# The cover's M rays/s in output file $1, or the output and exit 1.
-cover() {
-    r=$(awk '/^cover/ {print $3}' "$1")
+# The first workload's M rays/s in output file $1 (the cover unless
+# LUMEN_BENCH_ARGS names another), or the output and exit 1.
+rays() {
+    r=$(awk 'seen && NF >= 3 {print $3; exit} /^workload/ {seen = 1}' "$1")
     if [ -z "$r" ]; then
         cat "$1" >&2
         exit 1
@@ -42,8 +43,8 @@ while [ "$i" -lt "$rounds" ]; do
     pb=$!
     wait "$pa" || { cat "$out/a" >&2; exit 1; }
     wait "$pb" || { cat "$out/b" >&2; exit 1; }
-    ra=$(cover "$out/a")
-    rb=$(cover "$out/b")
+    ra=$(rays "$out/a")
+    rb=$(rays "$out/b")
     ratio=$(awk -v a="$ra" -v b="$rb" 'BEGIN {printf "%.3f", b / a}')
     echo "round $((i + 1)): A $ra  B $rb M rays/s  B/A $ratio"
     echo "$ratio" >>"$out/ratios"
