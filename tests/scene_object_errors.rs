@@ -321,14 +321,14 @@ fn cases() -> Vec<Case> {
             "mesh-placed-too-large",
             mesh("tri.obj") + "transform = [{ scale = 1e19 }]\n",
             "[[objects]]\ntype = \"mesh\"",
-            &["objects[1]", "mesh's vertices", "1e18"],
+            &["objects[1]", "vertices of", "tri.obj", "1e18"],
         )
         .with("tri.obj", TRI),
         case(
             "instanced-too-large",
             mesh("tri.obj") + &mesh("tri.obj") + "transform = [{ translate = [0, 3e18, 0] }]\n",
             "[[objects]]\ntype = \"mesh\"\nfile = \"tri.obj\"\ntransform",
-            &["objects[2]", "mesh's vertices", "1e18"],
+            &["objects[2]", "vertices of", "tri.obj", "1e18"],
         )
         .with("tri.obj", TRI),
         case(
@@ -381,7 +381,7 @@ fn cases() -> Vec<Case> {
             "mesh-out-of-range",
             mesh("tri.obj") + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n",
             "transform = [{ scale = 1e38 }",
-            &["objects[1].transform", "beyond the range of f32"],
+            &["objects[1].transform", "tri.obj", "beyond the range of f32"],
         )
         .with("tri.obj", TRI),
         case(
@@ -390,7 +390,7 @@ fn cases() -> Vec<Case> {
                 + &mesh("tri.obj")
                 + "transform = [{ scale = 1e38 }, { translate = [3e38, 0, 0] }]\n",
             "transform = [{ scale = 1e38 }",
-            &["objects[2].transform", "beyond the range of f32"],
+            &["objects[2].transform", "tri.obj", "beyond the range of f32"],
         )
         .with("tri.obj", TRI),
     ]

@@ -726,7 +726,7 @@ impl<'a> Objects<'a> {
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n;
                 self.top
-                    .push_mesh(place_mesh(mesh, &only.transform, only.object)?);
+                    .push_mesh(place_mesh(mesh, path, &only.transform, only.object)?);
             } else {
                 // Stored once with the file's materials; an instance whose
                 // object names a material uses it instead.
@@ -739,11 +739,13 @@ impl<'a> Objects<'a> {
                 // must: its tree's box, placed.
                 for p in placed {
                     let placed_box = p.transform.bounds(&group.bvh.bounds());
-                    if !(placed_box.min.is_finite() && placed_box.max.is_finite()) {
-                        return Err(out_of_range(p.object));
-                    }
                     let extent = placed_box.min.abs().max(placed_box.max.abs());
-                    mesh_within(p.object, extent.max_element())?;
+                    let extent = if extent.is_finite() {
+                        extent.max_element()
+                    } else {
+                        f32::INFINITY
+                    };
+                    mesh_within(p.object, path, extent)?;
                 }
                 self.groups.push(group);
                 let group = self.groups.len() as u32 - 1;
@@ -907,18 +909,28 @@ fn placed_within(i: usize, what: &str, extent: f32) -> Result<(), SceneError> {
     ))
 }
 
-/// Refuses the mesh of object `i` when its vertices, placed (by the
-/// object's transform and the file's own), reach `extent` in size.
-fn mesh_within(i: usize, extent: f32) -> Result<(), SceneError> {
+/// Refuses the mesh of object `i`, read from `path`, when its vertices,
+/// placed (by the object's transform and the file's own), reach `extent`
+/// in size; an `extent` that is not finite is the transform's doing (a
+/// file's own numbers are finite), and the transform is named.
+fn mesh_within(i: usize, path: &Path, extent: f32) -> Result<(), SceneError> {
     if f64::from(extent) <= MAX_COORDINATE {
         return Ok(());
     }
-    Err(invalid(
-        format!("objects[{i}]"),
-        format!(
-            "the mesh's vertices, as placed, reach {extent:.2e} in size, more than the {MAX_COORDINATE:e} an object may reach, so that products of two coordinates fit in f32"
-        ),
-    ))
+    let path = path.display();
+    Err(if extent.is_finite() {
+        invalid(
+            format!("objects[{i}]"),
+            format!(
+                "the vertices of {path}, as placed, reach {extent:.2e} in size, more than the {MAX_COORDINATE:e} an object may reach, so that products of two coordinates fit in f32"
+            ),
+        )
+    } else {
+        invalid(
+            format!("objects[{i}].transform"),
+            format!("places the vertices of {path} beyond the range of f32"),
+        )
+    })
 }
 
 /// The quad at `corner` with edges `u`, `v`, placed by `transform`: of
@@ -998,7 +1010,12 @@ fn box_faces(min: Vec3, max: Vec3) -> [(Vec3, Vec3, Vec3); 6] {
 }
 
 /// `mesh` moved into world space by `transform`.
-fn place_mesh(mut mesh: Mesh, transform: &Transform, object: usize) -> Result<Mesh, SceneError> {
+fn place_mesh(
+    mut mesh: Mesh,
+    path: &Path,
+    transform: &Transform,
+    object: usize,
+) -> Result<Mesh, SceneError> {
     if !transform.is_identity() {
         for p in &mut mesh.data.positions {
             *p = transform.point(Vec3::from(*p)).to_array();
@@ -1018,16 +1035,15 @@ fn place_mesh(mut mesh: Mesh, transform: &Transform, object: usize) -> Result<Me
             }
         }
     }
-    if mesh.data.positions.iter().flatten().any(|c| !c.is_finite()) {
-        return Err(out_of_range(object));
-    }
-    let extent = mesh
-        .data
-        .positions
-        .iter()
-        .flatten()
-        .fold(0f32, |m, c| m.max(c.abs()));
-    mesh_within(object, extent)?;
+    // NaN compares as no larger than anything: counted as infinite.
+    let extent = mesh.data.positions.iter().flatten().fold(0f32, |m, c| {
+        if c.is_finite() {
+            m.max(c.abs())
+        } else {
+            f32::INFINITY
+        }
+    });
+    mesh_within(object, path, extent)?;
     Ok(mesh)
 }
 
