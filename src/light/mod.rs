@@ -114,11 +114,12 @@ impl Light {
         if self.texture.is_none() {
             return luminance(self.emission.radiance);
         }
+        let normal = Surface::of(&self.shape).normal;
         let mut total = 0.0;
         for i in 0..n {
             for j in 0..n {
                 let uv = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
-                let (point, outward, st) = sample_area(&self.shape, uv);
+                let (point, outward, st) = sample_area(&self.shape, normal, uv);
                 total += luminance(self.radiance_at(textures, point, outward, st));
             }
         }
@@ -200,6 +201,9 @@ pub enum LightSelection {
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
     lights: Vec<Light>,
+    /// The normal and area of each of `lights`, worked out once rather
+    /// than at every sample.
+    surfaces: Vec<Surface>,
     /// The textures of textured lights.
     textures: Vec<Texture>,
     /// The environment, chosen as light number `lights.len()`.
@@ -259,6 +263,7 @@ impl Lights {
             Vec::new()
         };
         Lights {
+            surfaces: lights.iter().map(|l| Surface::of(&l.shape)).collect(),
             lights,
             textures,
             environment,
@@ -303,17 +308,18 @@ impl Lights {
                 pdf,
             });
         };
+        let surface = &self.surfaces[i];
         let (target, outward, st) = match light.shape {
             Shape::Sphere { center, radius } if !inside(center, radius, point) => {
                 let (target, outward) = sample_cap(center, radius, point, uv);
                 (target, outward, uv)
             }
-            shape => sample_area(&shape, uv),
+            shape => sample_area(&shape, surface.normal, uv),
         };
         let to = target - point;
         let distance = to.length();
         let direction = to / distance;
-        let pdf = chance * solid_angle_density(&light.shape, point, target, outward);
+        let pdf = chance * solid_angle_density(&light.shape, surface.area, point, target, outward);
         if !(pdf > 0.0 && pdf.is_finite() && distance > 0.0 && distance.is_finite()) {
             return None;
         }
@@ -340,7 +346,7 @@ impl Lights {
         if chance == 0.0 {
             return 0.0;
         }
-        chance * solid_angle_density(&light.shape, from, point, outward)
+        chance * solid_angle_density(&light.shape, self.surfaces[i].area, from, point, outward)
     }
 
     /// The density per unit solid angle with which [`Lights::sample`] picks
@@ -367,7 +373,13 @@ fn inside(center: Point3, radius: f32, point: Point3) -> bool {
 /// over the area, whose density 1/A becomes d² / (|cos θ| A) per unit
 /// solid angle.
 #[inline]
-fn solid_angle_density(shape: &Shape, from: Point3, point: Point3, outward: Vec3) -> f32 {
+fn solid_angle_density(
+    shape: &Shape,
+    area: f32,
+    from: Point3,
+    point: Point3,
+    outward: Vec3,
+) -> f32 {
     match *shape {
         Shape::Sphere { center, radius } if !inside(center, radius, from) => {
             1.0 / cap_solid_angle(radius * radius / (center - from).length_squared())
@@ -375,7 +387,7 @@ fn solid_angle_density(shape: &Shape, from: Point3, point: Point3, outward: Vec3
         _ => {
             let to = point - from;
             let d2 = to.length_squared();
-            d2 * d2.sqrt() / (outward.dot(to).abs() * shape.area())
+            d2 * d2.sqrt() / (outward.dot(to).abs() * area)
         }
     }
 }
@@ -388,16 +400,41 @@ fn cap_solid_angle(sin2: f32) -> f32 {
     2.0 * PI * sin2 / (1.0 + cos)
 }
 
-/// A uniform point on the area of `shape`, its outward unit normal, and its
+/// The unit normal and the area of a light's shape.
+#[derive(Clone, Copy, Debug)]
+struct Surface {
+    /// A quad's or triangle's outward unit normal (unused for spheres).
+    normal: Vec3,
+    area: f32,
+}
+
+impl Surface {
+    fn of(shape: &Shape) -> Self {
+        let normal = match *shape {
+            Shape::Sphere { .. } => Vec3::ZERO,
+            Shape::Quad { u, v, .. } => u.cross(v).normalize(),
+            Shape::Triangle {
+                vertices: [a, b, c],
+            } => (b - a).cross(c - a).normalize(),
+        };
+        Surface {
+            normal,
+            area: shape.area(),
+        }
+    }
+}
+
+/// A uniform point on the area of `shape`, whose unit normal is `normal`
+/// if it is flat ([`Surface::of`]), its outward unit normal, and its
 /// parameters: a quad's (α, β), a triangle's barycentrics (b₁, b₂) of its
 /// second and third corners (a sphere's follow from the normal).
-fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
+fn sample_area(shape: &Shape, normal: Vec3, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
     match *shape {
         Shape::Sphere { center, radius } => {
             let outward = sampling::unit_vector([s, t]);
             (center + radius * outward, outward, [s, t])
         }
-        Shape::Quad { corner, u, v } => (corner + s * u + t * v, u.cross(v).normalize(), [s, t]),
+        Shape::Quad { corner, u, v } => (corner + s * u + t * v, normal, [s, t]),
         Shape::Triangle {
             vertices: [a, b, c],
         } => {
@@ -407,11 +444,7 @@ fn sample_area(shape: &Shape, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
             } else {
                 (s, t)
             };
-            (
-                a + s * (b - a) + t * (c - a),
-                (b - a).cross(c - a).normalize(),
-                [s, t],
-            )
+            (a + s * (b - a) + t * (c - a), normal, [s, t])
         }
     }
 }

@@ -158,7 +158,7 @@ fn triangle_and_quad_points_are_uniform_by_area() {
         let mut counts = vec![0u64; 2 * n * n];
         let mut rng = Rng::new(41);
         for _ in 0..draws {
-            let (point, _, _) = sample_area(&shape, rng.next_2d());
+            let (point, _, _) = sample_area(&shape, Surface::of(&shape).normal, rng.next_2d());
             // The point's coordinates along the two edges, solved from it.
             let (e1, e2, origin) = match shape {
                 Shape::Triangle { .. } => (b - a, c - a, a),
