@@ -13,6 +13,9 @@
 //! would have been sampled, which multiple importance sampling needs.
 
 pub mod environment;
+mod rectangle;
+
+use rectangle::SphericalRectangle;
 
 pub use environment::{Environment, EnvironmentMap};
 
@@ -314,12 +317,21 @@ impl Lights {
                 let (target, outward) = sample_cap(center, radius, point, uv);
                 (target, outward, uv)
             }
+            Shape::Quad { corner, u, v } => match surface.seen_from(&light.shape, point) {
+                Some(rectangle) => {
+                    let target = rectangle.sample(uv);
+                    let d = target - corner;
+                    let st = [d.dot(u) / u.length_squared(), d.dot(v) / v.length_squared()];
+                    (target, surface.normal, st)
+                }
+                None => sample_area(&light.shape, surface.normal, uv),
+            },
             shape => sample_area(&shape, surface.normal, uv),
         };
         let to = target - point;
         let distance = to.length();
         let direction = to / distance;
-        let pdf = chance * solid_angle_density(&light.shape, surface.area, point, target, outward);
+        let pdf = chance * solid_angle_density(&light.shape, surface, point, target, outward);
         if !(pdf > 0.0 && pdf.is_finite() && distance > 0.0 && distance.is_finite()) {
             return None;
         }
@@ -346,7 +358,7 @@ impl Lights {
         if chance == 0.0 {
             return 0.0;
         }
-        chance * solid_angle_density(&light.shape, self.surfaces[i].area, from, point, outward)
+        chance * solid_angle_density(&light.shape, &self.surfaces[i], from, point, outward)
     }
 
     /// The density per unit solid angle with which [`Lights::sample`] picks
@@ -375,7 +387,7 @@ fn inside(center: Point3, radius: f32, point: Point3) -> bool {
 #[inline]
 fn solid_angle_density(
     shape: &Shape,
-    area: f32,
+    surface: &Surface,
     from: Point3,
     point: Point3,
     outward: Vec3,
@@ -385,9 +397,12 @@ fn solid_angle_density(
             1.0 / cap_solid_angle(radius * radius / (center - from).length_squared())
         }
         _ => {
+            if let Some(rectangle) = surface.seen_from(shape, from) {
+                return (1.0 / rectangle.solid_angle()) as f32;
+            }
             let to = point - from;
             let d2 = to.length_squared();
-            d2 * d2.sqrt() / (outward.dot(to).abs() * area)
+            d2 * d2.sqrt() / (outward.dot(to).abs() * surface.area)
         }
     }
 }
@@ -400,12 +415,20 @@ fn cap_solid_angle(sin2: f32) -> f32 {
     2.0 * PI * sin2 / (1.0 + cos)
 }
 
-/// The unit normal and the area of a light's shape.
+/// A rectangle is sampled by solid angle rather than by area from points
+/// whose squared distance to its centre is below this times its area.
+const SPHERICAL_WITHIN: f32 = 1.0;
+
+/// The unit normal and the area of a light's shape, and whether it is a
+/// rectangle.
 #[derive(Clone, Copy, Debug)]
 struct Surface {
     /// A quad's or triangle's outward unit normal (unused for spheres).
     normal: Vec3,
     area: f32,
+    /// A quad whose edges are perpendicular: sampled by solid angle where
+    /// it covers enough of it ([`SphericalRectangle`]).
+    rectangle: bool,
 }
 
 impl Surface {
@@ -417,9 +440,35 @@ impl Surface {
                 vertices: [a, b, c],
             } => (b - a).cross(c - a).normalize(),
         };
+        let rectangle = match *shape {
+            Shape::Quad { u, v, .. } => {
+                u.dot(v).abs() <= 1e-6 * u.length() * v.length() && normal.is_finite()
+            }
+            _ => false,
+        };
         Surface {
             normal,
             area: shape.area(),
+            rectangle,
+        }
+    }
+
+    /// `shape` (the shape of this surface) seen from `from`, when it is
+    /// sampled by solid angle from there.
+    #[inline]
+    fn seen_from(&self, shape: &Shape, from: Point3) -> Option<SphericalRectangle> {
+        match *shape {
+            Shape::Quad { corner, u, v } if self.rectangle => {
+                // Worth its cost only close up, where sampling the area
+                // would vary as the inverse square of the distance over
+                // the cosine: within a few times its size of its centre.
+                let to = corner + 0.5 * (u + v) - from;
+                if !(to.length_squared() < SPHERICAL_WITHIN * self.area) {
+                    return None;
+                }
+                SphericalRectangle::new(corner, u, v, from)
+            }
+            _ => None,
         }
     }
 }

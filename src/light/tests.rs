@@ -93,12 +93,15 @@ fn a_sphere_seen_from_inside_is_sampled_by_area() {
     assert_close("inside", e, 4.0 * std::f64::consts::PI);
 }
 
+/// A rectangle close by is sampled uniformly over its solid angle (every
+/// sample of the same density, 1 / Ω), one farther off by area; both
+/// estimate Ω, and each sample's density is the one [`Lights::pdf`] gives.
 #[test]
-fn a_quad_is_sampled_uniformly_by_area() {
+fn a_rectangle_is_sampled_by_solid_angle_close_up_and_by_area_farther() {
     // A rectangle a × b seen from height h above one corner subtends
     // atan(ab / (h √(a² + b² + h²))).
     let (a, b) = (3.0f64, 2.0f64);
-    for h in [0.5f64, 1.0, 4.0] {
+    for h in [0.5f64, 1.0, 4.0, 20.0] {
         let shape = Shape::Quad {
             corner: Vec3::ZERO,
             u: Vec3::new(a as f32, 0.0, 0.0),
@@ -106,12 +109,20 @@ fn a_quad_is_sampled_uniformly_by_area() {
         };
         let from = Vec3::new(0.0, h as f32, 0.0);
         let exact = (a * b / (h * (a * a + b * b + h * h).sqrt())).atan();
-        assert_close(
-            &format!("h = {h}"),
-            solid_angle_estimate(shape, from),
-            exact,
-        );
+        let e = solid_angle_estimate(shape, from);
+        assert_close(&format!("h = {h}"), e, exact);
+        let close = (a * a + b * b) / 4.0 + h * h < f64::from(SPHERICAL_WITHIN) * a * b;
+        let uniform = e.1 < 1e-6 * e.0;
+        assert_eq!(close, uniform, "h = {h}: {e:?}");
     }
+    // A parallelogram is sampled by area however close.
+    let slanted = Shape::Quad {
+        corner: Vec3::ZERO,
+        u: Vec3::new(3.0, 0.0, 0.0),
+        v: Vec3::new(1.0, 0.0, 2.0),
+    };
+    let e = solid_angle_estimate(slanted, Vec3::new(0.0, 0.5, 0.0));
+    assert!(e.1 > 1e-3 * e.0, "{e:?}");
 }
 
 #[test]
