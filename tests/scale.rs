@@ -5,6 +5,7 @@
 
 mod common;
 
+use common::d3::{cross, dot, sub, D3};
 use common::{compile_file, icosphere_obj, pixel_stats, scene_file, scratch_dir};
 use lumen::scene::Overrides;
 
@@ -132,24 +133,6 @@ impl Rng {
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     }
-}
-
-type D3 = [f64; 3];
-
-fn sub(a: D3, b: D3) -> D3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: D3, b: D3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: D3, b: D3) -> D3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// `v` rounded to f32, as the scene holds it.

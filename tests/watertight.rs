@@ -25,6 +25,9 @@
 //! Run with `cargo test --release --test watertight -- --nocapture` to see
 //! the numbers measured.
 
+mod common;
+
+use common::d3::{cross, d3, dot, sub, D3};
 use lumen::geometry::triangle::TriangleRay;
 use lumen::geometry::{Bvh, Primitive, Triangle};
 use lumen::math::{Interval, Vec3};
@@ -67,25 +70,6 @@ impl Rng {
             }
         }
     }
-}
-
-type D3 = [f64; 3];
-
-fn d3(v: Vec3) -> D3 {
-    [v.x as f64, v.y as f64, v.z as f64]
-}
-fn sub(a: D3, b: D3) -> D3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: D3, b: D3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: D3, b: D3) -> D3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// A closed, consistently oriented triangle mesh with what the checks need.

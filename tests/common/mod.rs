@@ -2,6 +2,8 @@
 //! statistics taken through the library's own render loop.
 #![allow(dead_code)]
 
+#[path = "d3.rs"]
+pub mod d3;
 #[path = "stale.rs"]
 pub mod stale;
 
