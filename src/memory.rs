@@ -47,16 +47,7 @@ impl std::error::Error for MemoryError {}
 /// or a limit on the address space (`ulimit -v`) leaves less. `None` where
 /// the system does not say (not Linux).
 pub fn available() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kib = meminfo
-        .lines()
-        .find_map(|l| l.strip_prefix("MemAvailable:"))?
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse::<u64>()
-        .ok()?;
-    let system = kib.saturating_mul(1024);
+    let system = kib_field("/proc/meminfo", "MemAvailable:")?.saturating_mul(1024);
     Some(
         [cgroup_room(), address_space_room()]
             .into_iter()
@@ -76,16 +67,22 @@ fn address_space_room() -> Option<u64> {
         .next()?
         .parse::<u64>()
         .ok()?; // "unlimited": no limit
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let used_kib = status
+    let used_kib = kib_field("/proc/self/status", "VmSize:")?;
+    Some(limit.saturating_sub(used_kib.saturating_mul(1024)))
+}
+
+/// The number of kilobytes on the line of `file` (a /proc file of
+/// `Key:   1234 kB` lines) that starts with `key`.
+fn kib_field(file: &str, key: &str) -> Option<u64> {
+    std::fs::read_to_string(file)
+        .ok()?
         .lines()
-        .find_map(|l| l.strip_prefix("VmSize:"))?
+        .find_map(|l| l.strip_prefix(key))?
         .trim()
         .trim_end_matches("kB")
         .trim()
-        .parse::<u64>()
-        .ok()?;
-    Some(limit.saturating_sub(used_kib.saturating_mul(1024)))
+        .parse()
+        .ok()
 }
 
 /// What a cgroup v2 memory limit leaves: `memory.max - memory.current` of

@@ -1,4 +1,5 @@
 //! Peak memory of a full-size cover render, measured on the real binary.
+
 #![cfg(target_os = "linux")]
 //!
 //! The film of a 1200×675 image takes 52 bytes a pixel (three `i128`
@@ -7,6 +8,7 @@
 //! This file holds one test only: `RUSAGE_CHILDREN` reports the largest child
 //! this test process has waited for.
 
+mod common;
 mod lumen_process;
 
 #[test]
@@ -22,15 +24,7 @@ fn full_size_cover_render_stays_under_100_mb() {
     let img = image::open(&out).unwrap();
     assert_eq!((img.width(), img.height()), (1200, 675));
 
-    // SAFETY: an all-zero rusage is valid (integers only), and getrusage
-    // fills the struct it is given.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    assert_eq!(
-        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
-        0
-    );
-    // ru_maxrss is in kilobytes on Linux.
-    let peak_mb = usage.ru_maxrss as f64 / 1024.0;
+    let peak_mb = common::children_peak_mb();
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(
         peak_mb > 42.0,

@@ -3,8 +3,10 @@
 //! name keeps the render's peak memory far below 40 copies (640 MB).
 //! This file holds one test only: `RUSAGE_CHILDREN` reports the largest
 //! child this test process has waited for.
+
 #![cfg(target_os = "linux")]
 
+mod common;
 mod lumen_process;
 
 #[test]
@@ -41,15 +43,7 @@ fn an_atlas_shared_by_many_materials_is_held_once() {
     );
     assert!(status.success(), "{stderr}");
 
-    // SAFETY: an all-zero rusage is valid (integers only), and getrusage
-    // fills the struct it is given.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    assert_eq!(
-        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
-        0
-    );
-    // ru_maxrss is in kilobytes on Linux.
-    let peak_mb = usage.ru_maxrss as f64 / 1024.0;
+    let peak_mb = common::children_peak_mb();
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(
         peak_mb > 16.0,

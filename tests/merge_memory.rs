@@ -41,15 +41,7 @@ fn merging_many_parts_holds_the_film_and_a_few_parts_only() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
-    // SAFETY: an all-zero rusage is valid (integers only), and getrusage
-    // fills the struct it is given.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    assert_eq!(
-        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
-        0
-    );
-    // ru_maxrss is in kilobytes on Linux.
-    let peak_mb = usage.ru_maxrss as f64 / 1024.0;
+    let peak_mb = common::children_peak_mb();
     std::fs::remove_dir_all(&dir).unwrap();
     // The image's film: 52 bytes a pixel.
     let film_mb = 1200.0 * 675.0 * 52.0 / (1024.0 * 1024.0);

@@ -56,15 +56,16 @@ impl Quad {
         }
         let n = u.cross(v);
         let n2 = n.length_squared();
+        // u × v in f64, where its square neither overflows nor underflows.
+        let n64 = u.as_dvec3().cross(v.as_dvec3());
         let (normal, w, length) = if n2.is_normal() {
             let length = n2.sqrt();
             (n / length, n / n2, length)
         } else {
             // |u × v|² overflows (edges of 6e9) or underflows: worked out
             // in f64, where it does not.
-            let n = u.as_dvec3().cross(v.as_dvec3());
-            let length = n.length();
-            let normal = n / length;
+            let length = n64.length();
+            let normal = n64 / length;
             (
                 Vec3::from(normal.as_vec3()),
                 Vec3::from((normal / length).as_vec3()),
@@ -85,8 +86,7 @@ impl Quad {
         let d = normal.dot(corner);
         let terms = (normal * corner).abs().element_sum();
         let d = if terms > 16.0 * d.abs() {
-            let n = u.as_dvec3().cross(v.as_dvec3());
-            (n.dot(corner.as_dvec3()) / n.length()) as f32
+            (n64.dot(corner.as_dvec3()) / n64.length()) as f32
         } else {
             d
         };

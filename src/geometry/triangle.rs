@@ -29,6 +29,7 @@
 use crate::lanes::{Mask, Real};
 use crate::math::{Interval, Point3, Vec3};
 use crate::ray::Ray;
+use glam::DVec3;
 
 /// A triangle given by its three vertices, counter-clockwise seen from the
 /// side its geometric normal (b − a) × (c − a) points to.
@@ -260,21 +261,14 @@ pub(crate) fn plane_distance(
     direction: [f64; 3],
     vertices: [[f32; 3]; 3],
 ) -> Option<f64> {
-    let [a, b, c] = vertices.map(|v| v.map(f64::from));
-    let o = origin.map(f64::from);
-    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-    let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
-    let (e1, e2) = (sub(b, a), sub(c, a));
-    let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    let along = dot(n, direction);
+    let [a, b, c] = vertices.map(|v| DVec3::from_array(v.map(f64::from)));
+    let o = DVec3::from_array(origin.map(f64::from));
+    let n = (b - a).cross(c - a);
+    let along = n.dot(DVec3::from_array(direction));
     if along == 0.0 {
         return None;
     }
-    Some(dot(n, sub(a, o)) / along)
+    Some(n.dot(a - o) / along)
 }
 
 /// The test of one ray whose `f32` edge functions have a zero: they are

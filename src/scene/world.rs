@@ -531,21 +531,14 @@ fn within_large(tri: &Triangle, p: Point3, margin: f32) -> (Point3, [f32; 3]) {
         // neighbour's side of an edge it shares; the point stays there.
         return (p, lift(bary, [0.0; 3]).map(|x| x as f32));
     }
-    if !(m[0] + m[1] + m[2] < 1.0) {
-        let centre = (a + b + c) / 3.0;
-        return (centre.as_vec3().into(), [1.0 / 3.0; 3]);
-    }
-    // Those short of their margin (by s) raised to it, the others' excess
-    // over theirs (r) shrunk to pay for it: the point moves by Σ (sᵢ −
-    // rᵢ·S/R)·vᵢ, whose weights sum to 0, worked out along the edges
-    // (adding the vertices themselves would round the point to their size).
-    let s = [0, 1, 2].map(|i| (m[i] - bary[i]).max(0.0));
-    let r = [0, 1, 2].map(|i| (bary[i] - m[i]).max(0.0));
-    let (short, excess) = (s[0] + s[1] + s[2], r[0] + r[1] + r[2]);
-    let shift = [0, 1, 2].map(|i| s[i] - r[i] * short / excess);
+    // Raised to their margins as `lift` does it (the centroid where the
+    // margins leave no room), the point moved by the change of its
+    // coordinates, whose weights sum to 0, along the edges (adding the
+    // vertices themselves would round the point to their size).
+    let lifted = lift(bary, m);
+    let shift = [0, 1, 2].map(|i| lifted[i] - bary[i]);
     let point = q + shift[1] * (b - a) + shift[2] * (c - a);
-    let lifted = [0, 1, 2].map(|i| (bary[i] + shift[i]) as f32);
-    (point.as_vec3().into(), lifted)
+    (point.as_vec3().into(), lifted.map(|x| x as f32))
 }
 
 /// Barycentric coordinates `b` with every `bᵢ` at least `m[i]`: those

@@ -573,3 +573,18 @@ fn run_and_write(
     session.checkpoint().write(path).unwrap();
     run
 }
+
+/// The peak resident memory, in MB, of the largest child process this test
+/// process has waited for (`RUSAGE_CHILDREN`): a test that runs one child
+/// measures that child.
+pub fn children_peak_mb() -> f64 {
+    // SAFETY: an all-zero rusage is valid (integers only), and getrusage
+    // fills the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    assert_eq!(
+        unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) },
+        0
+    );
+    // ru_maxrss is in kilobytes on Linux.
+    usage.ru_maxrss as f64 / 1024.0
+}
