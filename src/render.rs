@@ -287,7 +287,7 @@ fn add_sample(row: &mut RowMut, stats: &mut RenderStats, x: usize, index: u32, c
 /// The camera ray of sample `index` of pixel `(x, y)`, whose sampler is
 /// `pixel_sampler`, and the sampler that goes on to serve its path.
 #[inline(always)]
-fn camera_sample(
+pub(crate) fn camera_sample(
     scene: &Scene,
     x: u32,
     y: u32,

@@ -1,6 +1,9 @@
 //! Throughput benchmarks on fixed workloads: `lumen bench`.
 
 pub mod efficiency;
+#[cfg(feature = "embree")]
+pub mod embree;
+pub mod traversal;
 
 use crate::render::{render, RenderStats};
 use crate::rng::Rng;

@@ -25,6 +25,7 @@ use crate::sampler::{Dim, Sampler};
 use crate::texture::Texture;
 use desc::{IntegratorDesc, SamplingDesc, ShadingDesc};
 use thiserror::Error;
+pub use world::PlacedShapes;
 use world::{LightIds, World};
 
 /// Largest magnitude of an object's coordinates and radius: the sphere test
@@ -314,6 +315,13 @@ impl Scene {
     pub fn hit(&self, ray: &Ray, interval: Interval) -> Option<HitRecord> {
         let hit = self.intersect(ray, interval)?;
         Some(self.record(ray, hit))
+    }
+
+    /// The scene's shapes as placed in the world, numbered as the tree's
+    /// items (see [`PlacedShapes`]), or `None` when some are placed by
+    /// instances.
+    pub fn placed_shapes(&self) -> Option<PlacedShapes> {
+        self.world.placed_shapes()
     }
 
     /// Which primitive `ray` hits first within `interval`, and where along

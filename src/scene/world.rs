@@ -619,6 +619,21 @@ pub(crate) struct Rounding {
     pub(crate) onto_spheres: bool,
 }
 
+/// The shapes of a scene as placed in the world, as plain coordinates: what
+/// another intersector needs to trace the same rays against the same
+/// surfaces (see [`crate::bench::traversal`]). Item numbers follow the
+/// tree's: spheres, then quads, then triangles, so that a hit's
+/// [`Hit::index`] names the same shape in each list.
+#[derive(Clone, Debug, Default)]
+pub struct PlacedShapes {
+    /// Centre and radius of each sphere.
+    pub spheres: Vec<[f32; 4]>,
+    /// The corners Q, Q + u, Q + u + v, Q + v of each quad.
+    pub quads: Vec<[[f32; 3]; 4]>,
+    /// The vertices of each triangle.
+    pub triangles: Vec<[[f32; 3]; 3]>,
+}
+
 impl World {
     /// Builds the tree over `top` and the placements `instances` of
     /// `groups`.
@@ -671,6 +686,46 @@ impl World {
             placed,
             rounding,
         }
+    }
+
+    /// The world's shapes as placed, or `None` when some are placed by
+    /// instances (which another intersector would need as instances too).
+    pub(crate) fn placed_shapes(&self) -> Option<PlacedShapes> {
+        if !self.placed.is_empty() {
+            return None;
+        }
+        let top = &self.top;
+        let mut shapes = PlacedShapes {
+            spheres: top
+                .spheres
+                .iter()
+                .map(|s| s.center.extend(s.radius).to_array())
+                .collect(),
+            quads: top
+                .quads
+                .iter()
+                .map(|(q, _)| {
+                    [
+                        q.corner,
+                        q.corner + q.u,
+                        q.corner + q.u + q.v,
+                        q.corner + q.v,
+                    ]
+                    .map(|p| p.to_array())
+                })
+                .collect(),
+            triangles: Vec::new(),
+        };
+        for mesh in &top.meshes {
+            let positions = &mesh.data.positions;
+            shapes.triangles.extend(
+                mesh.data
+                    .triangles
+                    .iter()
+                    .map(|t| t.map(|i| positions[i as usize])),
+            );
+        }
+        Some(shapes)
     }
 
     /// The radius of a sphere around everything (half the diagonal of the

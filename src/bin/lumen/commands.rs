@@ -72,7 +72,8 @@ pub(crate) fn scaling_command(fields: &[usize], spp: u32, runs: u32) -> Result<(
     Ok(())
 }
 
-pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<()> {
+/// The standard workloads at `spp`, or the one named `only`.
+fn standard_workloads(spp: u32, only: Option<&str>) -> Result<Vec<bench::Workload>> {
     let workloads: Vec<_> = bench::standard_workloads(spp)
         .into_iter()
         .filter(|w| only.is_none_or(|name| w.name == name))
@@ -88,6 +89,11 @@ pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<(
             hint::listing(only, names, str::to_string)
         ));
     }
+    Ok(workloads)
+}
+
+pub(crate) fn bench_command(spp: u32, runs: u32, only: Option<&str>) -> Result<()> {
+    let workloads = standard_workloads(spp, only)?;
     outln!(
         "lumen bench: {}, {spp} spp, median of {runs} runs",
         machine()
@@ -255,4 +261,111 @@ pub(crate) fn efficiency_command(
         }
     }
     Ok(())
+}
+
+/// `lumen bench --traversal`: each workload's recorded rays traced through
+/// lumen's tree and, in a build with the `embree` feature, through Embree's
+/// (see [`bench::traversal`]).
+pub(crate) fn traversal_command(spp: u32, runs: u32, only: Option<&str>) -> Result<()> {
+    use bench::traversal::{median, record_rays, trace_lumen, Agreement, MAX_RECORDED};
+    let workloads = standard_workloads(spp, only)?;
+    outln!(
+        "lumen bench --traversal: the camera and bounce rays of {spp} spp, one thread, nearest hits one ray at a time, median of {runs} runs ({} code)",
+        lumen::isa::Isa::detect().name()
+    )?;
+    let peers = traversal_peers();
+    let mut header = format!(
+        "{:<24} {:>10} {:>8} {:>11}",
+        "workload", "rays", "camera", "lumen M/s"
+    );
+    for (name, _) in &peers {
+        header += &format!(
+            " {:>14} {:>6} {:>9}",
+            format!("{name} M/s"),
+            "lumen/",
+            "agree"
+        );
+    }
+    outln!("{header}")?;
+    for w in workloads {
+        let scene =
+            lumen::scene::Scene::from_desc(&w.desc).map_err(|e| anyhow!("{}: {e}", w.name))?;
+        let recorded = record_rays(&scene, spp, MAX_RECORDED);
+        let rays = &recorded.rays;
+        let tracers: Vec<_> = peers
+            .iter()
+            .map(|(name, make)| make(&scene).map_err(|e| anyhow!("{}: {name}: {e}", w.name)))
+            .collect::<Result<_>>()?;
+        let (lumen_found, _) = trace_lumen(&scene, rays);
+        let mut lumen_times = Vec::new();
+        let mut peer_times = vec![Vec::new(); tracers.len()];
+        let mut agreements = Vec::new();
+        for run in 0..runs {
+            lumen_times.push(trace_lumen(&scene, rays).1);
+            for (k, trace) in tracers.iter().enumerate() {
+                let (found, time) = trace(rays);
+                peer_times[k].push(time);
+                if run == 0 {
+                    agreements.push(Agreement::of(&lumen_found, &found));
+                }
+            }
+        }
+        let per_second = |t: &[std::time::Duration]| rays.len() as f64 / median(t).as_secs_f64();
+        let lumen_rate = per_second(&lumen_times);
+        let mut line = format!(
+            "{:<24} {:>10} {:>7.0}% {:>11.2}",
+            w.name,
+            rays.len(),
+            100.0 * recorded.camera as f64 / rays.len().max(1) as f64,
+            lumen_rate / 1e6
+        );
+        for (times, agreement) in peer_times.iter().zip(&agreements) {
+            let rate = per_second(times);
+            line += &format!(
+                " {:>14.2} {:>6.3} {:>8.3}%",
+                rate / 1e6,
+                lumen_rate / rate,
+                100.0 * agreement.fraction()
+            );
+        }
+        outln!("{line}")?;
+    }
+    if peers.is_empty() {
+        outln!("Embree is not in this build: build with `cargo build --release --features embree` (needs Embree 3, Debian's libembree-dev) to trace the same rays through it")?;
+    }
+    Ok(())
+}
+
+/// A peer's tracer of recorded rays, made for a scene.
+type Tracer =
+    Box<dyn Fn(&[lumen::ray::Ray]) -> (Vec<bench::traversal::Found>, std::time::Duration)>;
+/// A peer's name and how to make its tracer.
+type Peer = (
+    &'static str,
+    fn(&lumen::scene::Scene) -> Result<Tracer, String>,
+);
+
+/// The intersectors this build can trace recorded rays with besides
+/// lumen's: Embree with AVX2, and with AVX-512 where the processor has it.
+fn traversal_peers() -> Vec<Peer> {
+    #[cfg(feature = "embree")]
+    {
+        use bench::embree::{EmbreeIsa, EmbreeScene};
+        fn embree(scene: &lumen::scene::Scene, isa: EmbreeIsa) -> Result<Tracer, String> {
+            let shapes = scene
+                .placed_shapes()
+                .ok_or("the scene places shapes by instances, which the anchor does not export")?;
+            let embree = EmbreeScene::new(&shapes, isa)?;
+            Ok(Box::new(move |rays| embree.trace(rays)))
+        }
+        let mut peers: Vec<Peer> = vec![("embree-avx2", |s| embree(s, EmbreeIsa::Avx2))];
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            peers.push(("embree-avx512", |s| embree(s, EmbreeIsa::Avx512)));
+        }
+        peers
+    }
+    #[cfg(not(feature = "embree"))]
+    Vec::new()
 }

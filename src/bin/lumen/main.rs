@@ -143,6 +143,12 @@ enum Command {
         /// their time and error against a reference of 4 × --spp.
         #[arg(long, value_name = "ERROR", conflicts_with_all = ["scaling", "field", "instances", "efficiency"])]
         adaptive: Option<f64>,
+        /// Instead of rendering, trace the camera and bounce rays of each
+        /// workload's paths (--spp samples) through lumen's tree on one
+        /// thread, and through Embree's in a build with the `embree`
+        /// feature: rays/s of each and how far their hits agree.
+        #[arg(long, conflicts_with_all = ["scaling", "field", "instances", "efficiency", "adaptive"])]
+        traversal: bool,
     },
 }
 
@@ -369,7 +375,7 @@ mod signals;
 
 use commands::{
     adaptive_command, bench_command, efficiency_command, gallery_command, instances_command,
-    scaling_command,
+    scaling_command, traversal_command,
 };
 use render::render_command;
 use scenes::export_command;
@@ -476,8 +482,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             efficiency,
             sampler,
             adaptive,
+            traversal,
         } => {
             with_threads(threads, || {
+                if traversal {
+                    return traversal_command(spp, runs, workload.as_deref());
+                }
                 if let Some(target) = adaptive {
                     return adaptive_command(target, spp, workload.as_deref());
                 }

@@ -1,0 +1,216 @@
+//! The traversal anchor's rays and shapes (`lumen bench --traversal`):
+//! lumen's tree finds, for recorded rays, the hits an independent brute-force
+//! intersector in f64 finds over the exported shapes; and, in a build with
+//! the `embree` feature, the hits Embree finds.
+
+use lumen::bench::traversal::{record_rays, trace_lumen, Agreement, Found};
+use lumen::bench::{bunny_scene, standard_workloads, BUNNY_235K};
+use lumen::ray::Ray;
+use lumen::scene::{PlacedShapes, Scene};
+
+type V = [f64; 3];
+
+fn v(a: [f32; 3]) -> V {
+    a.map(f64::from)
+}
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: V, b: V) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V, b: V) -> V {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The nearest hit from distance 0 of `ray` over every shape, tested one
+/// by one in f64 (spheres by their quadratic, triangles and quads by their
+/// plane and the point's coordinates in it).
+fn brute_force(shapes: &PlacedShapes, ray: &Ray) -> Found {
+    let o = v(ray.origin().to_array());
+    let d = v(ray.direction.to_array());
+    let mut best: Found = None;
+    let mut keep = |t: f64, item: usize| {
+        if t >= 0.0 && best.is_none_or(|(b, _)| t < f64::from(b)) {
+            best = Some((t as f32, item as u32));
+        }
+    };
+    for (i, s) in shapes.spheres.iter().enumerate() {
+        let oc = sub(v([s[0], s[1], s[2]]), o);
+        let h = dot(d, oc);
+        let c = dot(oc, oc) - f64::from(s[3]) * f64::from(s[3]);
+        let disc = h * h - dot(d, d) * c;
+        if disc >= 0.0 {
+            let root = disc.sqrt();
+            let near = (h - root) / dot(d, d);
+            keep(
+                if near >= 0.0 {
+                    near
+                } else {
+                    (h + root) / dot(d, d)
+                },
+                i,
+            );
+        }
+    }
+    // A planar polygon: the plane's distance, then the point's
+    // coordinates (α, β) along the edges from `corner`.
+    let mut polygon = |corner: V, e1: V, e2: V, item: usize, quad: bool| {
+        let n = cross(e1, e2);
+        let denom = dot(n, d);
+        if denom == 0.0 {
+            return;
+        }
+        let t = dot(n, sub(corner, o)) / denom;
+        let p = sub([o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]], corner);
+        let nn = dot(n, n);
+        let alpha = dot(cross(p, e2), n) / nn;
+        let beta = dot(cross(e1, p), n) / nn;
+        let inside = if quad {
+            (0.0..=1.0).contains(&alpha) && (0.0..=1.0).contains(&beta)
+        } else {
+            alpha >= 0.0 && beta >= 0.0 && alpha + beta <= 1.0
+        };
+        if inside {
+            keep(t, item);
+        }
+    };
+    let first_quad = shapes.spheres.len();
+    for (i, q) in shapes.quads.iter().enumerate() {
+        let c = v(q[0]);
+        polygon(c, sub(v(q[1]), c), sub(v(q[3]), c), first_quad + i, true);
+    }
+    let first_triangle = first_quad + shapes.quads.len();
+    for (i, t) in shapes.triangles.iter().enumerate() {
+        let a = v(t[0]);
+        polygon(
+            a,
+            sub(v(t[1]), a),
+            sub(v(t[2]), a),
+            first_triangle + i,
+            false,
+        );
+    }
+    best
+}
+
+/// Every `step`-th recorded ray of `scene` (at most `count`).
+fn some_rays(scene: &Scene, spp: u32, step: usize, count: usize) -> Vec<Ray> {
+    let recorded = record_rays(scene, spp, usize::MAX);
+    assert!(recorded.camera > 0 && recorded.rays.len() > recorded.camera);
+    recorded
+        .rays
+        .into_iter()
+        .step_by(step)
+        .take(count)
+        .collect()
+}
+
+/// `desc` at `width` pixels across, its shape kept.
+fn small(mut desc: lumen::scene::SceneDesc, width: u32) -> Scene {
+    if let Some(h) = desc.render.height.as_mut() {
+        *h = (*h * width).div_ceil(desc.render.width);
+    }
+    desc.render.width = width;
+    Scene::from_desc(&desc).unwrap()
+}
+
+#[test]
+fn recorded_rays_are_camera_rays_then_their_bounces_as_the_paths_made_them() {
+    let scene = small(lumen::scene::builtin::cover(), 24);
+    let a = record_rays(&scene, 2, usize::MAX);
+    let pixels = (scene.settings.width * scene.settings.height) as usize;
+    assert_eq!(a.camera, 2 * pixels);
+    // Bounce rays start where the ray before them in the same path ended.
+    let bounces = a.rays.len() - a.camera;
+    assert!(bounces > a.camera / 2, "{bounces} bounce rays");
+    // The same scene, settings and seed record the same rays.
+    let b = record_rays(&scene, 2, usize::MAX);
+    assert_eq!(format!("{:?}", a.rays), format!("{:?}", b.rays));
+    // A limit stops the recording after the pixel that reached it.
+    let c = record_rays(&scene, 2, 100);
+    assert!(c.rays.len() >= 100 && c.rays.len() < 100 + 2 * 50);
+    assert_eq!(
+        format!("{:?}", c.rays),
+        format!("{:?}", &a.rays[..c.rays.len()])
+    );
+}
+
+#[test]
+fn lumen_finds_the_hits_a_brute_force_f64_intersector_finds_on_the_cover() {
+    let scene = small(lumen::scene::builtin::cover(), 60);
+    let shapes = scene
+        .placed_shapes()
+        .expect("the cover places no instances");
+    assert_eq!(shapes.spheres.len(), scene.spheres.len());
+    let rays = some_rays(&scene, 2, 3, 4000);
+    let (found, _) = trace_lumen(&scene, &rays);
+    let truth: Vec<Found> = rays.iter().map(|r| brute_force(&shapes, r)).collect();
+    let agreement = Agreement::of(&found, &truth);
+    assert!(agreement.fraction() >= 0.999, "{agreement:?}");
+    assert!(truth.iter().filter(|f| f.is_some()).count() > rays.len() / 2);
+}
+
+#[test]
+fn lumen_finds_the_hits_a_brute_force_f64_intersector_finds_on_the_bunny() {
+    let scene = small(bunny_scene(BUNNY_235K), 40);
+    let shapes = scene.placed_shapes().expect("the bunny is placed once");
+    assert_eq!((shapes.quads.len(), shapes.triangles.len()), (1, 235_136));
+    let rays = some_rays(&scene, 1, 7, 300);
+    let (found, _) = trace_lumen(&scene, &rays);
+    let truth: Vec<Found> = rays.iter().map(|r| brute_force(&shapes, r)).collect();
+    let agreement = Agreement::of(&found, &truth);
+    assert!(agreement.fraction() >= 0.995, "{agreement:?}");
+    // Both the floor and the bunny are met.
+    let on_bunny = truth
+        .iter()
+        .filter(|f| f.is_some_and(|(_, i)| i > 0))
+        .count();
+    let on_floor = truth
+        .iter()
+        .filter(|f| f.is_some_and(|(_, i)| i == 0))
+        .count();
+    assert!(on_bunny > 30 && on_floor > 30, "{on_bunny} {on_floor}");
+}
+
+#[test]
+fn an_instanced_scene_exports_no_flat_shapes() {
+    let scene = Scene::from_desc(&lumen::bench::bunny_field(BUNNY_235K, 2)).unwrap();
+    assert!(scene.placed_shapes().is_none());
+    assert!(standard_workloads(1).iter().all(|w| {
+        let mut desc = w.desc.clone();
+        desc.render.width = 8;
+        Scene::from_desc(&desc).unwrap().placed_shapes().is_some()
+    }));
+}
+
+#[cfg(feature = "embree")]
+mod embree {
+    use super::*;
+    use lumen::bench::embree::{EmbreeIsa, EmbreeScene};
+
+    fn agree_with_embree(scene: &Scene, spp: u32) {
+        let shapes = scene.placed_shapes().unwrap();
+        let rays = record_rays(scene, spp, usize::MAX).rays;
+        let (found, _) = trace_lumen(scene, &rays);
+        let embree = EmbreeScene::new(&shapes, EmbreeIsa::Avx2).unwrap();
+        let (theirs, _) = embree.trace(&rays);
+        let agreement = Agreement::of(&found, &theirs);
+        eprintln!("{agreement:?}");
+        assert!(agreement.fraction() >= 0.9995, "{agreement:?}");
+    }
+
+    #[test]
+    fn lumen_and_embree_find_the_same_hits_on_the_cover() {
+        agree_with_embree(&small(lumen::scene::builtin::cover(), 100), 2);
+    }
+
+    #[test]
+    fn lumen_and_embree_find_the_same_hits_on_the_bunny() {
+        agree_with_embree(&small(bunny_scene(BUNNY_235K), 100), 2);
+    }
+}
