@@ -139,6 +139,10 @@ pub trait Wide: Real {
     fn bits(mask: Self::Mask) -> u32;
     /// Lane `i` true where bit `i` of `bits` is set.
     fn mask_from_bits(bits: u32) -> Self::Mask;
+    /// Lane-wise minimum with `minps` semantics (see [`min4`]).
+    fn min_ps(self, other: Self) -> Self;
+    /// Lane-wise maximum with `maxps` semantics (see [`max4`]).
+    fn max_ps(self, other: Self) -> Self;
 }
 
 /// Eight `f32` lanes as two 4-lane vectors of the architecture's baseline
@@ -242,6 +246,14 @@ impl Wide for F8 {
     fn mask_from_bits(bits: u32) -> M8 {
         let half = |b: u32| BVec4A::new(b & 1 != 0, b & 2 != 0, b & 4 != 0, b & 8 != 0);
         M8([half(bits), half(bits >> 4)])
+    }
+    #[inline(always)]
+    fn min_ps(self, o: F8) -> F8 {
+        F8([min4(self.0[0], o.0[0]), min4(self.0[1], o.0[1])])
+    }
+    #[inline(always)]
+    fn max_ps(self, o: F8) -> F8 {
+        F8([max4(self.0[0], o.0[0]), max4(self.0[1], o.0[1])])
     }
 }
 
@@ -451,6 +463,14 @@ mod avx {
                 let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bits);
                 MW8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bits)))
             }
+        }
+        #[inline(always)]
+        fn min_ps(self, o: W8) -> W8 {
+            W8(unsafe { _mm256_min_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn max_ps(self, o: W8) -> W8 {
+            W8(unsafe { _mm256_max_ps(self.0, o.0) })
         }
     }
 

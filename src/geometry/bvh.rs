@@ -1,22 +1,26 @@
-//! A 4-wide bounding volume hierarchy over primitives of every kind,
+//! A wide bounding volume hierarchy over primitives of every kind,
 //! traversed by one function for every query.
 //!
-//! The binary SAH tree of [`super::bvh_build`] is collapsed into nodes of four
-//! children: a node stores the boxes of its four children as structure of
-//! arrays (the lower x planes of all four in one 4-lane vector, and so on), so
-//! one ray is tested against four boxes with a handful of vector operations.
-//! Leaves are packets of up to eight primitives of one kind (the leaf's tag),
-//! stored as structure of arrays and tested together by that kind's kernel on
-//! eight lanes (see [`crate::lanes`]).
+//! The binary SAH tree of [`super::bvh_build`] is collapsed into nodes of
+//! four children for trees of spheres only, which bundles of rays walk
+//! together, and of eight for the rest (meshes), which single rays walk: a
+//! mesh's tree is larger than the caches, and half as many levels are half
+//! as many waits for memory. A node stores its children's boxes as structure
+//! of arrays (the lower x planes of all children in one vector, and so on),
+//! so one ray is tested against all of them with a handful of vector
+//! operations: four lanes of SSE2 or NEON, or eight of AVX2 where the
+//! processor has it. Leaves are packets of up to eight primitives of one
+//! kind (the leaf's tag), stored as structure of arrays and tested together
+//! by that kind's kernel on eight lanes (see [`crate::lanes`]).
 //!
 //! `Bvh::traverse` walks the tree for any `Rays`: one ray looking for
 //! its nearest hit ([`Bvh::hit`]) or for any hit ([`Bvh::occluded`]), or a
 //! bundle of rays ([`Bvh::hit_bundle`]). It visits the hit children nearest
 //! first and skips any entry of its stack whose box starts beyond the
-//! closest hit found so far.
-//!
-//! The box tests use glam's [`Vec4`], which uses SSE2 on x86-64 and NEON on
-//! aarch64 (both always present there) and plain scalar code elsewhere.
+//! closest hit found so far. Which children are visited, and in which order,
+//! changes no result: hits are kept in the order (distance, index) and boxes
+//! with a margin (`SLACK`), so both widths and every instruction set find the
+//! same hits to the bit.
 
 use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, BinaryTree, MAX_LEAF};
 use crate::geometry::instance::Instance;
@@ -29,6 +33,7 @@ use crate::math::Interval;
 use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
 use std::mem::MaybeUninit;
+use std::ops::Index;
 
 /// Children of a node referring to a leaf have this bit set.
 pub(super) const LEAF_BIT: u32 = 1 << 31;
@@ -39,9 +44,11 @@ const INDEX_MASK: u32 = (1 << KIND_SHIFT) - 1;
 /// An unused child slot (its box is empty, so it is never entered), and an
 /// unused lane of a packet.
 pub(super) const NO_CHILD: u32 = u32::MAX;
-/// Entries of the traversal stack: a node pushes at most three children and
-/// the tree is at most `MAX_SAH_DEPTH + 32` levels deep (see `bvh_build`).
-pub(super) const STACK_SIZE: usize = 256;
+/// Entries of the traversal stack: a node pushes at most seven children
+/// (three in a tree of four-wide nodes), a wide node lies at least one level
+/// of the binary tree below its parent, and the binary tree is at most
+/// `MAX_SAH_DEPTH + 32` = 80 levels deep (see `bvh_build`).
+pub(super) const STACK_SIZE: usize = 7 * 80;
 
 /// Four children's boxes, structure of arrays, and their references.
 #[derive(Clone, Copy, Debug)]
@@ -61,6 +68,76 @@ impl Node {
         children: [NO_CHILD; 4],
         used: 0,
     };
+
+    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32) {
+        for axis in 0..3 {
+            self.planes[axis][0][lane] = bounds.min[axis];
+            self.planes[axis][1][lane] = bounds.max[axis];
+        }
+        self.children[lane] = child;
+        self.used |= 1 << lane;
+    }
+}
+
+/// Eight children's boxes, structure of arrays, and their references: the
+/// node of trees that hold other shapes than spheres (see [`Bvh::over`]).
+/// One ray meets a mesh's tree half as many levels deep as with four
+/// children, and the tree is larger than the caches: each level is a wait
+/// for memory.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Node8 {
+    /// `planes[axis][0]`: the eight lower bounds along `axis`; `[1]`: the upper.
+    pub(super) planes: [[Lane8; 2]; 3],
+    /// Node index, `LEAF_BIT | kind | packet index`, or `NO_CHILD`.
+    pub(super) children: [u32; 8],
+    /// Bit `lane` is set when `children[lane]` is used.
+    pub(super) used: u32,
+}
+
+/// What the traversal and the collapse ask of a node, of four children or
+/// eight.
+pub(super) trait TreeNode: Copy {
+    /// Children a node has room for.
+    const WIDTH: usize;
+    /// A list of up to `WIDTH` child lanes.
+    type Lanes: Copy + Default + AsRef<[usize]> + AsMut<[usize]>;
+    /// A node without children.
+    const EMPTY: Self;
+    /// The reference in child slot `lane`.
+    fn child(&self, lane: usize) -> u32;
+    /// Puts `child`, of box `bounds`, in slot `lane`.
+    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32);
+}
+
+impl TreeNode for Node {
+    const WIDTH: usize = 4;
+    type Lanes = [usize; 4];
+    const EMPTY: Node = Node::EMPTY;
+
+    #[inline(always)]
+    fn child(&self, lane: usize) -> u32 {
+        self.children[lane]
+    }
+
+    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32) {
+        Node::set_child(self, lane, bounds, child);
+    }
+}
+
+impl TreeNode for Node8 {
+    const WIDTH: usize = 8;
+    type Lanes = [usize; 8];
+    const EMPTY: Node8 = Node8 {
+        planes: [[[f32::INFINITY; 8], [f32::NEG_INFINITY; 8]]; 3],
+        children: [NO_CHILD; 8],
+        used: 0,
+    };
+
+    #[inline(always)]
+    fn child(&self, lane: usize) -> u32 {
+        self.children[lane]
+    }
 
     fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32) {
         for axis in 0..3 {
@@ -200,11 +277,15 @@ pub struct Hit {
     pub sub: u32,
 }
 
-/// A 4-wide SAH bounding volume hierarchy over a set of primitives.
+/// A wide SAH bounding volume hierarchy over a set of primitives.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Node 0 is the root; empty when there are no primitives.
+    /// Node 0 is the root; empty when there are no primitives or the tree
+    /// is eight-wide.
     nodes: Vec<Node>,
+    /// The eight-wide nodes of a tree that holds other shapes than spheres
+    /// (node 0 the root), in place of `nodes`.
+    wide: Vec<Node8>,
     spheres: Vec<SpherePacket>,
     triangles: Vec<TrianglePacket>,
     quads: Vec<QuadPacket>,
@@ -254,6 +335,7 @@ impl Bvh {
         } = build_binary(primitives);
         let mut bvh = Bvh {
             nodes: Vec::new(),
+            wide: Vec::new(),
             spheres: Vec::new(),
             triangles: Vec::new(),
             quads: Vec::new(),
@@ -271,21 +353,28 @@ impl Bvh {
             order: &order,
             primitives,
         };
+        // Bundles of rays, which pay only on spheres, walk four-wide nodes;
+        // single rays through meshes, eight-wide ones.
+        let spheres_only = leaves
+            .iter()
+            .enumerate()
+            .all(|(kind, &n)| n == 0 || kind == Kind::Sphere as usize);
+        let width = if spheres_only { 4 } else { 8 };
         let roots = if binary[0].is_leaf() {
-            Opened([0; 4], 1)
+            Opened([0; 8], 1)
         } else {
-            collapse.open(0)
+            collapse.open(0, width)
         };
-        // Reserved at its size: an estimate took twice the nodes' memory
-        // when it was shrunk (a copy).
-        bvh.nodes = Vec::with_capacity(collapse.count_nodes(&roots));
         // The nodes in one pass, which numbers the packets; the packets
         // then on every core (making them reads the primitives: most of
         // the time of a large mesh's collapse).
         let mut packet_leaves = leaves.map(Vec::with_capacity);
-        collapse.emit_node(&roots, &mut bvh, &mut packet_leaves);
+        if spheres_only {
+            bvh.nodes = collapse.emit_tree(&roots, &mut packet_leaves);
+        } else {
+            bvh.wide = collapse.emit_tree(&roots, &mut packet_leaves);
+        }
         collapse.fill_packets(&packet_leaves, &mut bvh);
-        bvh.nodes.shrink_to_fit();
         bvh.spheres.shrink_to_fit();
         bvh.triangles.shrink_to_fit();
         bvh.quads.shrink_to_fit();
@@ -307,13 +396,14 @@ impl Bvh {
 
     /// Number of nodes (for statistics and memory estimates).
     pub fn node_count(&self) -> usize {
-        self.nodes.len()
+        self.nodes.len() + self.wide.len()
     }
 
     /// Bytes of memory held by the hierarchy.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
         self.nodes.capacity() * size_of::<Node>()
+            + self.wide.capacity() * size_of::<Node8>()
             + self.spheres.capacity() * size_of::<SpherePacket>()
             + self.triangles.capacity() * size_of::<TrianglePacket>()
             + self.quads.capacity() * size_of::<QuadPacket>()
@@ -364,7 +454,11 @@ impl Bvh {
         interval: Interval,
     ) -> (f32, u32, u32) {
         let mut query = SingleRay::<Q, SPHERES>::new(self, ray, interval);
-        self.traverse(&mut query);
+        if SPHERES || self.wide.is_empty() {
+            self.traverse(&self.nodes, &mut query);
+        } else {
+            self.traverse(&self.wide, &mut query);
+        }
         (query.closest, query.best, query.sub)
     }
 
@@ -378,18 +472,16 @@ impl Bvh {
         self.spheres_only
     }
 
-    /// Node `i`, which the traversal reached through a child reference.
+    /// The four-wide nodes (none when the tree is eight-wide).
     #[inline(always)]
-    pub(super) fn node(&self, i: u32) -> &Node {
-        debug_assert!((i as usize) < self.nodes.len());
-        // SAFETY: the traversal starts at node 0 of a non-empty tree and only
-        // follows references of used child slots, each of which `Collapse`
-        // wrote after pushing the node it names, so every index is in bounds.
-        // (Unchecked: the bounds checks were 3% of the render's instructions.)
-        #[allow(unsafe_code)]
-        unsafe {
-            self.nodes.get_unchecked(i as usize)
-        }
+    pub(super) fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The eight-wide nodes (none when the tree is four-wide).
+    #[inline(always)]
+    pub(super) fn wide_nodes(&self) -> &[Node8] {
+        &self.wide
     }
 
     /// Sphere packet `i`, reached through a leaf reference of a used child
@@ -437,11 +529,12 @@ impl Bvh {
     }
 
     /// Walks the tree for `rays`, nearest children first: the one traversal
-    /// of every query. `rays` tests the boxes, tells which stacked boxes are
-    /// still worth entering, and tests the leaves.
+    /// of every query, on four-wide nodes or eight-wide. `rays` tests the
+    /// boxes, tells which stacked boxes are still worth entering, and tests
+    /// the leaves.
     #[inline(always)]
-    pub(super) fn traverse<R: Rays>(&self, rays: &mut R) {
-        if self.nodes.is_empty() {
+    pub(super) fn traverse<N: TreeNode, R: Enter<N>>(&self, nodes: &[N], rays: &mut R) {
+        if nodes.is_empty() {
             return;
         }
         // Uninitialised: zeroing the stack on every call cost ~10% of the render.
@@ -455,41 +548,49 @@ impl Bvh {
                     return;
                 }
             } else {
-                let node = self.node(current);
+                debug_assert!((current as usize) < nodes.len());
+                // SAFETY: the traversal starts at node 0 of a non-empty tree
+                // and only follows references of used child slots, each of
+                // which `Collapse` wrote after pushing the node it names, so
+                // every index is in bounds. (Unchecked: the bounds checks
+                // were 3% of the render's instructions.)
+                #[allow(unsafe_code)]
+                let node = unsafe { nodes.get_unchecked(current as usize) };
                 let (mask, entries) = rays.enter(node);
                 if mask != 0 {
-                    let first = mask.trailing_zeros() as usize & 3;
+                    let first = mask.trailing_zeros() as usize & (N::WIDTH - 1);
                     let rest = mask & (mask - 1);
                     if rest == 0 {
                         // One child hit (the most common case): go on with it.
-                        current = node.children[first];
+                        current = node.child(first);
                         entry = entries[first];
                         continue;
                     }
                     if rest & (rest - 1) == 0 {
                         // Two children (most of the rest): push the farther,
                         // go on with the nearer (the first lane on a tie).
-                        let second = rest.trailing_zeros() as usize & 3;
+                        let second = rest.trailing_zeros() as usize & (N::WIDTH - 1);
                         let order = rays.order(node, &entries);
                         let (near, far) = if order[second] < order[first] {
                             (second, first)
                         } else {
                             (first, second)
                         };
-                        stack[top].write((node.children[far], entries[far]));
+                        stack[top].write((node.child(far), entries[far]));
                         top += 1;
-                        current = node.children[near];
+                        current = node.child(near);
                         entry = entries[near];
                         continue;
                     }
-                    // Three or four: push the hit children farthest first; go
-                    // on with the nearest.
-                    let (lanes, n) = farthest_first(mask, rays.order(node, &entries));
+                    // More: push the hit children farthest first; go on
+                    // with the nearest.
+                    let (lanes, n) = farthest_first::<N, _>(mask, &rays.order(node, &entries));
+                    let lanes = lanes.as_ref();
                     for &lane in &lanes[..n - 1] {
-                        stack[top].write((node.children[lane], entries[lane]));
+                        stack[top].write((node.child(lane), entries[lane]));
                         top += 1;
                     }
-                    current = node.children[lanes[n - 1]];
+                    current = node.child(lanes[n - 1]);
                     entry = entries[lanes[n - 1]];
                     continue;
                 }
@@ -513,22 +614,31 @@ impl Bvh {
     }
 }
 
-/// What [`Bvh::traverse`] asks of the rays it walks the tree for.
+/// What [`Bvh::traverse`] asks of the rays it walks the tree for, whatever
+/// the width of the nodes.
 pub(super) trait Rays {
     /// Where the rays enter a box: one distance, or one per ray.
     type Entry: Copy + Default;
-    /// Tests the four boxes of `node`: the children to visit (bit per
-    /// child) and where the rays enter each.
-    fn enter(&self, node: &Node) -> (u32, [Self::Entry; 4]);
-    /// The order to visit the children of `node` in, nearest first (only
-    /// speed depends on it), given where the rays enter them: asked only
-    /// when two or more are hit.
-    fn order(&self, node: &Node, entries: &[Self::Entry; 4]) -> [f32; 4];
     /// Whether a box the rays enter at `entry` may still hold a hit that matters.
     fn needed(&self, entry: &Self::Entry) -> bool;
     /// Tests the primitives of `leaf` (a leaf reference), which the rays
     /// enter at `entry`; `true` ends the traversal.
     fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Self::Entry) -> bool;
+}
+
+/// The box tests of [`Rays`] on nodes of type `N`.
+pub(super) trait Enter<N: TreeNode>: Rays {
+    /// Where the rays enter each child of a node.
+    type Entries: Index<usize, Output = Self::Entry>;
+    /// A distance per child, to order them by.
+    type Order: Index<usize, Output = f32>;
+    /// Tests the boxes of `node`: the children to visit (bit per child)
+    /// and where the rays enter each.
+    fn enter(&self, node: &N) -> (u32, Self::Entries);
+    /// The order to visit the children of `node` in, nearest first (only
+    /// speed depends on it), given where the rays enter them: asked only
+    /// when two or more are hit.
+    fn order(&self, node: &N, entries: &Self::Entries) -> Self::Order;
 }
 
 /// The kind and packet index of a leaf reference.
@@ -577,6 +687,8 @@ struct SingleRay<Q, const SPHERES: bool> {
     best: u32,
     /// The primitive inside the instance `best`, if it is one.
     sub: u32,
+    /// Whether boxes are tested with AVX2 (see [`Bvh::avx2`]).
+    avx2: bool,
     query: std::marker::PhantomData<Q>,
 }
 
@@ -617,6 +729,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
             closest: interval.max,
             best: 0,
             sub: 0,
+            avx2: bvh.avx2,
             query: std::marker::PhantomData,
         }
     }
@@ -710,8 +823,17 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod single_avx2 {
-    use super::{QuadPacket, Query, SingleRay, SpherePacket, TrianglePacket};
+    use super::{Node8, QuadPacket, Query, SingleRay, SpherePacket, TrianglePacket};
     use crate::lanes::W8;
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn boxes8<Q: Query, const S: bool>(
+        r: &SingleRay<Q, S>,
+        node: &Node8,
+    ) -> (u32, [f32; 8]) {
+        r.boxes8::<W8>(node)
+    }
 
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -752,12 +874,13 @@ fn splat_triangle_ray<R: Real>(r: &TriangleRay<f32>) -> TriangleRay<R> {
     }
 }
 
-impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
-    type Entry = f32;
-
+impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
+    /// The slab test of four boxes, given as their planes: which the ray
+    /// enters before its best hit so far (bit per box, of those in `used`),
+    /// and where.
     #[inline(always)]
-    fn enter(&self, node: &Node) -> (u32, [f32; 4]) {
-        let (p, near, o, inv) = (&node.planes, &self.near, &self.origin, &self.inv);
+    fn boxes(&self, p: &[[Vec4; 2]; 3], used: u32) -> (u32, Vec4) {
+        let (near, o, inv) = (&self.near, &self.origin, &self.inv);
         let tx0 = (p[0][near[0]] - o[0]) * inv[0];
         let tx1 = (p[0][1 - near[0]] - o[0]) * inv[0];
         let ty0 = (p[1][near[1]] - o[1]) * inv[1];
@@ -768,7 +891,40 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
         // lying in a box's plane), so a NaN never culls a box it may hit.
         let t_near = max4(max4(max4(tx0, ty0), tz0), Vec4::splat(self.t_min));
         let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(self.closest)) * SLACK4;
-        let mask = t_near.cmple(t_far).bitmask() & node.used;
+        (t_near.cmple(t_far).bitmask() & used, t_near)
+    }
+}
+
+impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
+    /// The slab test of a node's eight boxes on lanes `R`, as
+    /// [`SingleRay::boxes`] does for four.
+    #[inline(always)]
+    fn boxes8<R: Wide>(&self, node: &Node8) -> (u32, [f32; 8]) {
+        let (p, near) = (&node.planes, &self.near);
+        let slab = |axis: usize, side: usize| {
+            let o = R::splat(self.origin[axis].x);
+            let inv = R::splat(self.inv[axis].x);
+            (R::from_array(p[axis][side]) - o) * inv
+        };
+        let tx0 = slab(0, near[0]);
+        let tx1 = slab(0, 1 - near[0]);
+        let ty0 = slab(1, near[1]);
+        let ty1 = slab(1, 1 - near[1]);
+        let tz0 = slab(2, near[2]);
+        let tz1 = slab(2, 1 - near[2]);
+        let t_near = tx0.max_ps(ty0).max_ps(tz0).max_ps(R::splat(self.t_min));
+        let t_far = tx1.min_ps(ty1).min_ps(tz1).min_ps(R::splat(self.closest)) * R::splat(SLACK);
+        (R::bits(t_near.le(t_far)) & node.used, t_near.to_array())
+    }
+}
+
+impl<Q: Query, const SPHERES: bool> Enter<Node> for SingleRay<Q, SPHERES> {
+    type Entries = [f32; 4];
+    type Order = [f32; 4];
+
+    #[inline(always)]
+    fn enter(&self, node: &Node) -> (u32, [f32; 4]) {
+        let (mask, t_near) = self.boxes(&node.planes, node.used);
         (mask, t_near.to_array())
     }
 
@@ -776,6 +932,31 @@ impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
     fn order(&self, _: &Node, t_near: &[f32; 4]) -> [f32; 4] {
         *t_near
     }
+}
+
+impl<Q: Query, const SPHERES: bool> Enter<Node8> for SingleRay<Q, SPHERES> {
+    type Entries = [f32; 8];
+    type Order = [f32; 8];
+
+    #[inline(always)]
+    fn enter(&self, node: &Node8) -> (u32, [f32; 8]) {
+        // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        if self.avx2 {
+            return unsafe { single_avx2::boxes8(self, node) };
+        }
+        self.boxes8::<F8>(node)
+    }
+
+    #[inline(always)]
+    fn order(&self, _: &Node8, t_near: &[f32; 8]) -> [f32; 8] {
+        *t_near
+    }
+}
+
+impl<Q: Query, const SPHERES: bool> Rays for SingleRay<Q, SPHERES> {
+    type Entry = f32;
 
     #[inline(always)]
     fn needed(&self, t_near: &f32) -> bool {
@@ -838,15 +1019,19 @@ fn finish(t_best: f32, equal: u32, index: &[u32], closest: f32, best: u32) -> Op
     comes_before((t_best, lowest), (closest, best)).then_some((t_best, lowest))
 }
 
-/// The lanes set in `mask` (at least one, of four) ordered by `distance`,
-/// farthest first, and how many there are: a traversal pushes all but the
-/// last and goes on with the last, the nearest.
+/// The lanes set in `mask` (at least one, of a node of type `N`) ordered
+/// by `distance`, farthest first, and how many there are: a traversal
+/// pushes all but the last and goes on with the last, the nearest.
 #[inline(always)]
-pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], usize) {
-    let mut order = [0usize; 4];
+pub(super) fn farthest_first<N: TreeNode, D: Index<usize, Output = f32>>(
+    mut mask: u32,
+    distance: &D,
+) -> (N::Lanes, usize) {
+    let mut lanes = N::Lanes::default();
+    let order = lanes.as_mut();
     let mut n = 0;
     while mask != 0 {
-        let lane = mask.trailing_zeros() as usize & 3;
+        let lane = mask.trailing_zeros() as usize & (N::WIDTH - 1);
         mask &= mask - 1;
         // Insertion sort, descending distance.
         let mut i = n;
@@ -857,7 +1042,7 @@ pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], 
         order[i] = lane;
         n += 1;
     }
-    (order, n)
+    (lanes, n)
 }
 
 /// Box tests keep a box whose entry is up to this factor beyond the far end
@@ -871,9 +1056,9 @@ pub(super) fn farthest_first(mut mask: u32, distance: [f32; 4]) -> ([usize; 4], 
 pub(crate) const SLACK: f32 = 1.0 + 1.0 / 4096.0;
 const SLACK4: Vec4 = Vec4::splat(SLACK);
 
-/// The two to four binary nodes that become a wide node's children (in
+/// The two to eight binary nodes that become a wide node's children (in
 /// place: a vector each cost an allocation a node).
-struct Opened([usize; 4], usize);
+struct Opened([usize; 8], usize);
 
 impl std::ops::Deref for Opened {
     type Target = [usize];
@@ -883,7 +1068,7 @@ impl std::ops::Deref for Opened {
     }
 }
 
-/// Turns the binary tree into 4-wide nodes and packets.
+/// Turns the binary tree into wide nodes and packets.
 struct Collapse<'a, P: ?Sized> {
     binary: &'a [BinaryNode],
     order: &'a [u32],
@@ -891,13 +1076,14 @@ struct Collapse<'a, P: ?Sized> {
 }
 
 impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
-    /// The up to four binary nodes that become the children of the wide node
-    /// replacing interior node `i`: its two children, then repeatedly the
-    /// interior one of largest surface area replaced by its own two children.
-    fn open(&self, i: usize) -> Opened {
+    /// The up to `width` binary nodes that become the children of the wide
+    /// node replacing interior node `i`: its two children, then repeatedly
+    /// the interior one of largest surface area replaced by its own two
+    /// children.
+    fn open(&self, i: usize, width: usize) -> Opened {
         let b = self.binary;
-        let mut list = Opened([i + 1, b[i].offset as usize, 0, 0], 2);
-        while list.len() < 4 {
+        let mut list = Opened([i + 1, b[i].offset as usize, 0, 0, 0, 0, 0, 0], 2);
+        while list.len() < width {
             let widest = list
                 .iter()
                 .enumerate()
@@ -916,22 +1102,37 @@ impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
         list
     }
 
-    /// The number of wide nodes [`Collapse::emit_node`] emits for
-    /// `children`.
-    fn count_nodes(&self, children: &[usize]) -> usize {
+    /// The number of wide nodes of `width` children that
+    /// [`Collapse::emit_node`] emits for `children`.
+    fn count_nodes(&self, children: &[usize], width: usize) -> usize {
         1 + children
             .iter()
             .filter(|&&c| !self.binary[c].is_leaf())
-            .map(|&c| self.count_nodes(&self.open(c)))
+            .map(|&c| self.count_nodes(&self.open(c, width), width))
             .sum::<usize>()
+    }
+
+    /// The nodes of type `N` of the tree whose root's children are the
+    /// binary nodes `roots` (see [`Collapse::emit_node`]).
+    fn emit_tree<N: TreeNode>(&self, roots: &[usize], leaves: &mut [Vec<u32>; 4]) -> Vec<N> {
+        // Reserved at its size: an estimate took twice the nodes' memory
+        // when it was shrunk (a copy).
+        let mut nodes = Vec::with_capacity(self.count_nodes(roots, N::WIDTH));
+        self.emit_node(roots, &mut nodes, leaves);
+        nodes
     }
 
     /// Emits the wide node whose children are the binary nodes `children`.
     /// A leaf child is given the next packet of its kind, made afterwards
     /// ([`Collapse::fill_packets`]): `leaves[kind]` gets its binary node.
-    fn emit_node(&self, children: &[usize], bvh: &mut Bvh, leaves: &mut [Vec<u32>; 4]) -> u32 {
-        let index = bvh.nodes.len();
-        bvh.nodes.push(Node::EMPTY);
+    fn emit_node<N: TreeNode>(
+        &self,
+        children: &[usize],
+        nodes: &mut Vec<N>,
+        leaves: &mut [Vec<u32>; 4],
+    ) -> u32 {
+        let index = nodes.len();
+        nodes.push(N::EMPTY);
         for (lane, &c) in children.iter().enumerate() {
             let node = &self.binary[c];
             let child = if node.is_leaf() {
@@ -944,10 +1145,10 @@ impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
                 debug_assert!(packet <= INDEX_MASK as usize);
                 LEAF_BIT | (kind as u32) << KIND_SHIFT | packet as u32
             } else {
-                let grandchildren = self.open(c);
-                self.emit_node(&grandchildren, bvh, leaves)
+                let grandchildren = self.open(c, N::WIDTH);
+                self.emit_node(&grandchildren, nodes, leaves)
             };
-            bvh.nodes[index].set_child(lane, &node.bounds(), child);
+            nodes[index].set_child(lane, &node.bounds(), child);
         }
         index as u32
     }
@@ -1254,6 +1455,46 @@ mod tests {
     }
 
     #[test]
+    fn eight_wide_trees_give_the_same_hits_with_and_without_avx2() {
+        let mut rng = Rng::new(21);
+        let prims = random_mixed(&mut rng, 3000, 20.0);
+        let bvh = Bvh::new(&prims);
+        assert!(
+            bvh.nodes.is_empty() && bvh.wide.len() > 50,
+            "an eight-wide tree"
+        );
+        let mut portable = bvh.clone();
+        portable.avx2 = false;
+        if !bvh.avx2 {
+            eprintln!("this processor has no AVX2: only the portable box tests ran");
+        }
+        let key = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.index, h.sub));
+        let mut hits = 0;
+        for k in 0..20_000 {
+            let origin = point(&mut rng, 30.0);
+            let direction = if k % 2 == 0 {
+                crate::sampling::unit_vector(rng.next_2d())
+            } else {
+                (point(&mut rng, 10.0) - origin).normalize()
+            };
+            let ray = Ray::new(origin, direction);
+            let interval = Interval::new(0.001, rng.range_f32(5.0, 80.0));
+            let hit = bvh.hit(&ray, interval);
+            assert_eq!(key(hit), key(portable.hit(&ray, interval)));
+            assert_eq!(
+                key(bvh.any_hit(&ray, interval)),
+                key(portable.any_hit(&ray, interval))
+            );
+            if k % 16 == 0 {
+                let expected = brute_force(&prims, &ray, interval);
+                assert_eq!(hit.map(|h| (h.t, h.index)), expected);
+            }
+            hits += usize::from(hit.is_some());
+        }
+        assert!(hits > 5_000, "only {hits} hits");
+    }
+
+    #[test]
     fn deep_trees_do_not_overflow_the_stack() {
         // Radii growing geometrically make SAH peel one sphere at a time.
         let prims: Vec<Primitive> = (0..3000)
@@ -1266,6 +1507,25 @@ mod tests {
             .collect();
         let mut rng = Rng::new(9);
         check_against_brute_force(&prims, &mut rng, 200);
+    }
+
+    #[test]
+    fn deep_eight_wide_trees_do_not_overflow_the_stack() {
+        // Triangles growing geometrically around one point: SAH peels one
+        // at a time, and the tree is as deep as the build allows.
+        let prims: Vec<Primitive> = (0..3000)
+            .map(|i| {
+                let s = 1.002f32.powi(i);
+                let c = Vec3::new(i as f32 * 0.001, 0.0, 0.0);
+                Primitive::Triangle(Triangle::new(
+                    c + Vec3::new(-s, -s, 0.0),
+                    c + Vec3::new(s, -s, 0.1 * s),
+                    c + Vec3::new(0.0, s, -0.1 * s),
+                ))
+            })
+            .collect();
+        let mut rng = Rng::new(10);
+        assert!(check_against_brute_force(&prims, &mut rng, 200) > 50);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! Built top-down with the surface area heuristic (SAH) over binned centroids,
 //! into an array in depth-first order: the left child of node `i` is node
 //! `i + 1`, and each interior node stores the index of its right child.
-//! [`super::bvh::Bvh`] then collapses this binary tree into its 4-wide form.
+//! [`super::bvh::Bvh`] then collapses this binary tree into its wide form.
 
 use crate::geometry::primitive::{Kind, PrimitiveSet};
 use crate::math::{Point3, Vec3};

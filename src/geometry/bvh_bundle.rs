@@ -28,8 +28,8 @@
 //! bundle.
 
 use super::bvh::{
-    comes_before, leaf_parts, Bvh, Hit, InstancePacket, Node, QuadPacket, Rays, SpherePacket,
-    TrianglePacket, NO_CHILD, SLACK,
+    comes_before, leaf_parts, Bvh, Enter, Hit, InstancePacket, Node, Node8, QuadPacket, Rays,
+    SpherePacket, TrianglePacket, NO_CHILD, SLACK,
 };
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
@@ -163,11 +163,15 @@ impl Bvh {
         // the other kinds' tests.
         let (closest, best, sub) = if self.spheres_only() {
             let mut query = BundleRays::<true>::new(self, rays, reference, interval);
-            self.traverse(&mut query);
+            self.traverse(self.nodes(), &mut query);
             (query.closest, query.best, query.sub)
         } else {
             let mut query = BundleRays::<false>::new(self, rays, reference, interval);
-            self.traverse(&mut query);
+            if self.wide_nodes().is_empty() {
+                self.traverse(self.nodes(), &mut query);
+            } else {
+                self.traverse(self.wide_nodes(), &mut query);
+            }
             (query.closest, query.best, query.sub)
         };
         let mut hits = [None; LANES];
@@ -446,20 +450,17 @@ mod bundle_avx2 {
     }
 }
 
-impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
-    /// Per lane, where the ray enters the box (NaN for lanes that miss it,
-    /// which no comparison accepts).
-    type Entry = Lanes;
-
+impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
+    /// The slab tests of every ray against the `W` boxes of `planes` (those
+    /// set in `used`): the boxes some ray enters before its best hit so far
+    /// (bit per box), and per box where each ray enters it.
     #[inline(always)]
-    fn enter(&self, node: &Node) -> (u32, [Lanes; 4]) {
+    fn boxes<const W: usize>(&self, bounds: &[[[f32; W]; 2]; 3], used: u32) -> (u32, [Lanes; W]) {
         let rays = self.rays;
-        // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
-        let bounds = node.planes.map(|pair| pair.map(|v| v.to_array()));
-        let mut t_near = [[f32::NAN; LANES]; 4];
+        let mut t_near = [[f32::NAN; LANES]; W];
         let mut hit_mask = 0u32;
-        for child in 0..4 {
-            if node.used & (1 << child) == 0 {
+        for child in 0..W {
+            if used & (1 << child) == 0 {
                 continue;
             }
             let mut any = false;
@@ -492,16 +493,68 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
         (hit_mask, t_near)
     }
 
-    /// Where the reference ray meets the boxes.
+    /// Where the reference ray meets four boxes, given as their planes.
     #[inline(always)]
-    fn order(&self, node: &Node, _: &[Lanes; 4]) -> [f32; 4] {
-        let (p, near) = (&node.planes, &self.ref_near);
+    fn reference_entries(&self, p: &[[Vec4; 2]; 3]) -> Vec4 {
+        let near = &self.ref_near;
         let (o, inv) = (&self.ref_origin, &self.ref_inv);
         let rx = (p[0][near[0]] - o[0]) * inv[0];
         let ry = (p[1][near[1]] - o[1]) * inv[1];
         let rz = (p[2][near[2]] - o[2]) * inv[2];
-        rx.max(ry).max(rz).max(Vec4::splat(self.t_min)).to_array()
+        rx.max(ry).max(rz).max(Vec4::splat(self.t_min))
     }
+}
+
+impl<const SPHERES: bool> Enter<Node> for BundleRays<'_, SPHERES> {
+    type Entries = [Lanes; 4];
+    type Order = [f32; 4];
+
+    #[inline(always)]
+    fn enter(&self, node: &Node) -> (u32, [Lanes; 4]) {
+        // As arrays: indexing a `Vec4` by a variable lane compiles to a jump.
+        self.boxes(
+            &node.planes.map(|pair| pair.map(|v| v.to_array())),
+            node.used,
+        )
+    }
+
+    /// Where the reference ray meets the boxes.
+    #[inline(always)]
+    fn order(&self, node: &Node, _: &[Lanes; 4]) -> [f32; 4] {
+        self.reference_entries(&node.planes).to_array()
+    }
+}
+
+impl<const SPHERES: bool> Enter<Node8> for BundleRays<'_, SPHERES> {
+    type Entries = [Lanes; 8];
+    type Order = [f32; 8];
+
+    #[inline(always)]
+    fn enter(&self, node: &Node8) -> (u32, [Lanes; 8]) {
+        self.boxes(&node.planes, node.used)
+    }
+
+    /// Where the reference ray meets the boxes, four at a time.
+    #[inline(always)]
+    fn order(&self, node: &Node8, _: &[Lanes; 8]) -> [f32; 8] {
+        let half = |h: usize| {
+            self.reference_entries(
+                &node
+                    .planes
+                    .map(|pair| pair.map(|lanes| Vec4::from_slice(&lanes[4 * h..4 * h + 4]))),
+            )
+        };
+        let mut order = [0.0; 8];
+        half(0).write_to_slice(&mut order[..4]);
+        half(1).write_to_slice(&mut order[4..]);
+        order
+    }
+}
+
+impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
+    /// Per lane, where the ray enters the box (NaN for lanes that miss it,
+    /// which no comparison accepts).
+    type Entry = Lanes;
 
     #[inline(always)]
     fn needed(&self, t_near: &Lanes) -> bool {
