@@ -188,6 +188,45 @@ fn an_instanced_scene_exports_no_flat_shapes() {
     }));
 }
 
+#[test]
+fn the_bench_command_traces_a_workloads_rays_and_names_what_it_compared() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lumen"))
+        .args(["bench", "--traversal", "--spp", "1", "--runs", "1"])
+        .args(["--workload", "three-spheres-400x225"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("three-spheres-400x225"))
+        .unwrap_or_else(|| panic!("no row in {text}"));
+    let fields: Vec<f64> = row
+        .split_whitespace()
+        .skip(1)
+        .map(|f| f.trim_end_matches('%').parse().unwrap())
+        .collect();
+    // 400 × 225 camera rays at 1 spp and their bounces; a rate above zero.
+    assert!(
+        fields[0] > 90_000.0 && fields[1] > 20.0 && fields[1] < 100.0,
+        "{row}"
+    );
+    assert!(fields[2] > 0.0, "{row}");
+    if cfg!(feature = "embree") {
+        assert!(text.contains("embree-avx2"), "{text}");
+    } else {
+        assert!(text.contains("Embree is not in this build"), "{text}");
+    }
+    // An unknown workload is refused with the names of those there are.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lumen"))
+        .args(["bench", "--traversal", "--workload", "bunny"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("bunny-235k-400x400"), "{err}");
+}
+
 #[cfg(feature = "embree")]
 mod embree {
     use super::*;

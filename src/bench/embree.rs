@@ -71,42 +71,41 @@ impl EmbreeScene {
             first_item.push(next);
             next += shapes.spheres.len() as u32;
         }
-        if !shapes.quads.is_empty() {
-            let n = shapes.quads.len();
+        for (kind, polygons) in [
+            (GeometryKind::QUAD, Polygons::Quads(&shapes.quads)),
+            (
+                GeometryKind::TRIANGLE,
+                Polygons::Triangles(&shapes.triangles),
+            ),
+        ] {
+            if polygons.len() == 0 {
+                continue;
+            }
             let mut g = device
-                .create_geometry(GeometryKind::QUAD)
-                .map_err(|e| fail("quads", e))?;
-            let corners: Vec<[f32; 3]> = shapes.quads.iter().flatten().copied().collect();
-            g.set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, 4 * n)
-                .map_err(|e| fail("quad vertices", e))?
-                .copy_from_slice(&corners);
-            let index: Vec<[u32; 4]> = (0..n as u32)
-                .map(|i| [4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3])
-                .collect();
-            g.set_new_buffer::<[u32; 4]>(BufferUsage::INDEX, 0, Format::UINT4, 16, n)
-                .map_err(|e| fail("quad index", e))?
+                .create_geometry(kind)
+                .map_err(|e| fail("geometry", e))?;
+            let (vertices, index) = polygons.buffers();
+            let corners = polygons.corners();
+            g.set_new_buffer::<[f32; 3]>(
+                BufferUsage::VERTEX,
+                0,
+                Format::FLOAT3,
+                12,
+                vertices.len(),
+            )
+            .map_err(|e| fail("vertices", e))?
+            .copy_from_slice(&vertices);
+            let format = if corners == 4 {
+                Format::UINT4
+            } else {
+                Format::UINT3
+            };
+            g.set_new_buffer::<u32>(BufferUsage::INDEX, 0, format, 4 * corners, polygons.len())
+                .map_err(|e| fail("index", e))?
                 .copy_from_slice(&index);
             scene.attach_geometry(&g.commit());
             first_item.push(next);
-            next += n as u32;
-        }
-        if !shapes.triangles.is_empty() {
-            let n = shapes.triangles.len();
-            let mut g = device
-                .create_geometry(GeometryKind::TRIANGLE)
-                .map_err(|e| fail("triangles", e))?;
-            let vertices: Vec<[f32; 3]> = shapes.triangles.iter().flatten().copied().collect();
-            g.set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, 3 * n)
-                .map_err(|e| fail("triangle vertices", e))?
-                .copy_from_slice(&vertices);
-            let index: Vec<[u32; 3]> = (0..n as u32)
-                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-                .collect();
-            g.set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, n)
-                .map_err(|e| fail("triangle index", e))?
-                .copy_from_slice(&index);
-            scene.attach_geometry(&g.commit());
-            first_item.push(next);
+            next += polygons.len() as u32;
         }
         scene.commit();
         Ok(EmbreeScene {
@@ -139,5 +138,38 @@ impl EmbreeScene {
             }));
         }
         (found, start.elapsed())
+    }
+}
+
+/// Quads or triangles, as the scene places them.
+enum Polygons<'a> {
+    Quads(&'a [[[f32; 3]; 4]]),
+    Triangles(&'a [[[f32; 3]; 3]]),
+}
+
+impl Polygons<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Polygons::Quads(q) => q.len(),
+            Polygons::Triangles(t) => t.len(),
+        }
+    }
+
+    fn corners(&self) -> usize {
+        match self {
+            Polygons::Quads(_) => 4,
+            Polygons::Triangles(_) => 3,
+        }
+    }
+
+    /// Every polygon's corners, one after another, and the index buffer
+    /// naming them in order.
+    fn buffers(&self) -> (Vec<[f32; 3]>, Vec<u32>) {
+        let vertices: Vec<[f32; 3]> = match self {
+            Polygons::Quads(q) => q.iter().flatten().copied().collect(),
+            Polygons::Triangles(t) => t.iter().flatten().copied().collect(),
+        };
+        let index = (0..vertices.len() as u32).collect();
+        (vertices, index)
     }
 }

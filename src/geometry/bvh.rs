@@ -33,7 +33,7 @@ use crate::math::Interval;
 use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
 use std::mem::MaybeUninit;
-use std::ops::Index;
+use std::ops::{Index, IndexMut};
 
 /// Children of a node referring to a leaf have this bit set.
 pub(super) const LEAF_BIT: u32 = 1 << 31;
@@ -50,49 +50,45 @@ pub(super) const NO_CHILD: u32 = u32::MAX;
 /// `MAX_SAH_DEPTH + 32` = 80 levels deep (see `bvh_build`).
 pub(super) const STACK_SIZE: usize = 7 * 80;
 
-/// Four children's boxes, structure of arrays, and their references.
+/// The boxes of a node's `W` children, structure of arrays (the lower x
+/// planes of all children in one `P`, and so on), and their references.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node {
-    /// `planes[axis][0]`: the four lower bounds along `axis`; `[1]`: the upper.
-    pub(super) planes: [[Vec4; 2]; 3],
+pub(super) struct WideNode<P, const W: usize> {
+    /// `planes[axis][0]`: the lower bounds along `axis`; `[1]`: the upper.
+    pub(super) planes: [[P; 2]; 3],
     /// Node index, `LEAF_BIT | kind | packet index`, or `NO_CHILD`.
-    pub(super) children: [u32; 4],
+    pub(super) children: [u32; W],
     /// Bit `lane` is set when `children[lane]` is used.
     pub(super) used: u32,
 }
 
-impl Node {
-    const EMPTY: Node = Node {
-        planes: [[Vec4::INFINITY, Vec4::NEG_INFINITY]; 3],
-        children: [NO_CHILD; 4],
-        used: 0,
-    };
+/// Four children: the node of trees of spheres only, which bundles of rays
+/// walk together.
+pub(super) type Node = WideNode<Vec4, 4>;
 
-    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32) {
-        for axis in 0..3 {
-            self.planes[axis][0][lane] = bounds.min[axis];
-            self.planes[axis][1][lane] = bounds.max[axis];
-        }
-        self.children[lane] = child;
-        self.used |= 1 << lane;
-    }
+/// Eight children: the node of trees that hold other shapes than spheres
+/// (see [`Bvh::over`]). One ray meets a mesh's tree half as many levels
+/// deep as with four children, and the tree is larger than the caches: each
+/// level is a wait for memory.
+pub(super) type Node8 = WideNode<Lane8, 8>;
+
+/// The lanes of a node's planes.
+pub(super) trait Planes: IndexMut<usize, Output = f32> + Copy {
+    /// +∞ in every lane: the lower plane of no box.
+    const NONE_LOW: Self;
+    /// −∞ in every lane: the upper plane of no box.
+    const NONE_HIGH: Self;
 }
 
-/// Eight children's boxes, structure of arrays, and their references: the
-/// node of trees that hold other shapes than spheres (see [`Bvh::over`]).
-/// One ray meets a mesh's tree half as many levels deep as with four
-/// children, and the tree is larger than the caches: each level is a wait
-/// for memory.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-pub(super) struct Node8 {
-    /// `planes[axis][0]`: the eight lower bounds along `axis`; `[1]`: the upper.
-    pub(super) planes: [[Lane8; 2]; 3],
-    /// Node index, `LEAF_BIT | kind | packet index`, or `NO_CHILD`.
-    pub(super) children: [u32; 8],
-    /// Bit `lane` is set when `children[lane]` is used.
-    pub(super) used: u32,
+impl Planes for Vec4 {
+    const NONE_LOW: Vec4 = Vec4::INFINITY;
+    const NONE_HIGH: Vec4 = Vec4::NEG_INFINITY;
+}
+
+impl Planes for Lane8 {
+    const NONE_LOW: Lane8 = [f32::INFINITY; 8];
+    const NONE_HIGH: Lane8 = [f32::NEG_INFINITY; 8];
 }
 
 /// What the traversal and the collapse ask of a node, of four children or
@@ -110,27 +106,15 @@ pub(super) trait TreeNode: Copy {
     fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32);
 }
 
-impl TreeNode for Node {
-    const WIDTH: usize = 4;
-    type Lanes = [usize; 4];
-    const EMPTY: Node = Node::EMPTY;
-
-    #[inline(always)]
-    fn child(&self, lane: usize) -> u32 {
-        self.children[lane]
-    }
-
-    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32) {
-        Node::set_child(self, lane, bounds, child);
-    }
-}
-
-impl TreeNode for Node8 {
-    const WIDTH: usize = 8;
-    type Lanes = [usize; 8];
-    const EMPTY: Node8 = Node8 {
-        planes: [[[f32::INFINITY; 8], [f32::NEG_INFINITY; 8]]; 3],
-        children: [NO_CHILD; 8],
+impl<P: Planes, const W: usize> TreeNode for WideNode<P, W>
+where
+    [usize; W]: Default,
+{
+    const WIDTH: usize = W;
+    type Lanes = [usize; W];
+    const EMPTY: Self = WideNode {
+        planes: [[P::NONE_LOW, P::NONE_HIGH]; 3],
+        children: [NO_CHILD; W],
         used: 0,
     };
 
