@@ -69,7 +69,7 @@ impl Triangle {
     }
 
     /// The distance along `ray` (unit or not) to the triangle's plane,
-    /// worked out in `f64` (see [`plane_distance`]); `None` when the ray
+    /// worked out in `f64` (see `plane_distance`); `None` when the ray
     /// runs along the plane.
     pub fn plane_distance(&self, ray: &Ray) -> Option<f32> {
         let t = plane_distance(
