@@ -324,11 +324,25 @@ mod tests {
             let scene = Scene::from_desc(&desc).expect("the cover compiles");
             same_bits_on_every_instruction_set(&scene);
         }
+        // A mesh: eight-wide nodes and triangle packets.
+        let mut desc = crate::bench::bunny_scene(crate::bench::BUNNY_235K);
+        desc.render.width = 32;
+        desc.render.height = Some(32);
+        desc.render.samples_per_pixel = 37;
+        let scene = Scene::from_desc(&desc).expect("the bunny compiles");
+        same_bits_on_every_instruction_set(&scene);
     }
 
     fn same_bits_on_every_instruction_set(scene: &Scene) {
         let width = scene.settings.width;
         let isa = Isa::detect();
+        // Which versions were compared (`cargo test -- --nocapture`): on a
+        // processor without AVX2 only the baseline runs.
+        eprintln!(
+            "render rows compared: {} and {}",
+            Isa::Baseline.name(),
+            isa.name()
+        );
         for y in 0..scene.settings.height {
             let render_with = |isa| {
                 let mut film = Film::with_halves(width, 1);
