@@ -88,3 +88,15 @@ fn a_benchmark_field_past_the_memory_is_refused_before_it_is_made() {
     let out = lumen_limited(&dir, 1_500_000, "bench --field 10000000 --runs 1");
     assert_refused_for_memory(&out, &dir, "a field of 10000000 spheres");
 }
+
+#[test]
+fn recorded_rays_past_the_memory_are_refused_before_they_are_taken() {
+    // The cover at 64 spp records the most rays lumen keeps (512 MiB).
+    let dir = temp_dir("limits-traversal");
+    let out = lumen_limited(
+        &dir,
+        600_000,
+        "bench --traversal --workload cover-400x225 --spp 64 --runs 1",
+    );
+    assert_refused_for_memory(&out, &dir, "recording the rays");
+}

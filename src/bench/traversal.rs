@@ -12,6 +12,7 @@
 use crate::geometry::bvh::Hit;
 use crate::isa::Isa;
 use crate::math::Interval;
+use crate::memory::{self, MemoryError};
 use crate::ray::Ray;
 use crate::render::camera_sample;
 use crate::sampler::{PixelSampler, Sampler};
@@ -32,35 +33,52 @@ pub const MAX_RECORDED: usize = 1 << 24;
 
 /// The camera and bounce rays of `scene`'s paths at `spp` samples per pixel
 /// (the scene's own sampler, seed and depth), pixel after pixel, each path
-/// followed to its end: what a render traces, less the shadow rays. Stops
-/// after the pixel in which the count passes `limit` (at most
-/// [`MAX_RECORDED`]).
-pub fn record_rays(scene: &Scene, spp: u32, limit: usize) -> RecordedRays {
+/// followed to its end: what a render traces, less the shadow rays; the
+/// first `limit` of them (at most [`MAX_RECORDED`]). Their memory is
+/// counted and taken before the first is recorded.
+pub fn record_rays(scene: &Scene, spp: u32, limit: usize) -> Result<RecordedRays, MemoryError> {
     let s = &scene.settings;
-    let limit = limit.min(MAX_RECORDED);
-    let mut recorded = RecordedRays::default();
+    let most = u64::from(s.width)
+        .saturating_mul(u64::from(s.height))
+        .saturating_mul(u64::from(spp))
+        .saturating_mul(u64::from(s.max_depth.max(1)));
+    let limit = most.min(limit.min(MAX_RECORDED) as u64) as usize;
+    let mut recorded = RecordedRays {
+        rays: memory::vec_for(limit as u64, "recording the rays")?,
+        camera: 0,
+    };
     for y in 0..s.height {
         for x in 0..s.width {
-            if recorded.rays.len() >= limit {
-                return recorded;
-            }
             let pixel = u64::from(y) * u64::from(s.width) + u64::from(x);
             let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, spp);
             for index in 0..spp {
+                if recorded.rays.len() == limit {
+                    return Ok(recorded);
+                }
                 let (ray, mut sampler) = camera_sample(scene, x, y, &pixel_sampler, index);
                 recorded.camera += 1;
-                follow_path(scene, ray, &mut sampler, &mut recorded.rays);
+                follow_path(scene, ray, &mut sampler, &mut recorded.rays, limit);
             }
         }
     }
-    recorded
+    Ok(recorded)
 }
 
 /// Follows one path from its camera ray, as the path integrator does but
-/// without sampling lights, pushing each segment's ray.
-fn follow_path(scene: &Scene, mut ray: Ray, sampler: &mut impl Sampler, rays: &mut Vec<Ray>) {
+/// without sampling lights, pushing each segment's ray while `rays` holds
+/// fewer than `limit`.
+fn follow_path(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut impl Sampler,
+    rays: &mut Vec<Ray>,
+    limit: usize,
+) {
     let mut from: Option<Hit> = None;
     for depth in 0..scene.settings.max_depth {
+        if rays.len() == limit {
+            return;
+        }
         rays.push(ray);
         let Some(hit) = scene.intersect_leaving(&ray, from.as_ref(), f32::INFINITY) else {
             return;

@@ -290,8 +290,16 @@ pub(crate) fn traversal_command(spp: u32, runs: u32, only: Option<&str>) -> Resu
     for w in workloads {
         let scene =
             lumen::scene::Scene::from_desc(&w.desc).map_err(|e| anyhow!("{}: {e}", w.name))?;
-        let recorded = record_rays(&scene, spp, MAX_RECORDED);
+        let recorded =
+            record_rays(&scene, spp, MAX_RECORDED).map_err(|e| anyhow!("{}: {e}", w.name))?;
         let rays = &recorded.rays;
+        // Each tracer's hits, lumen's kept for the comparison.
+        let found_bytes = std::mem::size_of::<bench::traversal::Found>() as u64;
+        lumen::memory::check(
+            rays.len() as u64 * found_bytes * (2 + peers.len() as u64),
+            "keeping the rays' hits",
+        )
+        .map_err(|e| anyhow!("{}: {e}", w.name))?;
         let tracers: Vec<_> = peers
             .iter()
             .map(|(name, make)| make(&scene).map_err(|e| anyhow!("{}: {name}: {e}", w.name)))
