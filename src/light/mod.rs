@@ -312,26 +312,24 @@ impl Lights {
             });
         };
         let surface = &self.surfaces[i];
-        let (target, outward, st) = match light.shape {
-            Shape::Sphere { center, radius } if !inside(center, radius, point) => {
-                let (target, outward) = sample_cap(center, radius, point, uv);
+        let seen = surface.seen_from(&light.shape, point);
+        let (target, outward, st) = match (&seen, light.shape) {
+            (Seen::Cap { center, radius }, _) => {
+                let (target, outward) = sample_cap(*center, *radius, point, uv);
                 (target, outward, uv)
             }
-            Shape::Quad { corner, u, v } => match surface.seen_from(&light.shape, point) {
-                Some(rectangle) => {
-                    let target = rectangle.sample(uv);
-                    let d = target - corner;
-                    let st = [d.dot(u) / u.length_squared(), d.dot(v) / v.length_squared()];
-                    (target, surface.normal, st)
-                }
-                None => sample_area(&light.shape, surface.normal, uv),
-            },
-            shape => sample_area(&shape, surface.normal, uv),
+            (Seen::Rectangle(rectangle), Shape::Quad { corner, u, v }) => {
+                let target = rectangle.sample(uv);
+                let d = target - corner;
+                let st = [d.dot(u) / u.length_squared(), d.dot(v) / v.length_squared()];
+                (target, surface.normal, st)
+            }
+            (_, shape) => sample_area(&shape, surface.normal, uv),
         };
         let to = target - point;
         let distance = to.length();
         let direction = to / distance;
-        let pdf = chance * solid_angle_density(&light.shape, surface, point, target, outward);
+        let pdf = chance * seen.density(surface, point, target, outward);
         if !(pdf > 0.0 && pdf.is_finite() && distance > 0.0 && distance.is_finite()) {
             return None;
         }
@@ -358,7 +356,11 @@ impl Lights {
         if chance == 0.0 {
             return 0.0;
         }
-        chance * solid_angle_density(&light.shape, &self.surfaces[i], from, point, outward)
+        let surface = &self.surfaces[i];
+        chance
+            * surface
+                .seen_from(&light.shape, from)
+                .density(surface, from, point, outward)
     }
 
     /// The density per unit solid angle with which [`Lights::sample`] picks
@@ -379,30 +381,33 @@ fn inside(center: Point3, radius: f32, point: Point3) -> bool {
     (center - point).length_squared() <= radius * radius
 }
 
-/// The density per unit solid angle, seen from `from`, of the point `point`
-/// (outward normal `outward`) of a light of `shape` as the sampling chooses
-/// it: uniform over the cone of a sphere seen from outside, else uniform
-/// over the area, whose density 1/A becomes d² / (|cos θ| A) per unit
-/// solid angle.
-#[inline]
-fn solid_angle_density(
-    shape: &Shape,
-    surface: &Surface,
-    from: Point3,
-    point: Point3,
-    outward: Vec3,
-) -> f32 {
-    match *shape {
-        Shape::Sphere { center, radius } if !inside(center, radius, from) => {
-            1.0 / cap_solid_angle(radius * radius / (center - from).length_squared())
-        }
-        _ => {
-            if let Some(rectangle) = surface.seen_from(shape, from) {
-                return (1.0 / rectangle.solid_angle()) as f32;
+/// How a light is sampled from a point: what [`Lights::sample`] draws and
+/// [`Lights::pdf`] gives the density of, decided once for both.
+enum Seen {
+    /// A sphere seen from outside: uniform over the cone it fills.
+    Cap { center: Point3, radius: f32 },
+    /// A rectangle seen close up: uniform over its solid angle.
+    Rectangle(SphericalRectangle),
+    /// Anything else: uniform over its area.
+    Area,
+}
+
+impl Seen {
+    /// The density per unit solid angle, seen from `from`, of the point
+    /// `point` (outward normal `outward`) of the light whose surface is
+    /// `surface`: over the area, 1/A becomes d² / (|cos θ| A).
+    #[inline]
+    fn density(&self, surface: &Surface, from: Point3, point: Point3, outward: Vec3) -> f32 {
+        match *self {
+            Seen::Cap { center, radius } => {
+                1.0 / cap_solid_angle(radius * radius / (center - from).length_squared())
             }
-            let to = point - from;
-            let d2 = to.length_squared();
-            d2 * d2.sqrt() / (outward.dot(to).abs() * surface.area)
+            Seen::Rectangle(ref rectangle) => (1.0 / rectangle.solid_angle()) as f32,
+            Seen::Area => {
+                let to = point - from;
+                let d2 = to.length_squared();
+                d2 * d2.sqrt() / (outward.dot(to).abs() * surface.area)
+            }
         }
     }
 }
@@ -453,22 +458,24 @@ impl Surface {
         }
     }
 
-    /// `shape` (the shape of this surface) seen from `from`, when it is
-    /// sampled by solid angle from there.
+    /// How `shape` (the shape of this surface) is sampled from `from`.
     #[inline]
-    fn seen_from(&self, shape: &Shape, from: Point3) -> Option<SphericalRectangle> {
+    fn seen_from(&self, shape: &Shape, from: Point3) -> Seen {
         match *shape {
+            Shape::Sphere { center, radius } if !inside(center, radius, from) => {
+                Seen::Cap { center, radius }
+            }
             Shape::Quad { corner, u, v } if self.rectangle => {
                 // Worth its cost only close up, where sampling the area
                 // would vary as the inverse square of the distance over
-                // the cosine: within a few times its size of its centre.
+                // the cosine: within its own size of its centre.
                 let to = corner + 0.5 * (u + v) - from;
                 if !(to.length_squared() < SPHERICAL_WITHIN * self.area) {
-                    return None;
+                    return Seen::Area;
                 }
-                SphericalRectangle::new(corner, u, v, from)
+                SphericalRectangle::new(corner, u, v, from).map_or(Seen::Area, Seen::Rectangle)
             }
-            _ => None,
+            _ => Seen::Area,
         }
     }
 }
