@@ -3,28 +3,17 @@
 //! intersector in f64 finds over the exported shapes; and, in a build with
 //! the `embree` feature, the hits Embree finds.
 
+mod common;
+
+use common::d3::{cross, dot, sub, D3};
 use lumen::bench::traversal::{record_rays, trace_lumen, Agreement, Found};
 use lumen::bench::{bunny_scene, standard_workloads, BUNNY_235K};
 use lumen::ray::Ray;
 use lumen::scene::{PlacedShapes, Scene};
 
-type V = [f64; 3];
-
-fn v(a: [f32; 3]) -> V {
+/// A stored coordinate triple in f64.
+fn v(a: [f32; 3]) -> D3 {
     a.map(f64::from)
-}
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V, b: V) -> V {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// The nearest hit from distance 0 of `ray` over every shape, tested one
@@ -59,7 +48,7 @@ fn brute_force(shapes: &PlacedShapes, ray: &Ray) -> Found {
     }
     // A planar polygon: the plane's distance, then the point's
     // coordinates (α, β) along the edges from `corner`.
-    let mut polygon = |corner: V, e1: V, e2: V, item: usize, quad: bool| {
+    let mut polygon = |corner: D3, e1: D3, e2: D3, item: usize, quad: bool| {
         let n = cross(e1, e2);
         let denom = dot(n, d);
         if denom == 0.0 {

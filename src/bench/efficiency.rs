@@ -117,9 +117,8 @@ pub fn measure(
         films.push(render(&scene, &|_| {}).0);
         times.extend(time_renders(&scene, runs).0);
     }
-    times.sort();
     Ok(Efficiency {
-        seconds: times[times.len() / 2].as_secs_f64(),
+        seconds: super::median(&times).as_secs_f64(),
         variance: variance_between(&films[0], &films[1]),
     })
 }

@@ -228,14 +228,20 @@ pub fn measure(workload: &Workload, runs: usize) -> Result<Measurement, SceneErr
 pub fn measure_scene(name: &'static str, scene: &Scene, runs: usize) -> Measurement {
     let _ = render(scene, &|_| {});
     let (times, stats) = time_renders(scene, runs);
-    let mut sorted = times.clone();
-    sorted.sort();
     Measurement {
         name,
         stats,
-        median: sorted[sorted.len() / 2],
+        median: median(&times),
         runs: times,
     }
+}
+
+/// The median of `times` (the upper one of an even count), which must not
+/// be empty.
+pub fn median(times: &[Duration]) -> Duration {
+    let mut sorted = times.to_vec();
+    sorted.sort();
+    sorted[sorted.len() / 2]
 }
 
 /// Renders `scene` `runs` times (at least once): each run's time, in run

@@ -184,10 +184,3 @@ impl Agreement {
         }
     }
 }
-
-/// The median of `times`, which must not be empty.
-pub fn median(times: &[Duration]) -> Duration {
-    let mut sorted = times.to_vec();
-    sorted.sort();
-    sorted[sorted.len() / 2]
-}

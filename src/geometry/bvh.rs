@@ -73,6 +73,15 @@ pub(super) type Node = WideNode<Vec4, 4>;
 /// level is a wait for memory.
 pub(super) type Node8 = WideNode<Lane8, 8>;
 
+/// A tree's nodes, node 0 the root (none when there are no primitives).
+#[derive(Clone, Debug)]
+pub(super) enum Nodes {
+    /// A tree of spheres only, which bundles of rays walk together.
+    Four(Vec<Node>),
+    /// A tree that holds other shapes (meshes), which single rays walk.
+    Eight(Vec<Node8>),
+}
+
 /// The lanes of a node's planes.
 pub(super) trait Planes: IndexMut<usize, Output = f32> + Copy {
     /// +∞ in every lane: the lower plane of no box.
@@ -264,12 +273,7 @@ pub struct Hit {
 /// A wide SAH bounding volume hierarchy over a set of primitives.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Node 0 is the root; empty when there are no primitives or the tree
-    /// is eight-wide.
-    nodes: Vec<Node>,
-    /// The eight-wide nodes of a tree that holds other shapes than spheres
-    /// (node 0 the root), in place of `nodes`.
-    wide: Vec<Node8>,
+    nodes: Nodes,
     spheres: Vec<SpherePacket>,
     triangles: Vec<TrianglePacket>,
     quads: Vec<QuadPacket>,
@@ -281,8 +285,6 @@ pub struct Bvh {
     /// Whether the processor has AVX2, asked once when the tree is built:
     /// asking for every ray cost ≈ 20 instructions per ray.
     avx2: bool,
-    /// Whether every leaf holds spheres, kept so that a ray reads one flag.
-    spheres_only: bool,
 }
 
 impl Bvh {
@@ -318,8 +320,7 @@ impl Bvh {
             leaves,
         } = build_binary(primitives);
         let mut bvh = Bvh {
-            nodes: Vec::new(),
-            wide: Vec::new(),
+            nodes: Nodes::Four(Vec::new()),
             spheres: Vec::new(),
             triangles: Vec::new(),
             quads: Vec::new(),
@@ -327,7 +328,6 @@ impl Bvh {
             instances,
             bounds: binary.first().map_or(Aabb::EMPTY, BinaryNode::bounds),
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
-            spheres_only: true,
         };
         if binary.is_empty() {
             return bvh;
@@ -353,18 +353,16 @@ impl Bvh {
         // then on every core (making them reads the primitives: most of
         // the time of a large mesh's collapse).
         let mut packet_leaves = leaves.map(Vec::with_capacity);
-        if spheres_only {
-            bvh.nodes = collapse.emit_tree(&roots, &mut packet_leaves);
+        bvh.nodes = if spheres_only {
+            Nodes::Four(collapse.emit_tree(&roots, &mut packet_leaves))
         } else {
-            bvh.wide = collapse.emit_tree(&roots, &mut packet_leaves);
-        }
+            Nodes::Eight(collapse.emit_tree(&roots, &mut packet_leaves))
+        };
         collapse.fill_packets(&packet_leaves, &mut bvh);
         bvh.spheres.shrink_to_fit();
         bvh.triangles.shrink_to_fit();
         bvh.quads.shrink_to_fit();
         bvh.instance_packets.shrink_to_fit();
-        bvh.spheres_only =
-            bvh.triangles.is_empty() && bvh.quads.is_empty() && bvh.instances.is_empty();
         bvh
     }
 
@@ -380,14 +378,20 @@ impl Bvh {
 
     /// Number of nodes (for statistics and memory estimates).
     pub fn node_count(&self) -> usize {
-        self.nodes.len() + self.wide.len()
+        match &self.nodes {
+            Nodes::Four(nodes) => nodes.len(),
+            Nodes::Eight(nodes) => nodes.len(),
+        }
     }
 
     /// Bytes of memory held by the hierarchy.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        self.nodes.capacity() * size_of::<Node>()
-            + self.wide.capacity() * size_of::<Node8>()
+        let nodes = match &self.nodes {
+            Nodes::Four(nodes) => nodes.capacity() * size_of::<Node>(),
+            Nodes::Eight(nodes) => nodes.capacity() * size_of::<Node8>(),
+        };
+        nodes
             + self.spheres.capacity() * size_of::<SpherePacket>()
             + self.triangles.capacity() * size_of::<TrianglePacket>()
             + self.quads.capacity() * size_of::<QuadPacket>()
@@ -438,10 +442,12 @@ impl Bvh {
         interval: Interval,
     ) -> (f32, u32, u32) {
         let mut query = SingleRay::<Q, SPHERES>::new(self, ray, interval);
-        if SPHERES || self.wide.is_empty() {
-            self.traverse(&self.nodes, &mut query);
-        } else {
-            self.traverse(&self.wide, &mut query);
+        match &self.nodes {
+            // Known at compile time not to be taken on spheres only.
+            Nodes::Eight(nodes) if !SPHERES => self.traverse(nodes, &mut query),
+            Nodes::Four(nodes) => self.traverse(nodes, &mut query),
+            // A tree of spheres only is four-wide.
+            Nodes::Eight(_) => {}
         }
         (query.closest, query.best, query.sub)
     }
@@ -453,19 +459,14 @@ impl Bvh {
     /// costs more, single rays were measured twice as fast.
     #[inline(always)]
     pub fn spheres_only(&self) -> bool {
-        self.spheres_only
+        // Such a tree, and only such a tree, is four-wide (see `Bvh::over`).
+        matches!(self.nodes, Nodes::Four(_))
     }
 
-    /// The four-wide nodes (none when the tree is eight-wide).
+    /// The tree's nodes.
     #[inline(always)]
-    pub(super) fn nodes(&self) -> &[Node] {
+    pub(super) fn nodes(&self) -> &Nodes {
         &self.nodes
-    }
-
-    /// The eight-wide nodes (none when the tree is four-wide).
-    #[inline(always)]
-    pub(super) fn wide_nodes(&self) -> &[Node8] {
-        &self.wide
     }
 
     /// Sphere packet `i`, reached through a leaf reference of a used child
@@ -877,9 +878,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
         let t_far = min4(min4(min4(tx1, ty1), tz1), Vec4::splat(self.closest)) * SLACK4;
         (t_near.cmple(t_far).bitmask() & used, t_near)
     }
-}
 
-impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
     /// The slab test of a node's eight boxes on lanes `R`, as
     /// [`SingleRay::boxes`] does for four.
     #[inline(always)]
@@ -1444,7 +1443,7 @@ mod tests {
         let prims = random_mixed(&mut rng, 3000, 20.0);
         let bvh = Bvh::new(&prims);
         assert!(
-            bvh.nodes.is_empty() && bvh.wide.len() > 50,
+            matches!(&bvh.nodes, Nodes::Eight(wide) if wide.len() > 50),
             "an eight-wide tree"
         );
         let mut portable = bvh.clone();

@@ -28,8 +28,8 @@
 //! bundle.
 
 use super::bvh::{
-    comes_before, leaf_parts, Bvh, Enter, Hit, InstancePacket, Node, Node8, QuadPacket, Rays,
-    SpherePacket, TrianglePacket, NO_CHILD, SLACK,
+    comes_before, leaf_parts, Bvh, Enter, Hit, InstancePacket, Node, Node8, Nodes, QuadPacket,
+    Rays, SpherePacket, TrianglePacket, NO_CHILD, SLACK,
 };
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
@@ -163,14 +163,15 @@ impl Bvh {
         // the other kinds' tests.
         let (closest, best, sub) = if self.spheres_only() {
             let mut query = BundleRays::<true>::new(self, rays, reference, interval);
-            self.traverse(self.nodes(), &mut query);
+            if let Nodes::Four(nodes) = self.nodes() {
+                self.traverse(nodes, &mut query);
+            }
             (query.closest, query.best, query.sub)
         } else {
             let mut query = BundleRays::<false>::new(self, rays, reference, interval);
-            if self.wide_nodes().is_empty() {
-                self.traverse(self.nodes(), &mut query);
-            } else {
-                self.traverse(self.wide_nodes(), &mut query);
+            match self.nodes() {
+                Nodes::Four(nodes) => self.traverse(nodes, &mut query),
+                Nodes::Eight(nodes) => self.traverse(nodes, &mut query),
             }
             (query.closest, query.best, query.sub)
         };

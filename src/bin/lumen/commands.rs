@@ -267,7 +267,8 @@ pub(crate) fn efficiency_command(
 /// lumen's tree and, in a build with the `embree` feature, through Embree's
 /// (see [`bench::traversal`]).
 pub(crate) fn traversal_command(spp: u32, runs: u32, only: Option<&str>) -> Result<()> {
-    use bench::traversal::{median, record_rays, trace_lumen, Agreement, MAX_RECORDED};
+    use bench::median;
+    use bench::traversal::{record_rays, trace_lumen, Agreement, MAX_RECORDED};
     let workloads = standard_workloads(spp, only)?;
     outln!(
         "lumen bench --traversal: the camera and bounce rays of {spp} spp, one thread, nearest hits one ray at a time, median of {runs} runs ({} code)",
