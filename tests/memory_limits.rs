@@ -100,3 +100,19 @@ fn recorded_rays_past_the_memory_are_refused_before_they_are_taken() {
     );
     assert_refused_for_memory(&out, &dir, "recording the rays");
 }
+
+#[test]
+fn a_tree_past_the_memory_is_refused_before_it_is_built() {
+    let dir = temp_dir("limits-tree");
+    // 2·10⁶ triangles: a 38 MB file, read and placed in about 120 MB; its
+    // tree's build needs at least 152 MB more. Under 264 MB of address
+    // space (threads and the binary take some), loading fits and the tree
+    // does not: before, the build aborted half-way.
+    let scene = lumen_process::write_grid(&dir, 1000);
+    let out = lumen_limited(
+        &dir,
+        270_000,
+        &format!("render {} -o out.png", scene.display()),
+    );
+    assert_refused_for_memory(&out, &dir, "building the tree of 2000000 shapes");
+}

@@ -22,7 +22,7 @@
 //! with a margin (`SLACK`), so both widths and every instruction set find the
 //! same hits to the bit.
 
-use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, BinaryTree, MAX_LEAF};
+use crate::geometry::bvh_build::{build_binary, Aabb, BinaryNode, BinaryTree, BuildItem, MAX_LEAF};
 use crate::geometry::instance::Instance;
 use crate::geometry::primitive::{Kind, Primitive, PrimitiveSet};
 use crate::geometry::quad::{self, QuadLanes};
@@ -30,6 +30,7 @@ use crate::geometry::sphere::{self, SphereLanes};
 use crate::geometry::triangle::{self, TriangleLanes, TriangleRay};
 use crate::lanes::{map3, max4, min4, Mask, Real, Wide, F8};
 use crate::math::Interval;
+use crate::memory::MemoryError;
 use crate::ray::{Ray, RayLanes};
 use glam::Vec4;
 use std::mem::MaybeUninit;
@@ -302,6 +303,36 @@ impl Bvh {
     /// instance that `instances` does not have.
     pub fn with_instances(primitives: &[Primitive], instances: Vec<Instance>) -> Self {
         Self::over(primitives, instances)
+    }
+
+    /// [`Bvh::over`], with the memory the build takes counted first (see
+    /// [`crate::memory`]): a tree that cannot fit in what this machine has
+    /// free is refused before it is started, rather than ending the process
+    /// half-way.
+    ///
+    /// # Panics
+    /// As [`Bvh::with_instances`].
+    pub fn try_over<P: PrimitiveSet + ?Sized>(
+        primitives: &P,
+        instances: Vec<Instance>,
+    ) -> Result<Self, MemoryError> {
+        let n = primitives.count();
+        // Below this, asking the system what it has free costs more than
+        // the tree.
+        if n >= 1 << 16 {
+            crate::memory::check(
+                Self::build_bytes(n),
+                &format!("building the tree of {n} shapes"),
+            )?;
+        }
+        Ok(Self::over(primitives, instances))
+    }
+
+    /// The least memory building a tree over `items` items takes at its
+    /// peak, beside the items themselves: the binary build's record of
+    /// each item and its nodes, both as many as the items.
+    pub fn build_bytes(items: usize) -> u64 {
+        (items as u64).saturating_mul((size_of::<BuildItem>() + size_of::<BinaryNode>()) as u64)
     }
 
     /// [`Bvh::with_instances`] over items made when the build asks for them

@@ -108,7 +108,7 @@ impl BinaryNode {
 /// aligned vectors of an [`Aabb`] and a [`Point3`] took 64 (the build's
 /// largest array, one per primitive).
 #[derive(Clone, Copy)]
-struct BuildItem {
+pub(super) struct BuildItem {
     min: [f32; 3],
     max: [f32; 3],
     centroid: [f32; 3],

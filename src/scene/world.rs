@@ -17,6 +17,7 @@ use crate::geometry::{
 use crate::light::{Light, LightTexture, Shape as LightShape};
 use crate::material::{Emissive, Material};
 use crate::math::{Color, Point3, Vec3};
+use crate::memory::MemoryError;
 use crate::mesh::TriangleMesh;
 use crate::ray::Ray;
 use std::sync::Arc;
@@ -562,10 +563,11 @@ pub(crate) struct Group {
 }
 
 impl Group {
-    /// The shapes with their tree.
-    pub(crate) fn new(shapes: Shapes) -> Group {
-        let bvh = Arc::new(Bvh::over(&shapes, Vec::new()));
-        Group { shapes, bvh }
+    /// The shapes with their tree (refused when the tree cannot fit: see
+    /// [`Bvh::try_over`]).
+    pub(crate) fn new(shapes: Shapes) -> Result<Group, MemoryError> {
+        let bvh = Arc::new(Bvh::try_over(&shapes, Vec::new())?);
+        Ok(Group { shapes, bvh })
     }
 }
 
@@ -636,13 +638,13 @@ pub struct PlacedShapes {
 
 impl World {
     /// Builds the tree over `top` and the placements `instances` of
-    /// `groups`.
+    /// `groups` (refused when the tree cannot fit: see [`Bvh::try_over`]).
     pub(crate) fn new(
         top: Shapes,
         groups: Vec<Group>,
         instances: &[PlacedGroup],
         rounding: Rounding,
-    ) -> World {
+    ) -> Result<World, MemoryError> {
         let trees: Vec<Instance> = instances
             .iter()
             .map(|p| {
@@ -661,7 +663,7 @@ impl World {
                 })
                 .collect(),
         };
-        let bvh = Bvh::over(&items, trees);
+        let bvh = Bvh::try_over(&items, trees)?;
         drop(items);
         let norm = |t: &Transform| {
             [Vec3::X, Vec3::Y, Vec3::Z]
@@ -679,13 +681,13 @@ impl World {
                 shrink: norm(&p.transform.inverse()),
             })
             .collect();
-        World {
+        Ok(World {
             bvh,
             top,
             groups,
             placed,
             rounding,
-        }
+        })
     }
 
     /// The world's shapes as placed, or `None` when some are placed by

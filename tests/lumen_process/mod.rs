@@ -250,3 +250,56 @@ pub fn output_and_peak_mb(mut cmd: Command) -> (Output, f64) {
     // ru_maxrss is in kilobytes on Linux.
     (output, usage.ru_maxrss as f64 / 1024.0)
 }
+
+/// Writes a binary PLY grid of `side` × `side` quads, two triangles each,
+/// bent into a wave (`scripts/make_big_ply.py`), and a scene of it.
+pub fn write_grid(dir: &Path, side: usize) -> std::path::PathBuf {
+    use std::io::Write;
+    let n = side + 1;
+    let triangles = 2 * side * side;
+    let mut out = std::io::BufWriter::new(std::fs::File::create(dir.join("grid.ply")).unwrap());
+    write!(
+        out,
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\n\
+         property float y\nproperty float z\nelement face {triangles}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        n * n
+    )
+    .unwrap();
+    for j in 0..n {
+        for i in 0..n {
+            let (u, v) = (
+                i as f32 / side as f32 * 2.0 - 1.0,
+                j as f32 / side as f32 * 2.0 - 1.0,
+            );
+            for c in [u, 0.1 * (6.0 * u).sin() * (4.0 * v).cos(), v] {
+                out.write_all(&c.to_le_bytes()).unwrap();
+            }
+        }
+    }
+    for j in 0..side {
+        for i in 0..side {
+            let a = (i + n * j) as i32;
+            let (b, c, d) = (a + 1, a + n as i32 + 1, a + n as i32);
+            for t in [[a, b, c], [a, c, d]] {
+                out.write_all(&[3]).unwrap();
+                t.iter()
+                    .for_each(|x| out.write_all(&x.to_le_bytes()).unwrap());
+            }
+        }
+    }
+    out.flush().unwrap();
+    let scene = dir.join("grid.toml");
+    std::fs::write(&scene, mesh_scene("grid.ply")).unwrap();
+    scene
+}
+
+/// A scene of the mesh `file` under the default sky.
+pub fn mesh_scene(file: &str) -> String {
+    format!(
+        "[render]\nwidth = 64\nheight = 64\nsamples_per_pixel = 1\nmax_depth = 4\n\
+         [camera]\nvfov = 40\nlookfrom = [0, 3, 4]\nlookat = [0, 0, 0]\n\
+         [materials.clay]\ntype = \"diffuse\"\nalbedo = [0.7, 0.7, 0.7]\n\
+         [[objects]]\ntype = \"mesh\"\nfile = \"{file}\"\nmaterial = \"clay\"\n"
+    )
+}

@@ -160,7 +160,8 @@ impl Scene {
             scale: error_scale(settings.offset),
             onto_spheres: desc.render.epsilon.is_none(),
         };
-        let world = World::new(top, groups, &instances, rounding);
+        let world = World::new(top, groups, &instances, rounding)
+            .map_err(|e| invalid("objects", e.to_string()))?;
         stats.instances = instances.len() as u64;
         stats.geometry_bytes = world.memory_bytes() as u64;
         let (lights, light_ids) = world.lights(&materials);
@@ -372,7 +373,9 @@ impl<'a> Objects<'a> {
             placed.motion = motion;
         }
         if !(shapes.spheres.is_empty() && shapes.quads.is_empty()) {
-            self.groups.push(Group::new(shapes));
+            let group =
+                Group::new(shapes).map_err(|e| invalid(format!("objects[{i}]"), e.to_string()))?;
+            self.groups.push(group);
             self.instances.push(PlacedGroup {
                 group: self.groups.len() as u32 - 1,
                 transform: Transform::IDENTITY,
@@ -456,7 +459,9 @@ impl<'a> Objects<'a> {
                         // Placed by an instance, whose material may be
                         // another: (u, v) always.
                         shapes.spheres.push(Surface::new(&sphere, m, true));
-                        self.groups.push(Group::new(shapes));
+                        let group = Group::new(shapes)
+                            .map_err(|e| invalid(format!("objects[{i}]"), e.to_string()))?;
+                        self.groups.push(group);
                         self.instances.push(PlacedGroup {
                             group: self.groups.len() as u32 - 1,
                             transform,
@@ -734,7 +739,13 @@ impl<'a> Objects<'a> {
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n * placed.len() as u64;
-                let group = Group::new(Shapes::of_mesh(mesh));
+                let group = Group::new(Shapes::of_mesh(mesh)).map_err(|e| {
+                    let first = placed.first().map_or(0, |p| p.object);
+                    invalid(
+                        format!("objects[{first}].file"),
+                        format!("{}: {e}", path.display()),
+                    )
+                })?;
                 // Each placement must stay within f32, as a mesh placed once
                 // must: its tree's box, placed.
                 for p in placed {
