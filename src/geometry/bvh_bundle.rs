@@ -355,26 +355,30 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             t_min: R::from_array(self.triangle.t_min),
             origin2: R::from_array(self.triangle.origin2),
         };
-        let is_axis = map3(&self.is_axis, |[x, y]| {
+        let is_axis = [0, 1, 2].map(|a| {
+            let [x, y] = self.is_axis[a];
             (R::mask_from_bits(x), R::mask_from_bits(y))
         });
-        self.one_by_one(&p.index, entry, |s| {
-            // Vertex `v` in every lane's own axes.
-            let permuted = |v: &[[f32; LANES]; 3]| {
-                let (x, y, z) = (R::splat(v[0][s]), R::splat(v[1][s]), R::splat(v[2][s]));
-                map3(&is_axis, |(is_x, is_y)| {
-                    R::select(is_x, x, R::select(is_y, y, z))
-                })
-            };
+        // Written out rather than through `one_by_one`: a closure this large
+        // is not inlined, and the vector operations in it, compiled outside
+        // the AVX2 context, would each be a call.
+        let enter = self.entering::<R>(entry);
+        let mut closest = R::from_array(self.closest);
+        for (s, &primitive) in p.index.iter().enumerate() {
+            if primitive == NO_CHILD {
+                break;
+            }
             let tri = TriangleLanes {
                 vertices: [
-                    permuted(&p.vertices[0]),
-                    permuted(&p.vertices[1]),
-                    permuted(&p.vertices[2]),
+                    permuted(&p.vertices[0], s, &is_axis),
+                    permuted(&p.vertices[1], s, &is_axis),
+                    permuted(&p.vertices[2], s, &is_axis),
                 ],
             };
-            triangle::intersect(&triangle, &tri)
-        });
+            let (t, valid) = triangle::intersect(&triangle, &tri);
+            self.found(&mut closest, t, valid, enter, primitive);
+        }
+        self.closest = closest.to_array();
     }
 
     /// The quads of `p` against the bundle.
@@ -383,6 +387,19 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
         let ray = self.ray_lanes::<R>();
         self.one_by_one(&p.index, entry, |s| quad::intersect(&ray, &p.splat(s)));
     }
+}
+
+/// Vertex `v` of primitive `s` of a packet in every lane's own axes
+/// (`is_axis`: per axis of the lane's frame, whether it is the world's x,
+/// or else y, or else z).
+#[inline(always)]
+fn permuted<R: Wide>(v: &[[f32; LANES]; 3], s: usize, is_axis: &[(R::Mask, R::Mask); 3]) -> [R; 3] {
+    let (x, y, z) = (R::splat(v[0][s]), R::splat(v[1][s]), R::splat(v[2][s]));
+    [
+        R::select(is_axis[0].0, x, R::select(is_axis[0].1, y, z)),
+        R::select(is_axis[1].0, x, R::select(is_axis[1].1, y, z)),
+        R::select(is_axis[2].0, x, R::select(is_axis[2].1, y, z)),
+    ]
 }
 
 impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
