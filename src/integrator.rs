@@ -411,7 +411,9 @@ const HALT_CHECK_ROUNDS: u32 = 256;
 /// of a round can be traced as bundles (see
 /// [`RayBundle`](crate::geometry::RayBundle)): a single ray's traversal
 /// waits on one test after another, while a bundle keeps the processor busy
-/// with eight (in scenes of spheres only: [`Scene::bundles_pay_off`]).
+/// with eight: the camera rays in every scene (without cut-outs), the
+/// bounces in scenes of spheres only ([`Scene::camera_bundles_pay_off`],
+/// [`Scene::bundles_pay_off`]).
 /// `reference` (the pixel's central ray) orders the visit of the first
 /// round's bundles; later rounds use a ray of the bundle. Once `halt`
 /// says to stop, the paths are left where they are within a few hundred
@@ -471,8 +473,8 @@ pub fn trace_paths<S: Sampler>(
 
 /// Sets `hits[i]` to the hit of `rays[i]`, which leaves the surface of hit
 /// `from[i]`, for every path `i` of `live`: eight at a time as bundles
-/// where they pay off, the few left over (and every ray elsewhere) one by
-/// one.
+/// where they pay off (camera rays, `reference` given; bounces among
+/// spheres), the few left over (and every ray elsewhere) one by one.
 #[inline(always)]
 fn find_hits(
     scene: &Scene,
@@ -483,11 +485,8 @@ fn find_hits(
     hits: &mut [Option<Hit>; PATHS],
 ) {
     // Where bundles do not pay off, no group is large enough for one.
-    let min_bundle = if scene.bundles_pay_off() {
-        MIN_BUNDLE
-    } else {
-        usize::MAX
-    };
+    let pays = scene.bundles_pay_off() || (reference.is_some() && scene.camera_bundles_pay_off());
+    let min_bundle = if pays { MIN_BUNDLE } else { usize::MAX };
     for group in live.chunks(LANES) {
         if group.len() < min_bundle {
             for &i in group {
@@ -537,9 +536,18 @@ mod tests {
     #[test]
     fn paths_side_by_side_equal_paths_one_at_a_time() {
         let names = ["cover", "glass-hollow", "metal-fuzz-0.5", "bounce-cube"];
+        let mut descs: Vec<_> = names
+            .iter()
+            .map(|name| builtin::find(name).expect("built-in").desc())
+            .collect();
+        // A mesh, whose camera rays go as bundles and its bounces one by one.
+        let mut bunny =
+            crate::bench::bunny_scene(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny.glb"));
+        bunny.render.height = Some(24);
+        descs.push(bunny);
         let kinds = [SamplerKind::Independent, SamplerKind::Sobol];
-        for (name, kind) in names.iter().flat_map(|n| kinds.map(|k| (n, k))) {
-            let mut desc = builtin::find(name).expect("built-in").desc();
+        for (desc, kind) in descs.iter().flat_map(|d| kinds.map(|k| (d, k))) {
+            let mut desc = desc.clone();
             desc.render.width = 24;
             for max_depth in [1, 2, 3, 50] {
                 desc.render.max_depth = max_depth;
@@ -581,11 +589,13 @@ mod tests {
                     assert_eq!(
                         bits(&together),
                         bits(&alone),
-                        "{name}, {kind:?}, depth {max_depth}, {n} paths"
+                        "{}, {kind:?}, depth {max_depth}, {n} paths",
+                        desc.caption
                     );
                     assert_eq!(
                         together_rays, alone_rays,
-                        "{name}, depth {max_depth}: segments"
+                        "{}, depth {max_depth}: segments",
+                        desc.caption
                     );
                 }
             }

@@ -513,6 +513,12 @@ impl Bvh {
         }
     }
 
+    /// How many triangle packets the tree has.
+    #[cfg(test)]
+    pub(super) fn triangle_packets(&self) -> usize {
+        self.triangles.len()
+    }
+
     /// Triangle packet `i` (bounds-checked: triangle tests dominate the
     /// check's cost).
     #[inline(always)]

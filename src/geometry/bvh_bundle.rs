@@ -19,6 +19,12 @@
 //! distances as tracing its rays one at a time; a lane tests a leaf's
 //! primitives only when its own ray enters the leaf's box, as it would alone.
 //!
+//! When every ray of a bundle meets each box's planes in the same order
+//! and has the same triangle axes (a pixel's camera rays, nearly always),
+//! the eight-wide box test and the triangle test take the shared order
+//! once instead of choosing per lane: the same operations on the same
+//! numbers, so the same bits.
+//!
 //! Children are visited in the order of a *reference* ray given by the
 //! caller (the pixel's central ray, say), near to the bundle's rays. The order
 //! only affects speed: each lane's result, like [`Bvh::hit`]'s, is the first
@@ -150,8 +156,9 @@ impl Bvh {
     /// the bundle's order (`None` beyond its length). Each distance is the
     /// one [`Bvh::hit`] finds for that ray. `reference` orders the visit of
     /// children (see the module documentation); any ray close to the
-    /// bundle's rays makes a good reference. Faster than single rays on
-    /// trees of spheres only (see [`Bvh::spheres_only`]).
+    /// bundle's rays makes a good reference. Faster than single rays when
+    /// the rays are close (a pixel's camera rays), or on trees of spheres
+    /// only (see [`Bvh::spheres_only`]) for any rays.
     #[inline(always)]
     pub fn hit_bundle(
         &self,
@@ -204,6 +211,15 @@ struct BundleRays<'a, const SPHERES: bool> {
     /// (as bits) for which it is x, and those for which it is y (else z).
     triangle: TriangleRay<Lanes>,
     is_axis: [[u32; 2]; 3],
+    /// When every lane's ray goes the same way along each axis (a pixel's
+    /// camera rays, nearly always): per axis, whether the upper plane is
+    /// met first, for all; the box test then makes no choice per lane.
+    shared_flip: Option<[bool; 3]>,
+    /// When every lane's ray has the same triangle axes: those, so that a
+    /// triangle's vertices are permuted once for all lanes.
+    shared_axes: Option<[usize; 3]>,
+    /// Whether the processor has AVX2 (asked once, by the tree).
+    avx2: bool,
     /// Per lane, the best hit so far as in `Bvh::hit`: (distance, index),
     /// starting from (interval.max, 0). Unused lanes start at −∞, so that
     /// they never enter a box or accept a primitive.
@@ -226,6 +242,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             origin2: [0.0; LANES],
         };
         let mut is_axis = [[0; 2]; 3];
+        let mut shared_axes = None;
         if !SPHERES && bvh.has_triangles() {
             for lane in 0..LANES {
                 let ray = rays.ray(lane);
@@ -239,11 +256,29 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
                     is_axis[k][1] |= u32::from(axes[k] == 1) << lane;
                 }
             }
+            const ALL: u32 = (1 << LANES) - 1;
+            if is_axis
+                .iter()
+                .flatten()
+                .all(|&bits| bits == 0 || bits == ALL)
+            {
+                shared_axes = Some(std::array::from_fn(|k| match is_axis[k] {
+                    [ALL, _] => 0,
+                    [_, ALL] => 1,
+                    _ => 2,
+                }));
+            }
         }
+        let flip: [[bool; LANES]; 3] =
+            std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0));
+        let shared_flip = flip
+            .iter()
+            .all(|lanes| lanes.iter().all(|&f| f == lanes[0]))
+            .then(|| flip.map(|lanes| lanes[0]));
         BundleRays {
             rays,
             t_min: interval.min,
-            flip: std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0)),
+            flip,
             ref_near: [
                 usize::from(ref_inv.x < 0.0),
                 usize::from(ref_inv.y < 0.0),
@@ -253,6 +288,9 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             ref_inv: ref_inv.to_array().map(Vec4::splat),
             triangle,
             is_axis,
+            shared_flip,
+            shared_axes,
+            avx2: bvh.avx2(),
             closest,
             best: [0; LANES],
             sub: [0; LANES],
@@ -368,12 +406,21 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             if primitive == NO_CHILD {
                 break;
             }
-            let tri = TriangleLanes {
-                vertices: [
-                    permuted(&p.vertices[0], s, &is_axis),
-                    permuted(&p.vertices[1], s, &is_axis),
-                    permuted(&p.vertices[2], s, &is_axis),
-                ],
+            let tri = match self.shared_axes {
+                Some(axes) => TriangleLanes {
+                    vertices: [
+                        shared(&p.vertices[0], s, axes),
+                        shared(&p.vertices[1], s, axes),
+                        shared(&p.vertices[2], s, axes),
+                    ],
+                },
+                None => TriangleLanes {
+                    vertices: [
+                        permuted(&p.vertices[0], s, &is_axis),
+                        permuted(&p.vertices[1], s, &is_axis),
+                        permuted(&p.vertices[2], s, &is_axis),
+                    ],
+                },
             };
             let (t, valid) = triangle::intersect(&triangle, &tri);
             self.found(&mut closest, t, valid, enter, primitive);
@@ -399,6 +446,17 @@ fn permuted<R: Wide>(v: &[[f32; LANES]; 3], s: usize, is_axis: &[(R::Mask, R::Ma
         R::select(is_axis[0].0, x, R::select(is_axis[0].1, y, z)),
         R::select(is_axis[1].0, x, R::select(is_axis[1].1, y, z)),
         R::select(is_axis[2].0, x, R::select(is_axis[2].1, y, z)),
+    ]
+}
+
+/// Vertex `v` of primitive `s` of a packet in the axes `axes` every lane
+/// shares: what [`permuted`] gives then, without a choice per lane.
+#[inline(always)]
+fn shared<R: Wide>(v: &[[f32; LANES]; 3], s: usize, axes: [usize; 3]) -> [R; 3] {
+    [
+        R::splat(v[axes[0]][s]),
+        R::splat(v[axes[1]][s]),
+        R::splat(v[axes[2]][s]),
     ]
 }
 
@@ -434,8 +492,18 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
 #[allow(unsafe_code)]
 mod bundle_avx2 {
     use super::{BundleRays, Lanes};
-    use crate::geometry::bvh::{QuadPacket, SpherePacket, TrianglePacket};
+    use crate::geometry::bvh::{Node8, QuadPacket, SpherePacket, TrianglePacket};
     use crate::lanes::W8;
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn boxes8<const S: bool>(
+        r: &BundleRays<S>,
+        node: &Node8,
+        flip: [bool; 3],
+    ) -> (u32, [Lanes; 8]) {
+        r.boxes8_shared::<W8>(node, flip)
+    }
 
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -511,6 +579,39 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
         (hit_mask, t_near)
     }
 
+    /// [`Self::boxes`] of an eight-wide node on lanes `R`, for rays that
+    /// all meet the planes in the order `flip` (per axis, upper first):
+    /// the same operations on the same numbers, one box for every lane at
+    /// once.
+    #[inline(always)]
+    fn boxes8_shared<R: Wide>(&self, node: &Node8, flip: [bool; 3]) -> (u32, [Lanes; 8]) {
+        let rays = self.rays;
+        let origin = map3(&rays.origin, R::from_array);
+        let inverse = map3(&rays.inverse, R::from_array);
+        let closest = R::from_array(self.closest);
+        let (t_min, slack, nan) = (R::splat(self.t_min), R::splat(SLACK), R::splat(f32::NAN));
+        let sides = flip.map(|upper| if upper { (1, 0) } else { (0, 1) });
+        let mut t_near = [[0.0; LANES]; 8];
+        let mut hit_mask = 0u32;
+        let planes = &node.planes;
+        // Without a branch per child: an unused slot's box is empty, so no
+        // lane enters it, and its bit is cleared by `used` besides.
+        for child in 0..8 {
+            let x0 = (R::splat(planes[0][sides[0].0][child]) - origin[0]) * inverse[0];
+            let x1 = (R::splat(planes[0][sides[0].1][child]) - origin[0]) * inverse[0];
+            let y0 = (R::splat(planes[1][sides[1].0][child]) - origin[1]) * inverse[1];
+            let y1 = (R::splat(planes[1][sides[1].1][child]) - origin[1]) * inverse[1];
+            let z0 = (R::splat(planes[2][sides[2].0][child]) - origin[2]) * inverse[2];
+            let z1 = (R::splat(planes[2][sides[2].1][child]) - origin[2]) * inverse[2];
+            let near = x0.max_ps(y0).max_ps(z0).max_ps(t_min);
+            let far = x1.min_ps(y1).min_ps(z1).min_ps(closest) * slack;
+            let hit = near.le(far);
+            hit_mask |= u32::from(R::bits(hit) != 0) << child;
+            t_near[child] = R::select(hit, near, nan).to_array();
+        }
+        (hit_mask & node.used, t_near)
+    }
+
     /// Where the reference ray meets four boxes, given as their planes.
     #[inline(always)]
     fn reference_entries(&self, p: &[[Vec4; 2]; 3]) -> Vec4 {
@@ -549,7 +650,16 @@ impl<const SPHERES: bool> Enter<Node8> for BundleRays<'_, SPHERES> {
 
     #[inline(always)]
     fn enter(&self, node: &Node8) -> (u32, [Lanes; 8]) {
-        self.boxes(&node.planes, node.used)
+        let Some(flip) = self.shared_flip else {
+            return self.boxes(&node.planes, node.used);
+        };
+        // SAFETY: `avx2` is true only when `Isa::detect` found AVX2.
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        if self.avx2 {
+            return unsafe { bundle_avx2::boxes8(self, node, flip) };
+        }
+        self.boxes8_shared::<F8>(node, flip)
     }
 
     /// Where the reference ray meets the boxes, four at a time.
@@ -643,8 +753,10 @@ mod tests {
         bundles_agree_with_single_rays(true);
     }
 
-    fn bundles_agree_with_single_rays(mixed: bool) {
-        let mut rng = Rng::new(21);
+    /// 400 spheres on a ground sphere, or (`mixed`) 200 of them among a
+    /// triangulated terrain, quads and a floor of triangles far larger than
+    /// the view.
+    fn primitives(rng: &mut Rng, mixed: bool) -> Vec<Primitive> {
         let mut spheres: Vec<Sphere> = (0..400)
             .map(|_| {
                 let c = Vec3::new(
@@ -690,6 +802,123 @@ mod tests {
             prims.push(Primitive::Triangle(Triangle::new(a, d, c)));
             prims.push(Primitive::Triangle(Triangle::new(a, c, b)));
         }
+        prims
+    }
+
+    /// Up to `n` rays from near `origin` toward near `toward` (`coherent`, as
+    /// a pixel's camera rays), or from `origin` in any direction.
+    fn bundle_rays(
+        rng: &mut Rng,
+        n: usize,
+        origin: Vec3,
+        toward: Vec3,
+        coherent: bool,
+    ) -> Vec<Ray> {
+        (0..n)
+            .map(|_| {
+                if coherent {
+                    let jitter = crate::sampling::in_unit_sphere(rng) * 0.05;
+                    let o = origin + jitter;
+                    let target = toward + crate::sampling::in_unit_sphere(rng) * 0.05;
+                    Ray::new(o, (target - o).normalize())
+                } else {
+                    Ray::new(origin, crate::sampling::unit_vector(rng.next_2d()))
+                }
+            })
+            .collect()
+    }
+
+    /// For rays that meet every box's planes in the same order and share
+    /// their triangle axes (a pixel's camera rays, nearly always), the box
+    /// test of an eight-wide node and the triangle test skip the choices per
+    /// lane: on portable and on AVX2 lanes they give bit for bit what the
+    /// general tests give, on every node and triangle packet of a mesh's tree.
+    #[test]
+    fn shared_order_tests_equal_the_general_ones() {
+        let mut rng = Rng::new(5);
+        let bvh = Bvh::new(&primitives(&mut rng, true));
+        let Nodes::Eight(nodes) = bvh.nodes() else {
+            panic!("a tree with triangles is eight-wide")
+        };
+        let interval = Interval::new(0.001, f32::INFINITY);
+        let (mut shared_flips, mut shared_axes) = (0, 0);
+        for case in 0..200 {
+            let origin = Vec3::new(rng.range_f32(-15.0, 15.0), 2.0, rng.range_f32(-15.0, 15.0));
+            let toward = Vec3::new(rng.range_f32(-5.0, 5.0), 0.0, rng.range_f32(-5.0, 5.0));
+            let rays = bundle_rays(&mut rng, 1 + case % LANES, origin, toward, true);
+            let bundle = RayBundle::new(&rays);
+            let reference = Ray::new(origin, (toward - origin).normalize());
+            let mut q = BundleRays::<false>::new(&bvh, &bundle, &reference, interval);
+            // Some lanes with a best hit already, as deeper in a traversal.
+            for (l, c) in q.closest.iter_mut().enumerate().take(bundle.len()) {
+                if l % 3 == 1 {
+                    *c = rng.range_f32(1.0, 30.0);
+                }
+            }
+            let bits = |(mask, t): (u32, [Lanes; 8])| (mask, t.map(|l| l.map(f32::to_bits)));
+            if let Some(flip) = q.shared_flip {
+                shared_flips += 1;
+                for node in nodes {
+                    let general = bits(q.boxes(&node.planes, node.used));
+                    assert_eq!(bits(q.boxes8_shared::<F8>(node, flip)), general);
+                    #[cfg(target_arch = "x86_64")]
+                    if q.avx2 {
+                        // SAFETY: `avx2` is true only when the processor has AVX2.
+                        #[allow(unsafe_code)]
+                        let avx2 = unsafe { bundle_avx2::boxes8(&q, node, flip) };
+                        assert_eq!(bits(avx2), general);
+                    }
+                }
+            }
+            if q.shared_axes.is_some() {
+                shared_axes += 1;
+                let entry = [0.0; LANES];
+                let mut general = BundleRays {
+                    shared_axes: None,
+                    ..q
+                };
+                for i in 0..bvh.triangle_packets() {
+                    let p = bvh.triangle_packet(i as u32);
+                    general.triangles::<F8>(p, &entry);
+                    let mut portable = BundleRays { ..q };
+                    portable.triangles::<F8>(p, &entry);
+                    #[cfg(target_arch = "x86_64")]
+                    if q.avx2 {
+                        let mut avx2 = BundleRays { ..q };
+                        // SAFETY: as above.
+                        #[allow(unsafe_code)]
+                        unsafe {
+                            bundle_avx2::triangles(&mut avx2, p, &entry)
+                        };
+                        assert_eq!(
+                            avx2.closest.map(f32::to_bits),
+                            general.closest.map(f32::to_bits)
+                        );
+                        assert_eq!(avx2.best, general.best);
+                    }
+                    assert_eq!(
+                        portable.closest.map(f32::to_bits),
+                        general.closest.map(f32::to_bits)
+                    );
+                    assert_eq!(portable.best, general.best);
+                    q = BundleRays {
+                        closest: general.closest,
+                        best: general.best,
+                        ..q
+                    };
+                }
+            }
+        }
+        // Nearly every such bundle shares both.
+        assert!(
+            shared_flips > 180 && shared_axes > 180,
+            "{shared_flips} {shared_axes}"
+        );
+    }
+
+    fn bundles_agree_with_single_rays(mixed: bool) {
+        let mut rng = Rng::new(21);
+        let prims = primitives(&mut rng, mixed);
         let bvh = Bvh::new(&prims);
         let interval = Interval::new(0.001, f32::INFINITY);
         let mut hits = 0;
@@ -702,19 +931,7 @@ mod tests {
             );
             let toward = Vec3::new(rng.range_f32(-5.0, 5.0), 0.0, rng.range_f32(-5.0, 5.0));
             let reference = Ray::new(origin, (toward - origin).normalize());
-            let coherent = case % 2 == 0;
-            let rays: Vec<Ray> = (0..n)
-                .map(|_| {
-                    if coherent {
-                        let jitter = crate::sampling::in_unit_sphere(&mut rng) * 0.05;
-                        let o = origin + jitter;
-                        let target = toward + crate::sampling::in_unit_sphere(&mut rng) * 0.05;
-                        Ray::new(o, (target - o).normalize())
-                    } else {
-                        Ray::new(origin, crate::sampling::unit_vector(rng.next_2d()))
-                    }
-                })
-                .collect();
+            let rays = bundle_rays(&mut rng, n, origin, toward, case % 2 == 0);
             let got = bvh.hit_bundle(&RayBundle::new(&rays), &reference, interval);
             for (lane, ray) in rays.iter().enumerate() {
                 let expected = bvh.hit(ray, interval);
