@@ -271,10 +271,12 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
         }
         let flip: [[bool; LANES]; 3] =
             std::array::from_fn(|axis| std::array::from_fn(|l| rays.inverse[axis][l] < 0.0));
-        let shared_flip = flip
-            .iter()
-            .all(|lanes| lanes.iter().all(|&f| f == lanes[0]))
-            .then(|| flip.map(|lanes| lanes[0]));
+        // Only eight-wide nodes use it, and a tree of spheres only has none.
+        let shared_flip = (!SPHERES
+            && flip
+                .iter()
+                .all(|lanes| lanes.iter().all(|&f| f == lanes[0])))
+        .then(|| flip.map(|lanes| lanes[0]));
         BundleRays {
             rays,
             t_min: interval.min,
