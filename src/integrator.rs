@@ -535,7 +535,15 @@ mod tests {
     /// sampler.
     #[test]
     fn paths_side_by_side_equal_paths_one_at_a_time() {
-        let names = ["cover", "glass-hollow", "metal-fuzz-0.5", "bounce-cube"];
+        // bouncing-spheres: moving instances, whose hits depend on each
+        // ray's time.
+        let names = [
+            "cover",
+            "glass-hollow",
+            "metal-fuzz-0.5",
+            "bounce-cube",
+            "bouncing-spheres",
+        ];
         let mut descs: Vec<_> = names
             .iter()
             .map(|name| builtin::find(name).expect("built-in").desc())

@@ -1,6 +1,7 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::film::{Film, RowMut};
+use crate::geometry::bvh_bundle::LANES;
 use crate::halt::Halt;
 use crate::integrator::{first_hit_view, trace_paths, PATHS};
 use crate::isa::Isa;
@@ -165,6 +166,11 @@ pub fn render_pixels(
 /// a few tens of nanoseconds.
 const ASK_EVERY_PIXELS: usize = 8;
 
+/// Samples a pixel from which a pass traces each pixel's paths on their
+/// own: fewer make no bundle (`integrator::MIN_BUNDLE`), and the camera
+/// rays of neighbouring pixels are traced side by side instead.
+const PIXELS_ALONE_FROM: usize = 4;
+
 /// Renders samples `samples` of every pixel of `row`, which holds the
 /// pixels of image row `at.1` from column `at.0` on (of those whose `active`
 /// flag is set, if given), with the code compiled for `isa` (which must be
@@ -227,6 +233,57 @@ fn render_row_generic(
     let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PATHS];
     let mut samplers = [const { PixelSample::placeholder() }; PATHS];
     let mut colours = [Color::ZERO; PATHS];
+    let per_pixel = samples.len();
+    if side_by_side && per_pixel < PIXELS_ALONE_FROM {
+        // Too few of a pixel's samples for a bundle: neighbours' camera
+        // rays, nearly as close, go side by side instead.
+        let neighbours = (LANES / per_pixel.max(1)).max(1);
+        let mut members = [(0usize, 0u32); LANES];
+        let mut x = 0;
+        while x < width {
+            let (mut m, mut n) = (0, 0);
+            while x < width && m < neighbours {
+                if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
+                    return stats;
+                }
+                if active.is_none_or(|a| a[x]) {
+                    let column = x0 + x as u32;
+                    let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
+                    let pixel_sampler =
+                        PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
+                    for index in samples.clone() {
+                        (rays[n], samplers[n]) =
+                            camera_sample(scene, column, y, &pixel_sampler, index);
+                        n += 1;
+                    }
+                    members[m] = (x, column);
+                    m += 1;
+                }
+                x += 1;
+            }
+            if m == 0 {
+                continue;
+            }
+            let reference = scene.camera.central_ray(members[m / 2].1, y);
+            trace_paths(
+                scene,
+                &mut rays[..n],
+                &mut samplers[..n],
+                &reference,
+                &mut colours[..n],
+                &mut stats.rays,
+                halt,
+            );
+            // Each pixel's in sample order, as one at a time would add them.
+            let colours = colours[..n].chunks(per_pixel);
+            for (&(x, _), colours) in members[..m].iter().zip(colours) {
+                for (index, &c) in samples.clone().zip(colours) {
+                    add_sample(&mut row, &mut stats, x, index, c);
+                }
+            }
+        }
+        return stats;
+    }
     for x in 0..width {
         if active.is_some_and(|a| !a[x]) {
             continue;
@@ -367,6 +424,74 @@ mod tests {
                 bits(&base) == bits(&best),
                 "row {y}: baseline and {isa:?} differ"
             );
+        }
+    }
+
+    /// A pass of fewer samples a pixel than make a bundle traces the paths
+    /// of neighbouring pixels side by side: every pixel gets, bit for bit,
+    /// the samples its paths give one at a time, whichever pixels are left
+    /// out (adaptive sampling) and however many samples the pass holds.
+    #[test]
+    fn neighbouring_pixels_side_by_side_equal_paths_one_at_a_time() {
+        let mut bunny =
+            crate::bench::bunny_scene(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/bunny.glb"));
+        bunny.render.height = Some(12);
+        let moving = builtin::find("bouncing-spheres").expect("built-in").desc();
+        for mut desc in [builtin::cover(), bunny, moving] {
+            desc.render.width = 21;
+            let scene = Scene::from_desc(&desc).expect("compiles");
+            let s = &scene.settings;
+            let width = s.width as usize;
+            // Every third pixel left out, and the first.
+            let active: Vec<bool> = (0..width).map(|x| x % 3 != 0 && x > 0).collect();
+            for samples in [0..1, 5..7, 2..5, 0..4] {
+                for y in [0, s.height / 2] {
+                    let mut together = Film::with_halves(s.width, 1);
+                    let row = together.rows_mut().collect::<Vec<_>>().pop().unwrap();
+                    let stats = render_row(
+                        Isa::detect(),
+                        &scene,
+                        (0, y),
+                        samples.clone(),
+                        row,
+                        Some(&active),
+                        &Halt::never(),
+                    );
+                    let mut alone = Film::with_halves(s.width, 1);
+                    let mut row = alone.rows_mut().collect::<Vec<_>>().pop().unwrap();
+                    let mut expected = RenderStats::default();
+                    for x in (0..width).filter(|&x| active[x]) {
+                        let pixel = u64::from(y) * u64::from(s.width) + x as u64;
+                        let ps = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
+                        for index in samples.clone() {
+                            let (ray, mut sampler) = camera_sample(&scene, x as u32, y, &ps, index);
+                            let c = crate::integrator::trace_path(
+                                &scene,
+                                ray,
+                                &mut sampler,
+                                &mut expected.rays,
+                            );
+                            add_sample(&mut row, &mut expected, x, index, c);
+                        }
+                    }
+                    assert_eq!(stats, expected, "{}: {samples:?}, row {y}", desc.caption);
+                    let bits = |f: &Film| {
+                        let (sums, counts) = f.raw();
+                        let (odd, odd_counts) = f.raw_odd();
+                        let bits = sums.iter().chain(odd).flat_map(|s| s.0);
+                        (
+                            bits.collect::<Vec<_>>(),
+                            counts.to_vec(),
+                            odd_counts.to_vec(),
+                        )
+                    };
+                    assert!(
+                        bits(&together) == bits(&alone),
+                        "{}: {samples:?}, row {y}",
+                        desc.caption
+                    );
+                }
+            }
         }
     }
 

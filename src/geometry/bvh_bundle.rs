@@ -58,6 +58,8 @@ pub struct RayBundle {
     origin: [Lanes; 3],
     direction: [Lanes; 3],
     inverse: [Lanes; 3],
+    /// Each ray's time in the shutter interval (for moving instances).
+    time: Lanes,
     len: usize,
 }
 
@@ -94,12 +96,14 @@ impl RayBundle {
             origin: [[0.0; LANES]; 3],
             direction: [[0.0; LANES]; 3],
             inverse: [[0.0; LANES]; 3],
+            time: [0.0; LANES],
             len: lanes.len(),
         };
         for lane in 0..LANES {
             let ray = &rays[usize::from(*lanes.get(lane).unwrap_or(&lanes[0]))];
             debug_assert!((ray.direction.length_squared() - 1.0).abs() < 1e-4);
             let inverse = ray.direction.recip();
+            b.time[lane] = ray.time();
             for axis in 0..3 {
                 b.origin[axis][lane] = ray.origin()[axis];
                 b.direction[axis][lane] = ray.direction[axis];
@@ -126,7 +130,7 @@ impl RayBundle {
     pub fn ray(&self, lane: usize) -> Ray {
         let o = self.origin.map(|c| c[lane]);
         let d = self.direction.map(|c| c[lane]);
-        Ray::new(o.into(), d.into())
+        Ray::timed(o.into(), d.into(), self.time[lane])
     }
 }
 
