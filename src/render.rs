@@ -410,21 +410,19 @@ mod tests {
             let (base, a) = render_with(Isa::Baseline);
             let (best, b) = render_with(isa);
             assert_eq!(a, b, "row {y}: counts differ between baseline and {isa:?}");
-            let bits = |f: &Film| {
-                let (sums, counts) = f.raw();
-                let (odd, odd_counts) = f.raw_odd();
-                let bits = sums.iter().chain(odd).flat_map(|s| s.0);
-                (
-                    bits.collect::<Vec<_>>(),
-                    counts.to_vec(),
-                    odd_counts.to_vec(),
-                )
-            };
             assert!(
-                bits(&base) == bits(&best),
+                film_bits(&base) == film_bits(&best),
                 "row {y}: baseline and {isa:?} differ"
             );
         }
+    }
+
+    /// A film's sums (whole and odd-sample halves) and counts, to compare.
+    fn film_bits(f: &Film) -> (Vec<i128>, Vec<u32>, Vec<u32>) {
+        let (sums, counts) = f.raw();
+        let (odd, odd_counts) = f.raw_odd();
+        let bits = sums.iter().chain(odd).flat_map(|s| s.0);
+        (bits.collect(), counts.to_vec(), odd_counts.to_vec())
     }
 
     /// A pass of fewer samples a pixel than make a bundle traces the paths
@@ -475,18 +473,8 @@ mod tests {
                         }
                     }
                     assert_eq!(stats, expected, "{}: {samples:?}, row {y}", desc.caption);
-                    let bits = |f: &Film| {
-                        let (sums, counts) = f.raw();
-                        let (odd, odd_counts) = f.raw_odd();
-                        let bits = sums.iter().chain(odd).flat_map(|s| s.0);
-                        (
-                            bits.collect::<Vec<_>>(),
-                            counts.to_vec(),
-                            odd_counts.to_vec(),
-                        )
-                    };
                     assert!(
-                        bits(&together) == bits(&alone),
+                        film_bits(&together) == film_bits(&alone),
                         "{}: {samples:?}, row {y}",
                         desc.caption
                     );
