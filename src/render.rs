@@ -228,11 +228,7 @@ fn render_row_generic(
     // Path tracing runs a pixel's samples side by side (`trace_paths`); the
     // debugging views trace one ray at a time.
     let side_by_side = s.shading == Shading::Path;
-    // A pixel's camera rays, their samplers and colours, filled for each
-    // group of samples.
-    let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PATHS];
-    let mut samplers = [const { PixelSample::placeholder() }; PATHS];
-    let mut colours = [Color::ZERO; PATHS];
+    let mut paths = SideBySide::new();
     let per_pixel = samples.len();
     if side_by_side && per_pixel < PIXELS_ALONE_FROM {
         // Too few of a pixel's samples for a bundle: neighbours' camera
@@ -241,45 +237,21 @@ fn render_row_generic(
         let mut members = [(0usize, 0u32); LANES];
         let mut x = 0;
         while x < width {
-            let (mut m, mut n) = (0, 0);
+            let mut m = 0;
             while x < width && m < neighbours {
                 if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
                     return stats;
                 }
                 if active.is_none_or(|a| a[x]) {
-                    let column = x0 + x as u32;
-                    let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
-                    let pixel_sampler =
-                        PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
-                    for index in samples.clone() {
-                        (rays[n], samplers[n]) =
-                            camera_sample(scene, column, y, &pixel_sampler, index);
-                        n += 1;
-                    }
-                    members[m] = (x, column);
+                    members[m] = (x, x0 + x as u32);
                     m += 1;
                 }
                 x += 1;
             }
-            if m == 0 {
-                continue;
-            }
-            let reference = scene.camera.central_ray(members[m / 2].1, y);
-            trace_paths(
-                scene,
-                &mut rays[..n],
-                &mut samplers[..n],
-                &reference,
-                &mut colours[..n],
-                &mut stats.rays,
-                halt,
-            );
-            // Each pixel's in sample order, as one at a time would add them.
-            let colours = colours[..n].chunks(per_pixel);
-            for (&(x, _), colours) in members[..m].iter().zip(colours) {
-                for (index, &c) in samples.clone().zip(colours) {
-                    add_sample(&mut row, &mut stats, x, index, c);
-                }
+            if m > 0 {
+                let reference = scene.camera.central_ray(members[m / 2].1, y);
+                let group = (&members[..m], samples.clone());
+                paths.trace(scene, y, group, &reference, &mut row, &mut stats, halt);
             }
         }
         return stats;
@@ -293,9 +265,8 @@ fn render_row_generic(
         }
         // The pixel's column in the image, which addresses its samples.
         let column = x0 + x as u32;
-        let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
-        let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
         if !side_by_side {
+            let pixel_sampler = pixel_sampler(scene, column, y);
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
@@ -306,28 +277,81 @@ fn render_row_generic(
         let reference = scene.camera.central_ray(column, y);
         let mut start = samples.start;
         while start < samples.end {
-            let n = (samples.end - start).min(PATHS as u32) as usize;
-            for (i, (ray, sampler)) in rays.iter_mut().zip(&mut samplers).take(n).enumerate() {
-                (*ray, *sampler) =
-                    camera_sample(scene, column, y, &pixel_sampler, start + i as u32);
-            }
-            trace_paths(
-                scene,
-                &mut rays[..n],
-                &mut samplers[..n],
-                &reference,
-                &mut colours[..n],
-                &mut stats.rays,
-                halt,
-            );
-            // In sample order, as one at a time would add them.
-            for (i, &c) in colours[..n].iter().enumerate() {
-                add_sample(&mut row, &mut stats, x, start + i as u32, c);
-            }
-            start += n as u32;
+            let end = samples.end.min(start + PATHS as u32);
+            let group = (&[(x, column)][..], start..end);
+            paths.trace(scene, y, group, &reference, &mut row, &mut stats, halt);
+            start = end;
         }
     }
     stats
+}
+
+/// The sampler of the pixel in column `column` of image row `y`.
+#[inline(always)]
+fn pixel_sampler(scene: &Scene, column: u32, y: u32) -> PixelSampler {
+    let s = &scene.settings;
+    let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
+    PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel)
+}
+
+/// Room for up to [`PATHS`] camera rays traced side by side
+/// ([`trace_paths`]), with their samplers and colours.
+struct SideBySide {
+    rays: [Ray; PATHS],
+    samplers: [PixelSample; PATHS],
+    colours: [Color; PATHS],
+}
+
+impl SideBySide {
+    #[inline(always)]
+    fn new() -> Self {
+        SideBySide {
+            rays: [Ray::new(Vec3::ZERO, Vec3::X); PATHS],
+            samplers: [const { PixelSample::placeholder() }; PATHS],
+            colours: [Color::ZERO; PATHS],
+        }
+    }
+
+    /// Traces samples `samples` of each pixel `(x, column)` of `pixels` (of
+    /// image row `y`; at most [`PATHS`] paths in all) side by side, and adds
+    /// each pixel's to `row` in sample order, as one at a time would.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &mut self,
+        scene: &Scene,
+        y: u32,
+        (pixels, samples): (&[(usize, u32)], Range<u32>),
+        reference: &Ray,
+        row: &mut RowMut,
+        stats: &mut RenderStats,
+        halt: &Halt,
+    ) {
+        let mut n = 0;
+        for &(_, column) in pixels {
+            let pixel_sampler = pixel_sampler(scene, column, y);
+            for index in samples.clone() {
+                (self.rays[n], self.samplers[n]) =
+                    camera_sample(scene, column, y, &pixel_sampler, index);
+                n += 1;
+            }
+        }
+        trace_paths(
+            scene,
+            &mut self.rays[..n],
+            &mut self.samplers[..n],
+            reference,
+            &mut self.colours[..n],
+            &mut stats.rays,
+            halt,
+        );
+        let colours = self.colours[..n].chunks(samples.len().max(1));
+        for (&(x, _), colours) in pixels.iter().zip(colours) {
+            for (index, &c) in samples.clone().zip(colours) {
+                add_sample(row, stats, x, index, c);
+            }
+        }
+    }
 }
 
 /// Adds sample `index` of pixel `x` to `row` and counts it in `stats`, as
