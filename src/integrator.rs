@@ -129,6 +129,10 @@ fn step(
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }
+    // The last segment's bounce could only start a ray that is never traced.
+    if depth + 1 >= scene.settings.max_depth {
+        return Step::Done(path.radiance);
+    }
     let wo = -ray.direction;
     let Some(bsdf) = material.bsdf(&record, wo, &scene.textures) else {
         return Step::Done(path.radiance);
