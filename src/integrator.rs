@@ -569,7 +569,7 @@ mod tests {
                     let (x, y) = (pixel % 24, (pixel / 24).min(height - 1));
                     let mut rays = Vec::new();
                     let mut samplers = Vec::new();
-                    let pixel_sampler = PixelSampler::new(kind, 7, u64::from(pixel), 64);
+                    let pixel_sampler = PixelSampler::new(kind, 7, (x, y), 24, 64);
                     for sample in 0..n as u32 {
                         let (mut sampler, (dx, dy)) = pixel_sampler.start(sample);
                         rays.push(scene.camera.ray(x, y, dx, dy, &mut sampler));

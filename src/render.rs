@@ -290,8 +290,7 @@ fn render_row_generic(
 #[inline(always)]
 fn pixel_sampler(scene: &Scene, column: u32, y: u32) -> PixelSampler {
     let s = &scene.settings;
-    let pixel = u64::from(y) * u64::from(s.width) + u64::from(column);
-    PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel)
+    PixelSampler::new(s.sampler, s.seed, (column, y), s.width, s.samples_per_pixel)
 }
 
 /// Room for up to [`PATHS`] camera rays traced side by side
@@ -483,8 +482,7 @@ mod tests {
                     let mut row = alone.rows_mut().collect::<Vec<_>>().pop().unwrap();
                     let mut expected = RenderStats::default();
                     for x in (0..width).filter(|&x| active[x]) {
-                        let pixel = u64::from(y) * u64::from(s.width) + x as u64;
-                        let ps = PixelSampler::new(s.sampler, s.seed, pixel, s.samples_per_pixel);
+                        let ps = pixel_sampler(&scene, x as u32, y);
                         for index in samples.clone() {
                             let (ray, mut sampler) = camera_sample(&scene, x as u32, y, &ps, index);
                             let c = crate::integrator::trace_path(

@@ -9,6 +9,15 @@ use lumen::render::{render, render_samples};
 use lumen::sampler::{Dim, PixelSample, PixelSampler, Sampler, SamplerKind};
 use lumen::scene::Scene;
 
+/// The width of the image the tests' pixel indices are in.
+const WIDTH: u32 = 128;
+
+/// Pixel `pixel` (row-major) of an image [`WIDTH`] wide.
+fn at(pixel: u64) -> (u32, u32) {
+    let w = u64::from(WIDTH);
+    ((pixel % w) as u32, (pixel / w) as u32)
+}
+
 /// Every dimension a path draws, in the order a path with a light sample
 /// at each bounce would draw them.
 const BOUNCE_DIMS: [Dim; 6] = [
@@ -63,10 +72,14 @@ fn every_dimension_is_uniform_and_unrelated_to_the_others() {
     // mean of 1/2 within 5 standard errors of independent points (stratified
     // points only do better). Each pair of dimensions: correlation within 5
     // standard errors of 0 (1/√n).
-    for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
+    for kind in [
+        SamplerKind::Sobol,
+        SamplerKind::ZSobol,
+        SamplerKind::Independent,
+    ] {
         let mut columns: Vec<Vec<f64>> = Vec::new();
         for pixel in 0..4096u64 {
-            let sampler = PixelSampler::new(kind, 5, pixel, 16);
+            let sampler = PixelSampler::new(kind, 5, at(pixel), WIDTH, 16);
             for index in 0..16 {
                 let values = draws(&sampler, index);
                 columns.resize(values.len(), Vec::new());
@@ -115,7 +128,7 @@ fn neighbouring_pixels_errors_are_unrelated() {
     let (width, height) = (128u64, 128u64);
     for kind in [SamplerKind::Sobol, SamplerKind::Stratified] {
         let error = |pixel: u64| {
-            let sampler = PixelSampler::new(kind, 9, pixel, 4);
+            let sampler = PixelSampler::new(kind, 9, at(pixel), WIDTH, 4);
             let sum: f64 = (0..4)
                 .map(|i| {
                     let (_, (dx, dy)) = sampler.start(i);
@@ -141,33 +154,78 @@ fn neighbouring_pixels_errors_are_unrelated() {
     }
 }
 
+/// Whether `points` (2^k of them, in [0, 1)²) put one in each cell of each
+/// 2^a × 2^(k−a) grid: a (0, k, 2)-net.
+fn is_net(points: &[(f32, f32)]) -> bool {
+    let k = points.len().trailing_zeros();
+    (0..=k).all(|a| {
+        let (nx, ny) = (1u32 << a, 1u32 << (k - a));
+        let mut seen = vec![false; points.len()];
+        points.iter().all(|&(x, y)| {
+            let cell = (x * nx as f32) as usize * ny as usize + (y * ny as f32) as usize;
+            !std::mem::replace(&mut seen[cell], true)
+        })
+    })
+}
+
+/// The positions in their pixel of samples `samples` of pixel `(x, y)`.
+fn positions(sampler: &PixelSampler, samples: std::ops::Range<u32>) -> Vec<(f32, f32)> {
+    samples
+        .map(|i| {
+            let (_, (dx, dy)) = sampler.start(i);
+            (dx + 0.5, dy + 0.5)
+        })
+        .collect()
+}
+
 #[test]
 fn sobol_points_of_a_pixel_fill_every_elementary_interval() {
     // The first 2^k positions of a pixel put one sample in each cell of each
     // 2^a × 2^(k−a) grid, whatever the pixel and seed.
-    for pixel in [0u64, 1, 77, 123_456] {
-        for seed in [0u64, 3] {
-            let sampler = PixelSampler::new(SamplerKind::Sobol, seed, pixel, 64);
-            let points: Vec<(f32, f32)> = (0..64)
-                .map(|i| {
-                    let (_, (dx, dy)) = sampler.start(i);
-                    (dx + 0.5, dy + 0.5)
-                })
-                .collect();
-            for k in 0..=6u32 {
-                for a in 0..=k {
-                    let (nx, ny) = (1u32 << a, 1u32 << (k - a));
-                    let mut seen = vec![false; 1 << k];
-                    for &(x, y) in &points[..1 << k] {
-                        let cell =
-                            (x * nx as f32) as usize * ny as usize + (y * ny as f32) as usize;
-                        assert!(
-                            !std::mem::replace(&mut seen[cell], true),
-                            "pixel {pixel}, seed {seed}: two of the first {} samples in one {nx}×{ny} cell",
-                            1 << k
-                        );
-                    }
+    for kind in [SamplerKind::Sobol, SamplerKind::ZSobol] {
+        for pixel in [0u64, 1, 77, 123_456] {
+            for seed in [0u64, 3] {
+                let sampler = PixelSampler::new(kind, seed, at(pixel), WIDTH, 64);
+                let points = positions(&sampler, 0..64);
+                for k in 0..=6u32 {
+                    assert!(
+                        is_net(&points[..1 << k]),
+                        "{kind:?}, pixel {pixel}, seed {seed}: the first {} samples",
+                        1 << k
+                    );
                 }
+            }
+        }
+    }
+}
+
+#[test]
+fn zsobol_squares_of_pixels_fill_every_elementary_interval_together() {
+    // A 2^j × 2^j square of pixels (aligned) at 16 spp: their positions in
+    // their pixels, together, are a (0, 4 + 2j, 2)-net. With `sobol` they
+    // are not.
+    for seed in [0u64, 5] {
+        for j in 1..=3u32 {
+            let side = 1 << j;
+            for (sx, sy) in [(0u32, 0u32), (8, 24), (40, 16)] {
+                let square = |kind| {
+                    let mut points = Vec::new();
+                    for y in sy..sy + side {
+                        for x in sx..sx + side {
+                            let sampler = PixelSampler::new(kind, seed, (x, y), 64, 16);
+                            points.extend(positions(&sampler, 0..16));
+                        }
+                    }
+                    points
+                };
+                assert!(
+                    is_net(&square(SamplerKind::ZSobol)),
+                    "seed {seed}, {side}×{side} at ({sx}, {sy})"
+                );
+                assert!(
+                    !is_net(&square(SamplerKind::Sobol)),
+                    "sobol, {side}×{side} at ({sx}, {sy})"
+                );
             }
         }
     }
@@ -188,7 +246,11 @@ fn every_sampler_converges_to_the_same_image() {
     // of field, glass, fuzzy metal and the notes' cube bounce.
     for name in ["depth-of-field", "metal-fuzz-0.5", "bounce-cube"] {
         let reference = pixel_stats(&scene_with(name, 24, 96, 1, SamplerKind::Independent));
-        for kind in [SamplerKind::Sobol, SamplerKind::Stratified] {
+        for kind in [
+            SamplerKind::Sobol,
+            SamplerKind::ZSobol,
+            SamplerKind::Stratified,
+        ] {
             let other = pixel_stats(&scene_with(name, 24, 96, 2, kind));
             let (worst, noisy) =
                 assert_pixels_agree(&format!("{name} {kind:?}"), &reference, &other, 5.0);
@@ -208,7 +270,7 @@ fn every_sampler_converges_to_the_same_image() {
 }
 
 #[test]
-fn sobol_renders_are_less_noisy_than_independent_ones() {
+fn sobol_and_zsobol_renders_are_less_noisy_than_independent_ones() {
     // The point of the sampler: on the cover's spheres the same samples give
     // less variance. Measured as (A − B)²/2 between two seeds; at 64 spp
     // Sobol's is about a third of independent sampling's, so "below two
@@ -219,32 +281,220 @@ fn sobol_renders_are_less_noisy_than_independent_ones() {
             .into();
         lumen::bench::efficiency::variance_between(&films[0], &films[1])
     };
-    let (sobol, independent) = (
-        variance(SamplerKind::Sobol),
-        variance(SamplerKind::Independent),
+    let independent = variance(SamplerKind::Independent);
+    for kind in [SamplerKind::Sobol, SamplerKind::ZSobol] {
+        let v = variance(kind);
+        assert!(
+            v < 0.67 * independent,
+            "{kind:?} variance {v} vs independent {independent}"
+        );
+    }
+}
+
+#[test]
+fn sobol_and_zsobol_renders_are_bit_identical_across_threads_and_passes() {
+    // 37 samples: not a power of two, and passes that split the nets.
+    for kind in [SamplerKind::Sobol, SamplerKind::ZSobol] {
+        let scene = scene_with("cover", 40, 37, 4, kind);
+        let (whole, stats) = render_with_threads(&scene, 1);
+        for threads in [2, 3] {
+            assert!(
+                render_with_threads(&scene, threads).0 == whole,
+                "{kind:?}, {threads} threads"
+            );
+        }
+        for split in [1, 16, 33] {
+            let mut film = Film::new(scene.settings.width, scene.settings.height);
+            let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
+            passes.add(render_samples(&scene, &mut film, split..37, &|_| {}));
+            assert!(film == whole, "{kind:?}: 0..{split} then {split}..37");
+            assert_eq!(passes, stats);
+        }
+    }
+}
+
+/// The error of each pixel of a `size`×`size` image estimating the mean of
+/// f(u, v) = u·v + sin(6u)·cos(4v) over its position in the pixel with `spp`
+/// samples (render seed `seed`), row-major.
+fn pixel_errors(kind: SamplerKind, size: u32, spp: u32, seed: u64) -> Vec<f64> {
+    let f = |u: f64, v: f64| u * v + (6.0 * u).sin() * (4.0 * v).cos();
+    // ∫∫ u·v = 1/4; ∫ sin(6u) du = (1 − cos 6)/6; ∫ cos(4v) dv = sin(4)/4.
+    let exact = 0.25 + (1.0 - 6f64.cos()) / 6.0 * 4f64.sin() / 4.0;
+    let mut errors = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            let sampler = PixelSampler::new(kind, seed, (x, y), size, spp);
+            let sum: f64 = (0..spp)
+                .map(|i| {
+                    let (_, (dx, dy)) = sampler.start(i);
+                    f(f64::from(dx) + 0.5, f64::from(dy) + 0.5)
+                })
+                .sum();
+            errors.push(sum / f64::from(spp) - exact);
+        }
+    }
+    errors
+}
+
+/// The correlation of each pixel's error with its right-hand and its lower
+/// neighbour's, over `seeds` renders of a 64×64 image at `spp`.
+fn neighbour_correlations(kind: SamplerKind, spp: u32, seeds: u64) -> (f64, f64) {
+    let size = 64usize;
+    let (mut a, mut right, mut b, mut below) = (vec![], vec![], vec![], vec![]);
+    for seed in 0..seeds {
+        let e = pixel_errors(kind, size as u32, spp, seed);
+        for y in 0..size {
+            for x in 0..size {
+                if x + 1 < size {
+                    a.push(e[y * size + x]);
+                    right.push(e[y * size + x + 1]);
+                }
+                if y + 1 < size {
+                    b.push(e[y * size + x]);
+                    below.push(e[(y + 1) * size + x]);
+                }
+            }
+        }
+    }
+    (correlation(&a, &right), correlation(&b, &below))
+}
+
+#[test]
+fn zsobol_neighbours_errors_cancel_alike_across_and_down() {
+    // Blue noise: a pixel's error and its neighbour's are of opposite signs
+    // more often than not, as much along rows as along columns; with
+    // `sobol` they are unrelated. n ≈ 16,000 pairs: 5/√n ≈ 0.04.
+    let (across, down) = neighbour_correlations(SamplerKind::ZSobol, 4, 4);
+    eprintln!("zsobol: neighbours' errors correlate {across:.3} across, {down:.3} down");
+    assert!(across < -0.07 && down < -0.07, "zsobol: {across}, {down}");
+    assert!(
+        (across - down).abs() < 0.04,
+        "zsobol anisotropic: {across}, {down}"
+    );
+    let (across, down) = neighbour_correlations(SamplerKind::Sobol, 4, 4);
+    assert!(
+        across.abs() < 0.04 && down.abs() < 0.04,
+        "sobol: {across}, {down}"
+    );
+}
+
+/// The radially averaged power spectrum of the pixels' errors over `seeds`
+/// 64×64 images at `spp`, normalised by the errors' variance (white noise
+/// is 1 at every frequency): bands of radius 0–4, 4–8, …, 28–32 cycles per
+/// image.
+fn error_spectrum(kind: SamplerKind, spp: u32, seeds: u64) -> Vec<f64> {
+    let n = 64usize;
+    let mut power = vec![0.0; n * n];
+    let mut variance = 0.0;
+    for seed in 0..seeds {
+        let e = pixel_errors(kind, n as u32, spp, seed);
+        let mean = e.iter().sum::<f64>() / e.len() as f64;
+        variance += e.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / e.len() as f64;
+        // The 2-D discrete Fourier transform, rows then columns.
+        let twiddle = |k: usize| {
+            let a = -2.0 * std::f64::consts::PI * k as f64 / n as f64;
+            (a.cos(), a.sin())
+        };
+        let mut rows = vec![(0.0, 0.0); n * n];
+        for y in 0..n {
+            for k in 0..n {
+                let (mut re, mut im) = (0.0, 0.0);
+                for x in 0..n {
+                    let (c, s) = twiddle(k * x % n);
+                    re += (e[y * n + x] - mean) * c;
+                    im += (e[y * n + x] - mean) * s;
+                }
+                rows[y * n + k] = (re, im);
+            }
+        }
+        for kx in 0..n {
+            for ky in 0..n {
+                let (mut re, mut im) = (0.0, 0.0);
+                for y in 0..n {
+                    let (c, s) = twiddle(ky * y % n);
+                    let (a, b) = rows[y * n + kx];
+                    re += a * c - b * s;
+                    im += a * s + b * c;
+                }
+                power[ky * n + kx] += (re * re + im * im) / (n * n) as f64;
+            }
+        }
+    }
+    let mut bands = [(0.0, 0usize); 8];
+    for ky in 0..n {
+        for kx in 0..n {
+            // Frequencies from −n/2 to n/2 − 1 cycles per image.
+            let f = |k: usize| {
+                if k < n / 2 {
+                    k as f64
+                } else {
+                    k as f64 - n as f64
+                }
+            };
+            let r = f(kx).hypot(f(ky));
+            if (kx, ky) != (0, 0) && r < 32.0 {
+                let band = &mut bands[(r / 4.0) as usize];
+                band.0 += power[ky * n + kx];
+                band.1 += 1;
+            }
+        }
+    }
+    bands
+        .iter()
+        .map(|&(p, count)| p / count as f64 / variance)
+        .collect()
+}
+
+#[test]
+fn zsobol_errors_are_blue_noise() {
+    // The error's power at the lowest frequencies is a fraction of white
+    // noise's, and rises towards the highest; `sobol`'s is flat.
+    // Each band holds ≥ 48 frequencies × 8 images, so white noise's
+    // estimate has a relative standard deviation ≤ 1/√384 ≈ 0.05: 0.8–1.2
+    // is four of them.
+    let spectrum = error_spectrum(SamplerKind::ZSobol, 4, 8);
+    let white = error_spectrum(SamplerKind::Sobol, 4, 8);
+    eprintln!("error spectrum, zsobol: {spectrum:.3?}\nerror spectrum, sobol: {white:.3?}");
+    assert!(
+        spectrum[0] < 0.2 && spectrum[7] > 1.1,
+        "zsobol: {spectrum:.3?}"
     );
     assert!(
-        sobol < 0.67 * independent,
-        "Sobol variance {sobol} vs independent {independent}"
+        spectrum.windows(2).all(|w| w[0] < w[1]),
+        "zsobol: {spectrum:.3?}"
+    );
+    assert!(
+        white.iter().all(|p| (0.8..1.2).contains(p)),
+        "sobol: {white:.3?}"
     );
 }
 
 #[test]
-fn sobol_renders_are_bit_identical_across_threads_and_passes() {
-    // 37 samples: not a power of two, and passes that split the nets.
-    let scene = scene_with("cover", 40, 37, 4, SamplerKind::Sobol);
-    let (whole, stats) = render_with_threads(&scene, 1);
-    for threads in [2, 3] {
+fn zsobol_pixels_have_sobols_variance() {
+    // The same kind of net in every pixel, so the same error per pixel on
+    // average over renders: the mean squared error over 1,024 images of
+    // 8 × 8 pixels at 4 and 16 spp within 10% of `sobol`'s (measured 1.005
+    // and 1.013 times it). One image is not enough: all of a zsobol image's
+    // pixels share their scrambles, so its mean squared error varies from
+    // seed to seed by tens of percent (64 × 64 pixels, 8 seeds: 1.14 and
+    // 0.74 times sobol's).
+    for spp in [4, 16] {
+        let mse = |kind| {
+            let e: Vec<f64> = (0..1024)
+                .flat_map(|s| pixel_errors(kind, 8, spp, s))
+                .collect();
+            e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64
+        };
+        let (z, s) = (mse(SamplerKind::ZSobol), mse(SamplerKind::Sobol));
+        eprintln!("{spp} spp: zsobol {z:e}, sobol {s:e}");
         assert!(
-            render_with_threads(&scene, threads).0 == whole,
-            "{threads} threads"
+            (z / s - 1.0).abs() < 0.1,
+            "{spp} spp: zsobol {z:e}, sobol {s:e}"
         );
-    }
-    for split in [1, 16, 33] {
-        let mut film = Film::new(scene.settings.width, scene.settings.height);
-        let mut passes = render_samples(&scene, &mut film, 0..split, &|_| {});
-        passes.add(render_samples(&scene, &mut film, split..37, &|_| {}));
-        assert!(film == whole, "0..{split} then {split}..37");
-        assert_eq!(passes, stats);
+        let independent = mse(SamplerKind::Independent);
+        assert!(
+            z < 0.5 * independent,
+            "{spp} spp: zsobol {z:e}, independent {independent:e}"
+        );
     }
 }

@@ -9,7 +9,11 @@ use lumen::scene::Sampling;
 
 /// The offset from the pixel's centre of sample `index` of `spp` of `pixel`.
 fn pixel_offset(kind: Sampling, seed: u64, pixel: u64, index: u32, spp: u32) -> (f32, f32) {
-    PixelSampler::new(kind, seed, pixel, spp).start(index).1
+    let width = 4096;
+    let at = ((pixel % width) as u32, (pixel / width) as u32);
+    PixelSampler::new(kind, seed, at, width as u32, spp)
+        .start(index)
+        .1
 }
 
 /// Tolerance on stratum boundaries: the offset is computed in f32, so a

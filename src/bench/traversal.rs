@@ -49,8 +49,7 @@ pub fn record_rays(scene: &Scene, spp: u32, limit: usize) -> Result<RecordedRays
     };
     for y in 0..s.height {
         for x in 0..s.width {
-            let pixel = u64::from(y) * u64::from(s.width) + u64::from(x);
-            let pixel_sampler = PixelSampler::new(s.sampler, s.seed, pixel, spp);
+            let pixel_sampler = PixelSampler::new(s.sampler, s.seed, (x, y), s.width, spp);
             for index in 0..spp {
                 if recorded.rays.len() == limit {
                     return Ok(recorded);

@@ -20,11 +20,17 @@
 //! - `center`: independent, with every sample through the pixel's centre.
 //! - `sobol`: Owen-scrambled Sobol points (see [`sobol`]), scrambled
 //!   afresh for every pixel and dimension.
+//! - `zsobol`: the same points, but each pixel's samples are a block of one
+//!   sequence shared by the whole image, the pixels taken in Morton (Z)
+//!   order (see [`zsobol`]): neighbouring pixels' samples fill each other's
+//!   gaps, so their errors cancel and what is left of the noise is
+//!   spread as blue noise, at the same cost and variance per pixel.
 //!
 //! A plain [`Rng`] is a sampler too (an independent one), for tests and
 //! tools that need random directions outside a render.
 
 pub mod sobol;
+pub mod zsobol;
 
 use crate::rng::{mix64, Rng};
 pub use crate::scene::Sampling as SamplerKind;
@@ -131,19 +137,28 @@ pub struct PixelSampler {
     spp: u32,
     /// The pixel's stratum permutation key, or its scrambling seed.
     key: u64,
+    /// The index its sample 0 has in the Sobol sequence it draws from: 0,
+    /// except with `zsobol` (see [`zsobol::pixel_start`]).
+    first: u32,
 }
 
 impl PixelSampler {
-    /// The sampler of `pixel` (row-major index) in a render of `spp` samples
-    /// per pixel with seed `seed`.
+    /// The sampler of pixel `(x, y)` of an image `width` pixels wide in a
+    /// render of `spp` samples per pixel with seed `seed`.
     #[inline]
-    pub fn new(kind: SamplerKind, seed: u64, pixel: u64, spp: u32) -> Self {
+    pub fn new(kind: SamplerKind, seed: u64, (x, y): (u32, u32), width: u32, spp: u32) -> Self {
+        let pixel = u64::from(y) * u64::from(width) + u64::from(x);
+        let (key, first) = match kind {
+            SamplerKind::ZSobol => zsobol::pixel_start(seed, (x, y), spp),
+            _ => (pixel_key(seed, pixel), 0),
+        };
         Self {
             kind,
             seed,
             pixel,
             spp,
-            key: pixel_key(seed, pixel),
+            key,
+            first,
         }
     }
 
@@ -151,7 +166,8 @@ impl PixelSampler {
     /// offset in [-0.5, 0.5)² from the pixel's centre (drawn first).
     #[inline(always)]
     pub fn start(&self, index: u32) -> (PixelSample, (f32, f32)) {
-        let sobol = self.kind == SamplerKind::Sobol;
+        let sobol = matches!(self.kind, SamplerKind::Sobol | SamplerKind::ZSobol);
+        debug_assert!(index < self.spp.max(1), "sample {index} of {}", self.spp);
         let mut sample = PixelSample {
             rng: if sobol {
                 Rng::placeholder()
@@ -160,7 +176,9 @@ impl PixelSampler {
             },
             sobol,
             key: self.key,
-            index,
+            // A zsobol pixel's samples are the block of 2^k indices from
+            // `first` (spp ≤ 2^k), so `|` is `+`.
+            index: self.first | index,
             bounce: 0,
             used: 0,
             again: 0,
@@ -175,7 +193,7 @@ impl PixelSampler {
                 let j = sample.rng.get_2d(Dim::Pixel);
                 stratified_offset(index, self.spp, self.key, j)
             }
-            SamplerKind::Sobol => {
+            SamplerKind::Sobol | SamplerKind::ZSobol => {
                 let [jx, jy] = sample.get_2d(Dim::Pixel);
                 (jx - 0.5, jy - 0.5)
             }
@@ -191,9 +209,9 @@ pub struct PixelSample {
     /// draw from it).
     rng: Rng,
     sobol: bool,
-    /// The pixel's scrambling seed.
+    /// The pixel's scrambling seed (with `zsobol`, the image's).
     key: u64,
-    /// The sample's index in its pixel.
+    /// The sample's index in its pixel's Sobol sequence.
     index: u32,
     /// 0 for the camera's dimensions, 1 + b for bounce b's.
     bounce: u32,

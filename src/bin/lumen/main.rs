@@ -170,8 +170,10 @@ enum ScenesCommand {
 /// The samplers, as `--sampler` names them.
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum SamplerArg {
-    /// Owen-scrambled Sobol points: the least noise for the samples.
+    /// Owen-scrambled Sobol points, a sequence per pixel: little noise, spread as white noise.
     Sobol,
+    /// Sobol points over the pixels in Morton order: as little noise, spread as blue noise.
+    Zsobol,
     /// Independent random numbers.
     Independent,
     /// Independent, with the pixel's samples stratified over a √N×√N grid.
@@ -184,6 +186,7 @@ impl From<SamplerArg> for Sampling {
     fn from(s: SamplerArg) -> Self {
         match s {
             SamplerArg::Sobol => Sampling::Sobol,
+            SamplerArg::Zsobol => Sampling::ZSobol,
             SamplerArg::Independent => Sampling::Independent,
             SamplerArg::Stratified => Sampling::Stratified,
             SamplerArg::Center => Sampling::Center,
@@ -249,7 +252,7 @@ struct SettingArgs {
     /// Random seed, 0 to 2^63-1 (as in scene files).
     #[arg(long, value_parser = clap::value_parser!(u64).range(..=lumen::scene::desc::MAX_SEED))]
     seed: Option<u64>,
-    /// Where the random numbers come from [default: the scene's; `sobol`
+    /// Where the random numbers come from [default: the scene's; `zsobol`
     /// unless it says otherwise].
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
@@ -494,7 +497,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 if efficiency {
                     let samplers = match sampler {
                         Some(s) => vec![Sampling::from(s)],
-                        None => vec![Sampling::Independent, Sampling::Stratified, Sampling::Sobol],
+                        None => vec![
+                            Sampling::Independent,
+                            Sampling::Stratified,
+                            Sampling::Sobol,
+                            Sampling::ZSobol,
+                        ],
                     };
                     return efficiency_command(spp, runs, workload.as_deref(), &samplers);
                 }

@@ -179,7 +179,7 @@ impl Default for RenderDesc {
             samples_per_pixel: 100,
             max_depth: 50,
             seed: 0,
-            sampler: SamplingDesc::Sobol,
+            sampler: SamplingDesc::ZSobol,
             integrator: IntegratorDesc::Path,
             light_selection: LightSelection::Power,
             sample_background: None,
@@ -206,8 +206,13 @@ pub enum SamplingDesc {
     /// Independent, but the pixel's centre for every sample: no
     /// antialiasing (the notes' one-sample figures).
     Center,
-    /// Owen-scrambled Sobol points for every decision: the default.
+    /// Owen-scrambled Sobol points for every decision, a sequence per pixel.
     Sobol,
+    /// Sobol points as `Sobol`, each pixel's a block of one sequence over
+    /// the pixels in Morton order: the error spread as blue noise; the
+    /// default.
+    #[serde(rename = "zsobol")]
+    ZSobol,
 }
 
 /// How a path gathers light (see [`crate::integrator`]).

@@ -401,6 +401,7 @@ fn objects(n: &Node) -> Result<Vec<ObjectDesc>> {
 
 const SAMPLERS: &[(&str, SamplingDesc)] = &[
     ("sobol", SamplingDesc::Sobol),
+    ("zsobol", SamplingDesc::ZSobol),
     ("independent", SamplingDesc::Independent),
     ("stratified", SamplingDesc::Stratified),
     ("center", SamplingDesc::Center),
