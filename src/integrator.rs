@@ -92,7 +92,8 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 /// `hit` (or nothing, and the background lights it). The surface's emission
 /// is added to what the path gathered; its material absorbs the path or
 /// scatters it (bounce `depth`), multiplying the throughput by the sample's
-/// value. With the `path` integrator, a surface whose scattering has
+/// value, unless this is the path's last segment, whose bounce could only
+/// start a ray that is never traced. With the `path` integrator, a surface whose scattering has
 /// a density (see [`Bsdf::has_density`]) also samples a light
 /// (next-event estimation): a shadow ray towards a point chosen on it, the
 /// light it brings weighted against the chance that the bounce would have

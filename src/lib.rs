@@ -21,7 +21,8 @@
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
 //! - [`sampler`]: the numbers behind every random decision of a path
-//!   (independent, stratified, Owen-scrambled Sobol); [`sampling`]: random
+//!   (independent, stratified, Owen-scrambled Sobol per pixel or over the
+//!   pixels in Morton order); [`sampling`]: random
 //!   points and directions made from them; [`rng`]: seeded random numbers.
 //! - [`render`]: every sample of every pixel, in parallel, deterministically.
 //! - [`film`] and [`output`]: accumulation, gamma, tone mapping, image files.

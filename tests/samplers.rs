@@ -337,44 +337,75 @@ fn pixel_errors(kind: SamplerKind, size: u32, spp: u32, seed: u64) -> Vec<f64> {
 }
 
 /// The correlation of each pixel's error with its right-hand and its lower
-/// neighbour's, over `seeds` renders of a 64×64 image at `spp`.
-fn neighbour_correlations(kind: SamplerKind, spp: u32, seeds: u64) -> (f64, f64) {
+/// neighbour's in one 64×64 image at `spp` with seed `seed`.
+fn neighbour_correlations(kind: SamplerKind, spp: u32, seed: u64) -> (f64, f64) {
     let size = 64usize;
     let (mut a, mut right, mut b, mut below) = (vec![], vec![], vec![], vec![]);
-    for seed in 0..seeds {
-        let e = pixel_errors(kind, size as u32, spp, seed);
-        for y in 0..size {
-            for x in 0..size {
-                if x + 1 < size {
-                    a.push(e[y * size + x]);
-                    right.push(e[y * size + x + 1]);
-                }
-                if y + 1 < size {
-                    b.push(e[y * size + x]);
-                    below.push(e[(y + 1) * size + x]);
-                }
+    let e = pixel_errors(kind, size as u32, spp, seed);
+    for y in 0..size {
+        for x in 0..size {
+            if x + 1 < size {
+                a.push(e[y * size + x]);
+                right.push(e[y * size + x + 1]);
+            }
+            if y + 1 < size {
+                b.push(e[y * size + x]);
+                below.push(e[(y + 1) * size + x]);
             }
         }
     }
     (correlation(&a, &right), correlation(&b, &below))
 }
 
+/// The mean of `values` and its standard error.
+fn mean_and_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
 #[test]
 fn zsobol_neighbours_errors_cancel_alike_across_and_down() {
     // Blue noise: a pixel's error and its neighbour's are of opposite signs
     // more often than not, as much along rows as along columns; with
-    // `sobol` they are unrelated. n ≈ 16,000 pairs: 5/√n ≈ 0.04.
-    let (across, down) = neighbour_correlations(SamplerKind::ZSobol, 4, 4);
-    eprintln!("zsobol: neighbours' errors correlate {across:.3} across, {down:.3} down");
-    assert!(across < -0.07 && down < -0.07, "zsobol: {across}, {down}");
-    assert!(
-        (across - down).abs() < 0.04,
-        "zsobol anisotropic: {across}, {down}"
+    // `sobol` they are unrelated. A zsobol image's pixels share their
+    // scrambles, so the images (16 seeds) are the independent trials: the
+    // bounds are 4 standard errors of the mean over them (measured: −0.144
+    // ± 0.009 across, −0.148 ± 0.009 down). The order of each square's
+    // pixels, which makes the two alike, is checked where it is made
+    // (`sampler::zsobol`'s tests): without it the correlations were −0.176
+    // ± 0.030 and −0.125 ± 0.021, a difference too small against the
+    // spread between images to show here.
+    let mut trials = [vec![], vec![], vec![], vec![]];
+    for seed in 0..16 {
+        let (across, down) = neighbour_correlations(SamplerKind::ZSobol, 4, seed);
+        let (white_across, white_down) = neighbour_correlations(SamplerKind::Sobol, 4, seed);
+        let values = [across, down, across - down, white_across + white_down];
+        for (t, v) in trials.iter_mut().zip(values) {
+            t.push(v);
+        }
+    }
+    let [across, down, difference, white] = trials.map(|t| mean_and_error(&t));
+    eprintln!(
+        "neighbours' error correlation (mean, standard error): zsobol {across:.3?} across, \
+         {down:.3?} down; sobol across + down {white:.3?}"
     );
-    let (across, down) = neighbour_correlations(SamplerKind::Sobol, 4, 4);
     assert!(
-        across.abs() < 0.04 && down.abs() < 0.04,
-        "sobol: {across}, {down}"
+        across.0 + 4.0 * across.1 < 0.0 && across.0 < -0.07,
+        "zsobol across: {across:?}"
+    );
+    assert!(
+        down.0 + 4.0 * down.1 < 0.0 && down.0 < -0.07,
+        "zsobol down: {down:?}"
+    );
+    assert!(
+        difference.0.abs() < 4.0 * difference.1,
+        "zsobol anisotropic: {difference:?}"
+    );
+    assert!(
+        white.0.abs() < 4.0 * white.1,
+        "sobol's neighbours correlate: {white:?}"
     );
 }
 
@@ -449,22 +480,19 @@ fn error_spectrum(kind: SamplerKind, spp: u32, seeds: u64) -> Vec<f64> {
 fn zsobol_errors_are_blue_noise() {
     // The error's power at the lowest frequencies is a fraction of white
     // noise's, and rises towards the highest; `sobol`'s is flat.
-    // Each band holds ≥ 48 frequencies × 8 images, so white noise's
-    // estimate has a relative standard deviation ≤ 1/√384 ≈ 0.05: 0.8–1.2
-    // is four of them.
+    // The smallest ring holds 44 frequencies, half of them independent (a
+    // real image's spectrum is symmetric), × 8 images: white noise's
+    // estimate there has a relative standard deviation of 1/√176 ≈ 0.075,
+    // less in the larger rings, so 0.7–1.3 is four of them.
     let spectrum = error_spectrum(SamplerKind::ZSobol, 4, 8);
     let white = error_spectrum(SamplerKind::Sobol, 4, 8);
     eprintln!("error spectrum, zsobol: {spectrum:.3?}\nerror spectrum, sobol: {white:.3?}");
     assert!(
-        spectrum[0] < 0.2 && spectrum[7] > 1.1,
+        spectrum[0] < 0.2 && spectrum[1] < 0.5 && spectrum[7] > 1.1,
         "zsobol: {spectrum:.3?}"
     );
     assert!(
-        spectrum.windows(2).all(|w| w[0] < w[1]),
-        "zsobol: {spectrum:.3?}"
-    );
-    assert!(
-        white.iter().all(|p| (0.8..1.2).contains(p)),
+        white.iter().all(|p| (0.7..1.3).contains(p)),
         "sobol: {white:.3?}"
     );
 }

@@ -14,7 +14,7 @@
 # cycles_cornell.py; docs/peers.md, "Lights").
 #
 # CONFIG (default: all of them):
-#   lumen:SAMPLER[:RR]             lumen with --sampler SAMPLER (sobol, independent,
+#   lumen:SAMPLER[:RR]             lumen with --sampler SAMPLER (zsobol, sobol, independent,
 #                                  stratified; plain "lumen" is independent); RR off
 #                                  (the default: --integrator bsdf, no Russian
 #                                  roulette) or rr5 (--integrator path: roulette

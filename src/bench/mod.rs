@@ -66,6 +66,8 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
     desc.render.width = 400;
     desc.render.height = Some(400);
     desc.render.max_depth = 8;
+    // The sampler its throughput has always been measured with.
+    desc.render.sampler = crate::scene::Sampling::Sobol;
     desc.camera.vfov = 40.0;
     desc.camera.lookfrom = [0.0, 8.0, 22.0];
     desc.camera.lookat = [0.0, 4.5, 0.0];

@@ -9,8 +9,10 @@
 //! evenly.
 //!
 //! A render takes one [`PixelSample`] per camera sample, addressed by (render
-//! seed, pixel, sample index): whatever the thread count, however the samples
-//! are split into passes or runs, a sample draws exactly the same numbers.
+//! seed, pixel, sample index, and for `stratified` and `zsobol` the render's
+//! samples per pixel): whatever the thread count, however the samples are
+//! split into passes, runs, tiles or parts, a sample draws exactly the same
+//! numbers.
 //! The kinds ([`SamplerKind`]):
 //!
 //! - `independent`: a PCG stream per sample (see [`crate::rng`]); the
@@ -140,6 +142,9 @@ pub struct PixelSampler {
     /// The index its sample 0 has in the Sobol sequence it draws from: 0,
     /// except with `zsobol` (see [`zsobol::pixel_start`]).
     first: u32,
+    /// The bits of a sample's index within that sequence's block for the
+    /// pixel: all of them, except with `zsobol`.
+    mask: u32,
 }
 
 impl PixelSampler {
@@ -148,9 +153,12 @@ impl PixelSampler {
     #[inline]
     pub fn new(kind: SamplerKind, seed: u64, (x, y): (u32, u32), width: u32, spp: u32) -> Self {
         let pixel = u64::from(y) * u64::from(width) + u64::from(x);
-        let (key, first) = match kind {
-            SamplerKind::ZSobol => zsobol::pixel_start(seed, (x, y), spp),
-            _ => (pixel_key(seed, pixel), 0),
+        let (key, first, mask) = match kind {
+            SamplerKind::ZSobol => {
+                let (key, first) = zsobol::pixel_start(seed, (x, y), spp);
+                (key, first, zsobol::sample_mask(spp))
+            }
+            _ => (pixel_key(seed, pixel), 0, u32::MAX),
         };
         Self {
             kind,
@@ -159,6 +167,7 @@ impl PixelSampler {
             spp,
             key,
             first,
+            mask,
         }
     }
 
@@ -177,8 +186,9 @@ impl PixelSampler {
             sobol,
             key: self.key,
             // A zsobol pixel's samples are the block of 2^k indices from
-            // `first` (spp ≤ 2^k), so `|` is `+`.
-            index: self.first | index,
+            // `first` (spp ≤ 2^k), so `|` is `+`; the mask keeps a sample
+            // past spp (which no caller draws) in its own pixel's block.
+            index: self.first | (index & self.mask),
             bounce: 0,
             used: 0,
             again: 0,

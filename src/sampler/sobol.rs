@@ -15,8 +15,9 @@
 //!    independent of each other);
 //! 2. the point's coordinates are Owen-scrambled, each by its own seed, which
 //!    keeps the net's stratification and makes the point set a random one
-//!    (the estimate unbiased) whose error is unrelated to the neighbouring
-//!    pixels' (each pixel has its own seeds).
+//!    (the estimate unbiased) whose error, with the `sobol` sampler, is
+//!    unrelated to the neighbouring pixels' (each pixel has its own seeds;
+//!    the `zsobol` sampler shares them, see [`super::zsobol`]).
 //!
 //! An Owen scramble flips each bit of a coordinate (read as a binary
 //! fraction) depending on the bits above it. Hashing the bit-reversed value
