@@ -188,7 +188,8 @@ impl PixelSampler {
             // A zsobol pixel's samples are the block of 2^k indices from
             // `first` (spp ≤ 2^k), so `|` is `+`; the mask keeps a sample
             // past spp (which no caller draws) in its own pixel's block.
-            index: self.first | (index & self.mask),
+            // Kept bit-reversed, as the draws take it.
+            reversed_index: (self.first | (index & self.mask)).reverse_bits(),
             bounce: 0,
             used: 0,
             again: 0,
@@ -221,8 +222,8 @@ pub struct PixelSample {
     sobol: bool,
     /// The pixel's scrambling seed (with `zsobol`, the image's).
     key: u64,
-    /// The sample's index in its pixel's Sobol sequence.
-    index: u32,
+    /// The sample's index in its pixel's Sobol sequence, bit-reversed.
+    reversed_index: u32,
     /// 0 for the camera's dimensions, 1 + b for bounce b's.
     bounce: u32,
     /// The named slots of the current bounce drawn so far (bit per slot).
@@ -238,7 +239,7 @@ impl PixelSample {
             rng: Rng::placeholder(),
             sobol: false,
             key: 0,
-            index: 0,
+            reversed_index: 0,
             bounce: 0,
             used: 0,
             again: 0,
@@ -267,7 +268,7 @@ impl Sampler for PixelSample {
     fn get_1d(&mut self, dim: Dim) -> f32 {
         if self.sobol {
             let seed = self.dimension_seed(dim);
-            sobol::to_unit(sobol::sample_1d(self.index, seed))
+            sobol::to_unit(sobol::sample_1d(self.reversed_index, seed))
         } else {
             self.rng.get_1d(dim)
         }
@@ -277,7 +278,7 @@ impl Sampler for PixelSample {
     fn get_2d(&mut self, dim: Dim) -> [f32; 2] {
         if self.sobol {
             let seed = self.dimension_seed(dim);
-            sobol::sample_2d(self.index, seed).map(sobol::to_unit)
+            sobol::sample_2d(self.reversed_index, seed).map(sobol::to_unit)
         } else {
             self.rng.get_2d(dim)
         }

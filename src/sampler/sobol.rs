@@ -76,7 +76,38 @@ const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
     table
 };
 
+/// [`SOBOL1_REVERSED_BYTES`] for an index given bit-reversed: entry `[k][b]`
+/// is for reversed-index byte `k` of value `b`, i.e. index byte `3 − k` of
+/// value `b` reversed. The map from the reversed index to the reversed
+/// point is linear over GF(2) too, so [`sample_2d`] can take Sobol's
+/// dimension 1 straight from the shuffled index as it comes out of the
+/// scramble, bit-reversed, without reversing it first.
+const SOBOL1_FROM_REVERSED_BYTES: [[u32; 256]; 4] = {
+    let mut table = [[0u32; 256]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut b = 0;
+        while b < 256 {
+            table[k][b] = SOBOL1_REVERSED_BYTES[3 - k][(b as u8).reverse_bits() as usize];
+            b += 1;
+        }
+        k += 1;
+    }
+    table
+};
+
+/// Sobol dimension 1 of the index whose bit reversal is `r`, bit-reversed.
+#[inline(always)]
+fn sobol1_reversed_from_reversed(r: u32) -> u32 {
+    let [b0, b1, b2, b3] = r.to_le_bytes();
+    SOBOL1_FROM_REVERSED_BYTES[0][b0 as usize]
+        ^ SOBOL1_FROM_REVERSED_BYTES[1][b1 as usize]
+        ^ SOBOL1_FROM_REVERSED_BYTES[2][b2 as usize]
+        ^ SOBOL1_FROM_REVERSED_BYTES[3][b3 as usize]
+}
+
 /// Sobol dimension 1 of index `i`, bit-reversed.
+#[cfg(test)]
 #[inline(always)]
 fn sobol1_reversed(i: u32) -> u32 {
     let [b0, b1, b2, b3] = i.to_le_bytes();
@@ -107,8 +138,9 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 
 /// The index of sample `index` in the scrambled order of `seed`: a nested
 /// uniform shuffle, which maps each aligned block of 2^k indices onto an
-/// aligned block of 2^k.
-#[inline(always)]
+/// aligned block of 2^k. ([`sample_1d`] and [`sample_2d`] do it on the
+/// reversed index, without the reversals.)
+#[cfg(test)]
 fn shuffle(index: u32, seed: u32) -> u32 {
     // Each bit of the index flipped depending on the bits above it, so the
     // high bits (which block) depend on the high bits only.
@@ -123,28 +155,33 @@ fn seeds(seed: u64) -> [u32; 3] {
     [seed as u32, (seed >> 32) as u32, more as u32]
 }
 
-/// Point `index` of the 1-D sequence of `seed`, as a 32-bit binary fraction:
-/// `owen_scramble(sobol0(shuffle(index, s0)), s1)`, with the bit reversals
-/// that cancel left out (the scramble reverses its input, Sobol dimension 0
-/// is the reversed index), which halves the work (a reversal is a dozen
-/// instructions on x86-64).
+/// Point `index` of the 1-D sequence of `seed`, as a 32-bit binary fraction,
+/// given `reversed_index` = `index.reverse_bits()` (which a sample works out
+/// once for all its draws): `owen_scramble(sobol0(shuffle(index, s0)), s1)`,
+/// with the bit reversals that cancel left out (the scramble reverses its
+/// input, Sobol dimension 0 is the reversed index), which halves the work
+/// (a reversal is a dozen instructions on x86-64).
 #[inline(always)]
-pub fn sample_1d(index: u32, seed: u64) -> u32 {
+pub fn sample_1d(reversed_index: u32, seed: u64) -> u32 {
     let [s0, s1, _] = seeds(seed);
-    laine_karras(shuffle(index, s0), s1).reverse_bits()
+    let i = laine_karras(reversed_index, s0).reverse_bits();
+    laine_karras(i, s1).reverse_bits()
 }
 
-/// Point `index` of the 2-D sequence of `seed`, as 32-bit binary fractions:
-/// the Owen scrambles of Sobol dimensions 0 and 1 of the shuffled index,
-/// written, as in [`sample_1d`], without the reversals that cancel (which is
-/// why dimension 1's table holds reversed points).
+/// Point `index` of the 2-D sequence of `seed`, as 32-bit binary fractions,
+/// given `reversed_index` as [`sample_1d`] is: the Owen scrambles of Sobol
+/// dimensions 0 and 1 of the shuffled index, written, as there, without the
+/// reversals that cancel. Dimension 1 is read from the shuffled index while
+/// it is still reversed ([`SOBOL1_FROM_REVERSED_BYTES`]): three reversals a
+/// draw.
 #[inline(always)]
-pub fn sample_2d(index: u32, seed: u64) -> [u32; 2] {
+pub fn sample_2d(reversed_index: u32, seed: u64) -> [u32; 2] {
     let [s0, s1, s2] = seeds(seed);
-    let i = shuffle(index, s0);
+    let shuffled_reversed = laine_karras(reversed_index, s0);
+    let i = shuffled_reversed.reverse_bits();
     [
         laine_karras(i, s1).reverse_bits(),
-        laine_karras(sobol1_reversed(i), s2).reverse_bits(),
+        laine_karras(sobol1_reversed_from_reversed(shuffled_reversed), s2).reverse_bits(),
     ]
 }
 
@@ -185,6 +222,8 @@ mod tests {
     fn byte_tables_give_the_bit_by_bit_points() {
         for i in indices() {
             assert_eq!(sobol1_reversed(i).reverse_bits(), sobol1(i), "index {i}");
+            let from_reversed = sobol1_reversed_from_reversed(i.reverse_bits());
+            assert_eq!(from_reversed.reverse_bits(), sobol1(i), "index {i}");
         }
     }
 
@@ -195,8 +234,9 @@ mod tests {
             let [s0, s1, s2] = seeds(seed);
             let j = shuffle(i, s0);
             let expected = [owen_scramble(sobol0(j), s1), owen_scramble(sobol1(j), s2)];
-            assert_eq!(sample_2d(i, seed), expected, "index {i}");
-            assert_eq!(sample_1d(i, seed), expected[0], "index {i}");
+            let r = i.reverse_bits();
+            assert_eq!(sample_2d(r, seed), expected, "index {i}");
+            assert_eq!(sample_1d(r, seed), expected[0], "index {i}");
         }
     }
 
@@ -233,7 +273,9 @@ mod tests {
     fn scrambled_and_shuffled_prefixes_are_nets_for_every_seed() {
         for seed in 0..200u64 {
             let seed = mix64(seed);
-            let points: Vec<[u32; 2]> = (0..256u32).map(|i| sample_2d(i, seed)).collect();
+            let points: Vec<[u32; 2]> = (0..256u32)
+                .map(|i| sample_2d(i.reverse_bits(), seed))
+                .collect();
             for k in 0..=8 {
                 assert!(is_net(&points[..1 << k]), "seed {seed}: prefix 2^{k}");
             }
@@ -242,7 +284,7 @@ mod tests {
             for k in 0..=8u32 {
                 let mut cells: Vec<u32> = (0..1u32 << k)
                     .map(|i| {
-                        let x = sample_1d(i, seed);
+                        let x = sample_1d(i.reverse_bits(), seed);
                         if k == 0 {
                             0
                         } else {
