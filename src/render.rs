@@ -167,9 +167,11 @@ pub fn render_pixels(
 const ASK_EVERY_PIXELS: usize = 8;
 
 /// Samples a pixel from which a pass traces each pixel's paths on their
-/// own: fewer make no bundle (`integrator::MIN_BUNDLE`), and the camera
-/// rays of neighbouring pixels are traced side by side instead.
-const PIXELS_ALONE_FROM: usize = 4;
+/// own: fewer fill no bundle ([`LANES`] rays), and the camera rays of
+/// neighbouring pixels are traced side by side instead, as many pixels as
+/// [`PATHS`] paths hold, so that the bundles cut from them run across
+/// pixels.
+const PIXELS_ALONE_FROM: usize = LANES;
 
 /// Renders samples `samples` of every pixel of `row`, which holds the
 /// pixels of image row `at.1` from column `at.0` on (of those whose `active`
@@ -231,10 +233,10 @@ fn render_row_generic(
     let mut paths = SideBySide::new();
     let per_pixel = samples.len();
     if side_by_side && per_pixel < PIXELS_ALONE_FROM {
-        // Too few of a pixel's samples for a bundle: neighbours' camera
-        // rays, nearly as close, go side by side instead.
-        let neighbours = (LANES / per_pixel.max(1)).max(1);
-        let mut members = [(0usize, 0u32); LANES];
+        // Too few of a pixel's samples to fill a bundle: neighbours'
+        // camera rays, nearly as close, go side by side too.
+        let neighbours = (PATHS / per_pixel.max(1)).max(1);
+        let mut members = [(0usize, 0u32); PATHS];
         let mut x = 0;
         while x < width {
             let mut m = 0;
@@ -448,8 +450,9 @@ mod tests {
         (bits.collect(), counts.to_vec(), odd_counts.to_vec())
     }
 
-    /// A pass of fewer samples a pixel than make a bundle traces the paths
-    /// of neighbouring pixels side by side: every pixel gets, bit for bit,
+    /// A pass of fewer samples a pixel than fill a bundle traces the paths
+    /// of neighbouring pixels side by side (groups of up to 32 paths, so
+    /// 70 pixels wide makes several groups): every pixel gets, bit for bit,
     /// the samples its paths give one at a time, whichever pixels are left
     /// out (adaptive sampling) and however many samples the pass holds.
     #[test]
@@ -459,13 +462,13 @@ mod tests {
         bunny.render.height = Some(12);
         let moving = builtin::find("bouncing-spheres").expect("built-in").desc();
         for mut desc in [builtin::cover(), bunny, moving] {
-            desc.render.width = 21;
+            desc.render.width = 70;
             let scene = Scene::from_desc(&desc).expect("compiles");
             let s = &scene.settings;
             let width = s.width as usize;
             // Every third pixel left out, and the first.
             let active: Vec<bool> = (0..width).map(|x| x % 3 != 0 && x > 0).collect();
-            for samples in [0..1, 5..7, 2..5, 0..4] {
+            for samples in [0..1, 5..7, 2..5, 0..4, 3..8, 1..8] {
                 for y in [0, s.height / 2] {
                     let mut together = Film::with_halves(s.width, 1);
                     let row = together.rows_mut().collect::<Vec<_>>().pop().unwrap();
