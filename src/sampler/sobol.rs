@@ -172,7 +172,7 @@ pub fn sample_1d(reversed_index: u32, seed: u64) -> u32 {
 /// given `reversed_index` as [`sample_1d`] is: the Owen scrambles of Sobol
 /// dimensions 0 and 1 of the shuffled index, written, as there, without the
 /// reversals that cancel. Dimension 1 is read from the shuffled index while
-/// it is still reversed ([`SOBOL1_FROM_REVERSED_BYTES`]): three reversals a
+/// it is still reversed (byte tables of the reversed index): three reversals a
 /// draw.
 #[inline(always)]
 pub fn sample_2d(reversed_index: u32, seed: u64) -> [u32; 2] {
