@@ -96,25 +96,25 @@ const SOBOL1_FROM_REVERSED_BYTES: [[u32; 256]; 4] = {
     table
 };
 
+/// A map linear over GF(2) given by its value on each byte value of each of
+/// the four bytes (`table[k][b]` for byte `k` of value `b`), applied to `x`:
+/// the xor of its bytes' values.
+#[inline(always)]
+fn by_bytes(table: &[[u32; 256]; 4], x: u32) -> u32 {
+    let [b0, b1, b2, b3] = x.to_le_bytes();
+    table[0][b0 as usize] ^ table[1][b1 as usize] ^ table[2][b2 as usize] ^ table[3][b3 as usize]
+}
+
 /// Sobol dimension 1 of the index whose bit reversal is `r`, bit-reversed.
 #[inline(always)]
 fn sobol1_reversed_from_reversed(r: u32) -> u32 {
-    let [b0, b1, b2, b3] = r.to_le_bytes();
-    SOBOL1_FROM_REVERSED_BYTES[0][b0 as usize]
-        ^ SOBOL1_FROM_REVERSED_BYTES[1][b1 as usize]
-        ^ SOBOL1_FROM_REVERSED_BYTES[2][b2 as usize]
-        ^ SOBOL1_FROM_REVERSED_BYTES[3][b3 as usize]
+    by_bytes(&SOBOL1_FROM_REVERSED_BYTES, r)
 }
 
 /// Sobol dimension 1 of index `i`, bit-reversed.
 #[cfg(test)]
-#[inline(always)]
 fn sobol1_reversed(i: u32) -> u32 {
-    let [b0, b1, b2, b3] = i.to_le_bytes();
-    SOBOL1_REVERSED_BYTES[0][b0 as usize]
-        ^ SOBOL1_REVERSED_BYTES[1][b1 as usize]
-        ^ SOBOL1_REVERSED_BYTES[2][b2 as usize]
-        ^ SOBOL1_REVERSED_BYTES[3][b3 as usize]
+    by_bytes(&SOBOL1_REVERSED_BYTES, i)
 }
 
 /// A permutation of the 32-bit integers in which each output bit depends
