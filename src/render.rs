@@ -1,7 +1,6 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::film::{Film, RowMut};
-use crate::geometry::bvh_bundle::LANES;
 use crate::halt::Halt;
 use crate::integrator::{first_hit_view, trace_paths, PATHS};
 use crate::isa::Isa;
@@ -166,13 +165,6 @@ pub fn render_pixels(
 /// a few tens of nanoseconds.
 const ASK_EVERY_PIXELS: usize = 8;
 
-/// Samples a pixel from which a pass traces each pixel's paths on their
-/// own: fewer fill no bundle ([`LANES`] rays), and the camera rays of
-/// neighbouring pixels are traced side by side instead, as many pixels as
-/// [`PATHS`] paths hold, so that the bundles cut from them run across
-/// pixels.
-const PIXELS_ALONE_FROM: usize = LANES;
-
 /// Renders samples `samples` of every pixel of `row`, which holds the
 /// pixels of image row `at.1` from column `at.0` on (of those whose `active`
 /// flag is set, if given), with the code compiled for `isa` (which must be
@@ -227,62 +219,56 @@ fn render_row_generic(
     let s = &scene.settings;
     let mut stats = RenderStats::default();
     let width = row.sums.len();
-    // Path tracing runs a pixel's samples side by side (`trace_paths`); the
-    // debugging views trace one ray at a time.
-    let side_by_side = s.shading == Shading::Path;
-    let mut paths = SideBySide::new();
-    let per_pixel = samples.len();
-    if side_by_side && per_pixel < PIXELS_ALONE_FROM {
-        // Too few of a pixel's samples to fill a bundle: neighbours'
-        // camera rays, nearly as close, go side by side too.
-        let neighbours = (PATHS / per_pixel.max(1)).max(1);
-        let mut members = [(0usize, 0u32); PATHS];
-        let mut x = 0;
-        while x < width {
-            let mut m = 0;
-            while x < width && m < neighbours {
-                if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
-                    return stats;
-                }
-                if active.is_none_or(|a| a[x]) {
-                    members[m] = (x, x0 + x as u32);
-                    m += 1;
-                }
-                x += 1;
+    if s.shading != Shading::Path {
+        // The debugging views trace one ray at a time.
+        for x in 0..width {
+            if active.is_some_and(|a| !a[x]) {
+                continue;
             }
-            if m > 0 {
-                let reference = scene.camera.central_ray(members[m / 2].1, y);
-                let group = (&members[..m], samples.clone());
-                paths.trace(scene, y, group, &reference, &mut row, &mut stats, halt);
+            if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
+                break;
             }
-        }
-        return stats;
-    }
-    for x in 0..width {
-        if active.is_some_and(|a| !a[x]) {
-            continue;
-        }
-        if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
-            break;
-        }
-        // The pixel's column in the image, which addresses its samples.
-        let column = x0 + x as u32;
-        if !side_by_side {
+            // The pixel's column in the image, which addresses its samples.
+            let column = x0 + x as u32;
             let pixel_sampler = pixel_sampler(scene, column, y);
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
                 add_sample(&mut row, &mut stats, x, index, c);
             }
+        }
+        return stats;
+    }
+    // Path tracing runs [`PATHS`] paths side by side (`trace_paths`): a
+    // pixel's samples, in groups of that many, or when a pass holds fewer,
+    // the samples of as many neighbouring pixels as fit, so that the
+    // bundles cut from them stay full.
+    let per_group = (PATHS / samples.len().max(1)).max(1);
+    let chunk = PATHS / per_group;
+    let mut paths = SideBySide::new();
+    let mut members = [(0usize, 0u32); PATHS];
+    let mut x = 0;
+    while x < width {
+        let mut m = 0;
+        while x < width && m < per_group {
+            if x % ASK_EVERY_PIXELS == 0 && halt.asked() {
+                return stats;
+            }
+            if active.is_none_or(|a| a[x]) {
+                // With the pixel's column in the image, which addresses
+                // its samples.
+                members[m] = (x, x0 + x as u32);
+                m += 1;
+            }
+            x += 1;
+        }
+        if m == 0 {
             continue;
         }
-        let reference = scene.camera.central_ray(column, y);
-        let mut start = samples.start;
-        while start < samples.end {
-            let end = samples.end.min(start + PATHS as u32);
-            let group = (&[(x, column)][..], start..end);
+        let reference = scene.camera.central_ray(members[m / 2].1, y);
+        for start in samples.clone().step_by(chunk) {
+            let group = (&members[..m], start..samples.end.min(start + chunk as u32));
             paths.trace(scene, y, group, &reference, &mut row, &mut stats, halt);
-            start = end;
         }
     }
     stats
@@ -468,7 +454,7 @@ mod tests {
             let width = s.width as usize;
             // Every third pixel left out, and the first.
             let active: Vec<bool> = (0..width).map(|x| x % 3 != 0 && x > 0).collect();
-            for samples in [0..1, 5..7, 2..5, 0..4, 3..8, 1..8] {
+            for samples in [0..1, 5..7, 2..5, 0..4, 3..8, 1..8, 0..12, 3..43] {
                 for y in [0, s.height / 2] {
                     let mut together = Film::with_halves(s.width, 1);
                     let row = together.rows_mut().collect::<Vec<_>>().pop().unwrap();
