@@ -117,6 +117,9 @@ fn step(
         if let Some((_, bsdf_pdf)) = path.sampled_from {
             sky *= power_heuristic(bsdf_pdf, scene.lights.environment_pdf(ray.direction));
         }
+        if scene.lights.sources_seen() {
+            sky += path.throughput * discs_of_sky(scene, ray.direction, path.sampled_from);
+        }
         return Step::Done(path.radiance + sky);
     };
     let record = scene.record(ray, hit);
@@ -158,6 +161,23 @@ fn step(
         Ray::timed(record.spawn_origin(sample.wi), sample.wi, ray.time()),
         Some(hit),
     )
+}
+
+/// The radiance of the discs of the sky (directional lights with an
+/// angular radius) seen along unit `direction` by an escaping ray, each
+/// weighted, where the segment's start sampled a light (`sampled_from`),
+/// against the chance that it would have sampled that direction towards
+/// the disc.
+#[inline(never)]
+fn discs_of_sky(scene: &Scene, direction: Vec3, sampled_from: Option<(Point3, f32)>) -> Color {
+    scene
+        .lights
+        .seen_along(direction)
+        .map(|(radiance, light_pdf)| match sampled_from {
+            Some((_, bsdf_pdf)) => radiance * power_heuristic(bsdf_pdf, light_pdf),
+            None => radiance,
+        })
+        .sum()
 }
 
 /// The light a path brings back from an emitter it met at `record` (`hit`):
@@ -364,7 +384,12 @@ fn direct_light(
     if scene.occluded_leaving(&shadow, from, end) {
         return (Color::ZERO, true);
     }
-    let weight = power_heuristic(sample.pdf, scatter_pdf);
+    // No bounce finds a delta light: its sample has all the weight.
+    let weight = if sample.delta {
+        1.0
+    } else {
+        power_heuristic(sample.pdf, scatter_pdf)
+    };
     let mut light = sample.radiance * value * (weight / sample.pdf);
     if !scene.media.is_empty() {
         light *= scene.transmittance(&shadow, end);

@@ -14,10 +14,12 @@
 
 pub mod environment;
 mod rectangle;
+pub mod source;
 
 use rectangle::SphericalRectangle;
 
 pub use environment::{Environment, EnvironmentMap};
+pub use source::{LightDesc, LightSource};
 
 use crate::distribution::Distribution1D;
 use crate::geometry::Sphere;
@@ -182,8 +184,14 @@ pub struct LightSample {
     /// any occlusion).
     pub radiance: Color,
     /// The density of this direction per unit solid angle, including the
-    /// choice of the light.
+    /// choice of the light; for a delta light (`delta`), the chance of its
+    /// choice alone, and `radiance` is the irradiance it brings to a
+    /// surface facing it.
     pub pdf: f32,
+    /// Whether the light has a single direction here (a point, a spot, a
+    /// directional light without angular radius): no bounce can find it, so
+    /// the sample needs no weight against the bounces.
+    pub delta: bool,
 }
 
 /// How [`Lights`] chooses the light to sample.
@@ -209,9 +217,16 @@ pub struct Lights {
     surfaces: Vec<Surface>,
     /// The textures of textured lights.
     textures: Vec<Texture>,
-    /// The environment, chosen as light number `lights.len()`.
+    /// The lights that are no surface (point, spot, directional), chosen
+    /// as light numbers `lights.len()` on.
+    sources: Vec<LightSource>,
+    /// Whether any of `sources` can be seen by an escaping ray (a disc of
+    /// the sky).
+    sources_seen: bool,
+    /// The environment, chosen as light number `lights.len() +
+    /// sources.len()`.
     environment: Option<Environment>,
-    /// The choice of a light: `lights`, then the environment.
+    /// The choice of a light: `lights`, `sources`, then the environment.
     choice: Distribution1D,
 }
 
@@ -223,6 +238,26 @@ impl Lights {
     /// sheds any light the list is empty.
     pub fn new(
         lights: Vec<Light>,
+        textures: Vec<Texture>,
+        environment: Option<Environment>,
+        scene_radius: f32,
+        selection: LightSelection,
+    ) -> Self {
+        Self::with_sources(
+            lights,
+            Vec::new(),
+            textures,
+            environment,
+            scene_radius,
+            selection,
+        )
+    }
+
+    /// [`Lights::new`] with light `sources` too (point, spot and
+    /// directional lights), numbered after `lights`.
+    pub fn with_sources(
+        lights: Vec<Light>,
+        sources: Vec<LightSource>,
         textures: Vec<Texture>,
         environment: Option<Environment>,
         scene_radius: f32,
@@ -249,6 +284,7 @@ impl Lights {
                 .map(|l| l.power(&textures, grid))
                 .collect()
         };
+        powers.extend(sources.iter().map(|s| s.power(scene_radius)));
         powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
         let environment = environment.map(|(_, e)| e);
         if selection == LightSelection::Uniform {
@@ -269,6 +305,8 @@ impl Lights {
             surfaces: lights.iter().map(|l| Surface::of(&l.shape)).collect(),
             lights,
             textures,
+            sources_seen: sources.iter().any(LightSource::is_visible),
+            sources,
             environment,
             choice,
         }
@@ -298,6 +336,18 @@ impl Lights {
         let chance = self.choice.chance(i);
         let uv = sampler.get_2d(Dim::Light);
         let Some(light) = self.lights.get(i) else {
+            if let Some(source) = self.sources.get(i - self.lights.len()) {
+                let incident = source.illuminate(point, uv)?;
+                let pdf = chance * incident.pdf;
+                return (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
+                    point: incident.point,
+                    direction: incident.direction,
+                    distance: incident.distance,
+                    radiance: incident.radiance,
+                    pdf,
+                    delta: incident.delta,
+                });
+            }
             let sky = self.environment.as_ref()?.sample(uv)?;
             let pdf = chance * sky.pdf;
             if !(pdf > 0.0 && pdf.is_finite()) {
@@ -309,6 +359,7 @@ impl Lights {
                 distance: f32::INFINITY,
                 radiance: sky.radiance,
                 pdf,
+                delta: false,
             });
         };
         let surface = &self.surfaces[i];
@@ -343,6 +394,7 @@ impl Lights {
                 Color::ZERO
             },
             pdf,
+            delta: false,
         })
     }
 
@@ -369,9 +421,34 @@ impl Lights {
     #[inline]
     pub fn environment_pdf(&self, direction: Vec3) -> f32 {
         match &self.environment {
-            Some(sky) => self.choice.chance(self.lights.len()) * sky.pdf(direction),
+            Some(sky) => {
+                self.choice.chance(self.lights.len() + self.sources.len()) * sky.pdf(direction)
+            }
             None => 0.0,
         }
+    }
+
+    /// Whether an escaping ray can see any light that is no surface (a
+    /// disc of the sky): if not, [`Lights::seen_along`] finds nothing.
+    #[inline]
+    pub fn sources_seen(&self) -> bool {
+        self.sources_seen
+    }
+
+    /// The lights that are no surface an escaping ray sees along unit
+    /// `direction`: each one's radiance and the density, per unit solid
+    /// angle, with which [`Lights::sample`] picks that direction towards it
+    /// (its choice included).
+    pub fn seen_along(&self, direction: Vec3) -> impl Iterator<Item = (Color, f32)> + '_ {
+        let first = self.lights.len();
+        self.sources
+            .iter()
+            .enumerate()
+            .filter(|_| self.sources_seen)
+            .filter_map(move |(j, s)| {
+                let (radiance, pdf) = s.seen_along(direction)?;
+                Some((radiance, self.choice.chance(first + j) * pdf))
+            })
     }
 }
 

@@ -76,6 +76,7 @@ pub fn furnace_desc(
             material: "m".into(),
             transform: Vec::new(),
         }],
+        lights: Vec::new(),
     }
 }
 

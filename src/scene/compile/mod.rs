@@ -110,6 +110,15 @@ impl Scene {
             materials.push(compile_material(&field, m, &mut table, &mut sources)?);
         }
         let textures = table.textures;
+        let light_sources = desc
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                l.compile(&format!("lights[{i}]"))
+                    .map_err(|e| invalid(e.field, e.message))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let mut objects = Objects {
             desc,
             base,
@@ -174,8 +183,9 @@ impl Scene {
             .render
             .sample_background
             .unwrap_or(matches!(background, Environment::Map(_)));
-        let lights = Lights::new(
+        let lights = Lights::with_sources(
             lights,
+            light_sources,
             textures.clone(),
             sampled.then(|| background.clone()),
             world.bounding_radius(),

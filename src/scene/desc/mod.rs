@@ -6,6 +6,7 @@
 //! people write them; the renderer converts them to `f32` when it compiles the
 //! scene.
 
+pub use crate::light::source::{DirectionalLightDesc, LightDesc, PointLightDesc, SpotLightDesc};
 pub use crate::light::LightSelection;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -55,6 +56,10 @@ pub struct SceneDesc {
     /// The objects of the scene.
     #[serde(default)]
     pub objects: Vec<ObjectDesc>,
+    /// Lights that are no surface: point, spot and directional lights
+    /// (a surface shines by its material's emission).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lights: Vec<LightDesc>,
 }
 
 /// A table of named entries in which no name is given twice (a JSON object
@@ -98,6 +103,15 @@ impl SceneDesc {
         if self.objects.is_empty() {
             warnings.push(
                 "the scene has no objects: the image will show only its background".to_string(),
+            );
+        }
+        if self.render.integrator == IntegratorDesc::Bsdf
+            && self.lights.iter().any(LightDesc::is_delta)
+        {
+            warnings.push(
+                "point, spot and directional lights (without angular_radius) are found only by \
+                 the `path` integrator's light sampling: with `bsdf` they shed no light"
+                    .to_string(),
             );
         }
         warnings

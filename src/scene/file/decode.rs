@@ -15,7 +15,7 @@ use crate::light::LightSelection;
 use crate::material::KindInfo;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc, FilterDesc,
-    GltfCamera, IntegratorDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc,
+    GltfCamera, IntegratorDesc, LightDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc,
     SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc,
     MAX_SEED,
 };
@@ -321,6 +321,7 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
             "textures",
             "materials",
             "objects",
+            "lights",
         ],
         &[],
     )?;
@@ -345,7 +346,42 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
         objects: t
             .optional("objects", |n, _| objects(n))?
             .unwrap_or_default(),
+        lights: t.optional("lights", |n, _| lights(n))?.unwrap_or_default(),
     })
+}
+
+/// The `[[lights]]` tables: each kind's fields as the kind declares them
+/// (see [`crate::light::LightDesc`]).
+fn lights(n: &Node) -> Result<Vec<LightDesc>> {
+    let Value::Array(items) = &n.value else {
+        return Err(error(
+            "lights",
+            &n.span,
+            format!(
+                "expected an array of lights ([[lights]] tables), got {}",
+                n.value.describe()
+            ),
+        ));
+    };
+    let kinds = crate::light::source::kinds();
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, node)| {
+            let path = format!("lights[{i}]");
+            let k = kind_of(node, &path, "a light", &kinds, "lights")?;
+            LightDesc::deserialize_kind(
+                k.name,
+                NodeDe {
+                    node,
+                    path: path.clone(),
+                    what: k.what,
+                    skip: Some("type"),
+                },
+            )
+            .map_err(|e| e.into_decode(&path, &node.span, k.what))
+        })
+        .collect()
 }
 
 /// A table of named entries (`[materials.NAME]`, `[textures.NAME]`) of the

@@ -3,7 +3,8 @@
 
 use super::Format;
 use crate::scene::desc::{
-    BackgroundDesc, CameraDesc, MaterialDesc, ObjectDesc, RenderDesc, SceneDesc, TextureDesc,
+    BackgroundDesc, CameraDesc, LightDesc, MaterialDesc, ObjectDesc, RenderDesc, SceneDesc,
+    TextureDesc,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -42,6 +43,7 @@ pub fn write_scene(desc: &SceneDesc, format: Format, out: &mut impl Write) -> io
                 background: &desc.background,
                 textures: &desc.textures,
                 materials: &desc.materials,
+                lights: &desc.lights,
             };
             out.write_all(TOML_HEADER.as_bytes())?;
             out.write_all(toml::to_string(&head).map_err(io::Error::other)?.as_bytes())?;
@@ -74,6 +76,8 @@ struct Head<'a> {
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     textures: &'a BTreeMap<String, TextureDesc>,
     materials: &'a BTreeMap<String, MaterialDesc>,
+    #[serde(skip_serializing_if = "<[LightDesc]>::is_empty")]
+    lights: &'a [LightDesc],
 }
 
 /// One object, as a `[[objects]]` table.

@@ -17,8 +17,8 @@ use super::plain_toml;
 use super::toml_cut;
 use super::Format;
 use crate::scene::desc::{
-    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, ObjectDesc, RenderDesc, ScaleDesc,
-    SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, LightDesc, ObjectDesc, RenderDesc,
+    ScaleDesc, SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
 };
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -205,6 +205,27 @@ fn within_limits(d: &SceneDesc) -> bool {
         && background(&d.background)
         && d.textures.values().all(texture)
         && d.objects.iter().all(object)
+        && d.lights.iter().all(light)
+}
+
+fn light(l: &LightDesc) -> bool {
+    let optional = |v: &Option<[f64; 3]>| v.as_ref().is_none_or(|v| finite(v));
+    match l {
+        LightDesc::Point(p) => finite(&p.position) && finite(&p.intensity),
+        LightDesc::Spot(s) => {
+            finite(&s.position)
+                && finite(&s.intensity)
+                && optional(&s.direction)
+                && optional(&s.target)
+                && s.cutoff_angle.is_none_or(f64::is_finite)
+                && s.beam_width.is_none_or(f64::is_finite)
+        }
+        LightDesc::Directional(d) => {
+            finite(&d.direction)
+                && finite(&d.irradiance)
+                && d.angular_radius.is_none_or(f64::is_finite)
+        }
+    }
 }
 
 fn finite(values: &[f64]) -> bool {

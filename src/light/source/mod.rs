@@ -1,0 +1,232 @@
+//! Lights that are no surface: point, spot and directional lights. Each
+//! kind is declared once in its own file (its description's fields and
+//! what it sheds) and listed in `source_kinds!` below, which makes the
+//! description enum the scene readers decode, the table of kinds their
+//! messages use, and the dispatch.
+//!
+//! A point, a spot and a directional light without angular radius are
+//! *delta* lights: no ray can meet them, so they are found only by
+//! next-event estimation, whose sample then needs no weight against the
+//! bounces. A directional light with an angular radius is a disc of the
+//! sky, met by escaping rays too and weighted like the environment.
+
+mod directional;
+mod point;
+mod spot;
+
+pub use directional::{DirectionalLight, DirectionalLightDesc};
+pub use point::{PointLight, PointLightDesc};
+pub use spot::{SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
+
+use crate::material::{Invalid, KindInfo};
+use crate::math::{Color, Point3, Vec3};
+
+/// Lists the kinds once: the description enum (tagged by `type` in scene
+/// files), the table of kinds and their fields, and compilation.
+macro_rules! source_kinds {
+    ($( $(#[$meta:meta])* $variant:ident($desc:ty => $light:ty) = $name:literal, $what:literal; )*) => {
+        /// A light that is no surface, as a scene describes it (`type =
+        /// "…"` and the kind's fields).
+        #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(tag = "type", rename_all = "kebab-case")]
+        pub enum LightDesc {
+            $( $(#[$meta])* $variant($desc), )*
+        }
+
+        /// A light that is no surface, compiled.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum LightSource {
+            $( $(#[$meta])* $variant($light), )*
+        }
+
+        /// Every kind of light source: its `type`, how messages call it,
+        /// and its fields (`type` among them).
+        pub fn kinds() -> Vec<KindInfo> {
+            vec![$(KindInfo {
+                name: $name,
+                what: $what,
+                fields: std::iter::once("type")
+                    .chain(crate::material::param::fields_of::<$desc>().iter().copied())
+                    .collect(),
+            },)*]
+        }
+
+        impl LightDesc {
+            /// The kind's `type` name.
+            pub fn type_name(&self) -> &'static str {
+                match self {
+                    $(LightDesc::$variant(_) => $name,)*
+                }
+            }
+
+            /// Reads the fields of the kind called `name` from `d`.
+            pub fn deserialize_kind<'de, D: serde::Deserializer<'de>>(
+                name: &str,
+                d: D,
+            ) -> Result<LightDesc, D::Error> {
+                use serde::Deserialize;
+                match name {
+                    $($name => <$desc>::deserialize(d).map(LightDesc::$variant),)*
+                    _ => Err(serde::de::Error::unknown_variant(name, &[$($name),*])),
+                }
+            }
+
+            /// The light described, compiled: `field` is its path
+            /// (`lights[3]`) for messages.
+            pub fn compile(&self, field: &str) -> Result<LightSource, Invalid> {
+                Ok(match self {
+                    $(LightDesc::$variant(d) => LightSource::$variant(d.compile(field)?),)*
+                })
+            }
+        }
+    };
+}
+
+source_kinds! {
+    /// All its light from one point, equally in every direction.
+    Point(PointLightDesc => PointLight) = "point", "a point light";
+    /// A point light shining in a cone.
+    Spot(SpotLightDesc => SpotLight) = "spot", "a spot light";
+    /// Parallel light from infinitely far, or a disc of the sky.
+    Directional(DirectionalLightDesc => DirectionalLight) = "directional", "a directional light";
+}
+
+impl LightDesc {
+    /// Whether no ray can meet the light: a point, a spot, or a
+    /// directional light without angular radius.
+    pub fn is_delta(&self) -> bool {
+        match self {
+            LightDesc::Directional(d) => d.angular_radius.unwrap_or(0.0) == 0.0,
+            LightDesc::Point(_) | LightDesc::Spot(_) => true,
+        }
+    }
+}
+
+/// The light a source sheds on a point.
+#[derive(Clone, Copy, Debug)]
+pub struct Incident {
+    /// Where it comes from (for light from infinitely far: the shaded point
+    /// moved one unit along `direction`).
+    pub point: Point3,
+    /// Unit direction from the shaded point towards it.
+    pub direction: Vec3,
+    /// The distance to `point` (infinite for light from infinitely far).
+    pub distance: f32,
+    /// For a delta light, the irradiance it brings to a surface facing it
+    /// (intensity / d² for a point); otherwise the radiance along
+    /// `direction`.
+    pub radiance: Color,
+    /// The density of `direction` per unit solid angle; 1 for a delta
+    /// light, whose direction is certain.
+    pub pdf: f32,
+    /// Whether the light has a single direction here (no ray can meet it).
+    pub delta: bool,
+}
+
+impl Incident {
+    /// The light of intensity `intensity` at `position` arriving at `from`;
+    /// `None` when the two coincide.
+    #[inline]
+    fn from_point(from: Point3, position: Point3, intensity: Color) -> Option<Incident> {
+        let to = position - from;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0 && d2.is_finite()) {
+            return None;
+        }
+        let distance = d2.sqrt();
+        Some(Incident {
+            point: position,
+            direction: to / distance,
+            distance,
+            radiance: intensity / d2,
+            pdf: 1.0,
+            delta: true,
+        })
+    }
+}
+
+impl LightSource {
+    /// The light it sheds on `from`, its direction drawn from `u` where it
+    /// has more than one; `None` where it sheds none.
+    #[inline]
+    pub fn illuminate(&self, from: Point3, u: [f32; 2]) -> Option<Incident> {
+        match self {
+            LightSource::Point(l) => l.illuminate(from),
+            LightSource::Spot(l) => l.illuminate(from),
+            LightSource::Directional(l) => l.illuminate(from, u),
+        }
+    }
+
+    /// The radiance an escaping ray sees looking along unit `direction`,
+    /// and the density with which `illuminate` draws that direction: only
+    /// a disc of the sky is seen.
+    #[inline]
+    pub fn seen_along(&self, direction: Vec3) -> Option<(Color, f32)> {
+        match self {
+            LightSource::Directional(l) => l.seen_along(direction),
+            LightSource::Point(_) | LightSource::Spot(_) => None,
+        }
+    }
+
+    /// Whether an escaping ray can see it.
+    pub fn is_visible(&self) -> bool {
+        matches!(self, LightSource::Directional(l) if !l.is_delta())
+    }
+
+    /// Its power's luminance, up to the constant factor every light's has:
+    /// what the choice of lights goes by. Light from infinitely far counts
+    /// through the disc of the scene's bounding sphere (`scene_radius`).
+    pub fn power(&self, scene_radius: f32) -> f64 {
+        match self {
+            LightSource::Point(l) => l.power(),
+            LightSource::Spot(l) => l.power(),
+            LightSource::Directional(l) => l.power(scene_radius),
+        }
+    }
+}
+
+/// A colour of a light: finite and not negative, per channel.
+fn check_color(field: &str, c: [f64; 3]) -> Result<Color, Invalid> {
+    if c.iter()
+        .any(|v| !(v.is_finite() && *v >= 0.0 && *v <= f64::from(f32::MAX)))
+    {
+        return Err(Invalid::new(
+            field,
+            format!(
+                "must be three finite numbers, none negative, got [{}, {}, {}]",
+                c[0], c[1], c[2]
+            ),
+        ));
+    }
+    Ok(Color::new(c[0] as f32, c[1] as f32, c[2] as f32))
+}
+
+/// A position: finite.
+fn check_point(field: &str, p: [f64; 3]) -> Result<Point3, Invalid> {
+    if p.iter().any(|v| !(v.abs() <= f64::from(f32::MAX))) {
+        return Err(Invalid::new(
+            field,
+            format!(
+                "must be three finite numbers, got [{}, {}, {}]",
+                p[0], p[1], p[2]
+            ),
+        ));
+    }
+    Ok(Point3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+}
+
+/// A direction: finite and not zero; made unit length.
+fn check_vector(field: &str, v: [f64; 3]) -> Result<Vec3, Invalid> {
+    let d = glam::DVec3::from_array(v);
+    let unit = d.normalize_or_zero();
+    if !d.is_finite() || unit == glam::DVec3::ZERO {
+        return Err(Invalid::new(
+            field,
+            format!(
+                "must be a direction: three finite numbers, not all zero, got [{}, {}, {}]",
+                v[0], v[1], v[2]
+            ),
+        ));
+    }
+    Ok(Vec3::new(unit.x as f32, unit.y as f32, unit.z as f32))
+}

@@ -1,0 +1,152 @@
+//! A spot light: a point light whose light leaves in a cone, full within
+//! `beam_width` of its axis and falling off linearly in angle to nothing at
+//! `cutoff_angle` (Mitsuba's `spot`).
+
+use super::{check_color, check_point, check_vector, Incident};
+use crate::material::Invalid;
+use crate::math::{Color, Point3, Vec3};
+use crate::scene::desc::Triple;
+use std::f64::consts::PI;
+
+/// A spot light as a scene describes it.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLightDesc {
+    /// Where it is.
+    pub position: Triple,
+    /// The direction of its axis (any length but zero); give this or
+    /// `target`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<Triple>,
+    /// A point on its axis, instead of `direction`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<Triple>,
+    /// Radiant intensity on the axis, W/sr per channel.
+    pub intensity: Triple,
+    /// The angle from the axis, in degrees, beyond which it sheds no
+    /// light, in (0, 180); 20 when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_angle: Option<f64>,
+    /// The angle from the axis, in degrees, within which it sheds its full
+    /// intensity, in (0, `cutoff_angle`]; ¾ of `cutoff_angle` when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beam_width: Option<f64>,
+}
+
+/// The cut-off angle of a spot light that gives none, in degrees.
+pub const DEFAULT_CUTOFF: f64 = 20.0;
+
+/// A spot light, compiled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLight {
+    /// Where it is.
+    pub position: Point3,
+    /// The unit direction of its axis.
+    pub axis: Vec3,
+    /// Radiant intensity on the axis.
+    pub intensity: Color,
+    /// The cut-off angle, radians, and its cosine.
+    cutoff: f32,
+    cos_cutoff: f32,
+    /// The cosine of the beam width.
+    cos_beam: f32,
+    /// 1 / (cutoff − beam width), per radian.
+    inv_transition: f32,
+    beam: f32,
+}
+
+impl SpotLightDesc {
+    /// The light described; `field` is its path for messages.
+    pub fn compile(&self, field: &str) -> Result<SpotLight, Invalid> {
+        let position = check_point(&format!("{field}.position"), self.position)?;
+        let axis = match (self.direction, self.target) {
+            (Some(d), None) => check_vector(&format!("{field}.direction"), d)?,
+            (None, Some(t)) => {
+                let t = check_point(&format!("{field}.target"), t)?;
+                check_vector(
+                    &format!("{field}.target"),
+                    (t - position).as_dvec3().to_array(),
+                )
+                .map_err(|_| {
+                    Invalid::new(format!("{field}.target"), "is the light's own position")
+                })?
+            }
+            (Some(_), Some(_)) => {
+                return Err(Invalid::new(
+                    format!("{field}.target"),
+                    "give `direction` or `target`, not both",
+                ))
+            }
+            (None, None) => {
+                return Err(Invalid::new(
+                    format!("{field}.direction"),
+                    "a spot light needs `direction` or `target`",
+                ))
+            }
+        };
+        let cutoff = self.cutoff_angle.unwrap_or(DEFAULT_CUTOFF);
+        if !(cutoff > 0.0 && cutoff < 180.0) {
+            return Err(Invalid::new(
+                format!("{field}.cutoff_angle"),
+                format!("must be above 0 and below 180 degrees, got {cutoff}"),
+            ));
+        }
+        let beam = self.beam_width.unwrap_or(0.75 * cutoff);
+        if !(beam > 0.0 && beam <= cutoff) {
+            return Err(Invalid::new(
+                format!("{field}.beam_width"),
+                format!("must be above 0 and at most cutoff_angle ({cutoff}) degrees, got {beam}"),
+            ));
+        }
+        let (cutoff, beam) = (cutoff.to_radians() as f32, beam.to_radians() as f32);
+        Ok(SpotLight {
+            position,
+            axis,
+            intensity: check_color(&format!("{field}.intensity"), self.intensity)?,
+            cutoff,
+            cos_cutoff: cutoff.cos(),
+            cos_beam: beam.cos(),
+            inv_transition: if cutoff > beam {
+                1.0 / (cutoff - beam)
+            } else {
+                0.0
+            },
+            beam,
+        })
+    }
+}
+
+impl SpotLight {
+    /// The fraction of its axial intensity the light sends along unit
+    /// `direction`: 1 within the beam, falling linearly in angle to 0 at
+    /// the cut-off.
+    #[inline]
+    pub fn falloff(&self, direction: Vec3) -> f32 {
+        let cos = direction.dot(self.axis);
+        if !(cos > self.cos_cutoff) {
+            0.0
+        } else if cos >= self.cos_beam {
+            1.0
+        } else {
+            ((self.cutoff - cos.min(1.0).acos()) * self.inv_transition).clamp(0.0, 1.0)
+        }
+    }
+
+    /// The light arriving at `from`.
+    #[inline]
+    pub fn illuminate(&self, from: Point3) -> Option<Incident> {
+        let falloff = self.falloff((from - self.position).normalize_or_zero());
+        if falloff == 0.0 {
+            return None;
+        }
+        Incident::from_point(from, self.position, self.intensity * falloff)
+    }
+
+    /// Its power's luminance, as if the intensity fell off at the middle
+    /// of the transition: 2π(1 − cos θ) × intensity, θ halfway between
+    /// beam width and cut-off (it only steers the choice of lights).
+    pub fn power(&self) -> f64 {
+        let middle = 0.5 * f64::from(self.cutoff + self.beam);
+        2.0 * PI * (1.0 - middle.cos()) * f64::from(super::super::luminance(self.intensity))
+    }
+}
