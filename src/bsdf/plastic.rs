@@ -41,6 +41,10 @@ pub struct Plastic {
     pub roughness: Option<Microfacet>,
     /// Return the energy the coat's single scattering loses.
     pub multiscatter: bool,
+    /// Whether the light bouncing between base and coat is coloured at
+    /// every bounce (ρ / (1 − ρ Ri), darker bases more saturated, as real
+    /// paint), rather than once (ρ / (1 − Ri), Mitsuba's default).
+    pub nonlinear: bool,
 }
 
 impl Plastic {
@@ -130,7 +134,12 @@ impl Plastic {
         let p_coat = self.coat_probability(t_o);
         let ri = self.internal_reflectance();
         let through = t_o * self.transmittance(wi.z) * wi.z * FRAC_1_PI / (self.eta * self.eta);
-        let base = self.albedo / (Color::ONE - self.albedo * ri) * through;
+        let bounces = if self.nonlinear {
+            Color::ONE - self.albedo * ri
+        } else {
+            Color::splat(1.0 - ri)
+        };
+        let base = self.albedo / bounces * through;
         let mut f_cos = base;
         let mut pdf = (1.0 - p_coat) * wi.z * FRAC_1_PI;
         if let Some(d) = &self.roughness {

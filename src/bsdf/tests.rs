@@ -90,15 +90,19 @@ fn lobes_with(multiscatter: bool) -> Vec<Case> {
                 }),
             });
         }
-        cases.push(Case {
-            name: format!("plastic {what}{ms}"),
-            lobe: Lobe::Plastic(Plastic {
-                albedo: Color::new(0.8, 0.4, 0.2),
-                eta: 1.5,
-                roughness: Some(d),
-                multiscatter,
-            }),
-        });
+        for nonlinear in [true, false] {
+            let linear = if nonlinear { "" } else { " linear" };
+            cases.push(Case {
+                name: format!("plastic {what}{ms}{linear}"),
+                lobe: Lobe::Plastic(Plastic {
+                    albedo: Color::new(0.8, 0.4, 0.2),
+                    eta: 1.5,
+                    roughness: Some(d),
+                    multiscatter,
+                    nonlinear,
+                }),
+            });
+        }
     }
     if !multiscatter {
         cases.push(Case {
@@ -108,6 +112,7 @@ fn lobes_with(multiscatter: bool) -> Vec<Case> {
                 eta: 1.5,
                 roughness: None,
                 multiscatter,
+                nonlinear: true,
             }),
         });
     }
@@ -1046,6 +1051,7 @@ fn no_nan_at_the_edges() {
                 eta: eta.min(super::albedo::ETA_MAX),
                 roughness: d,
                 multiscatter: d.is_some(),
+                nonlinear: true,
             }));
             let Some(d) = d else {
                 continue;

@@ -17,7 +17,22 @@ material_desc! {
         /// Never reflect partially (no Schlick term).
         #[serde(default)]
         pub refract_only: bool,
+        /// How a smooth surface divides light between reflection and
+        /// refraction: "schlick" (the notes' approximation, the default) or
+        /// "exact" (the Fresnel equations, as a rough surface always does).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub fresnel: Option<FresnelDesc>,
     }
+}
+
+/// How a smooth dielectric reflects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FresnelDesc {
+    /// Schlick's approximation.
+    Schlick,
+    /// The Fresnel equations.
+    Exact,
 }
 
 impl DielectricDesc {
@@ -62,10 +77,23 @@ impl DielectricDesc {
                 "is the notes' smooth glass: a rough dielectric reflects by the Fresnel equations",
             ));
         }
+        let exact = match self.fresnel {
+            Some(FresnelDesc::Schlick) if rough => return Err(Invalid::new(
+                format!("{field}.fresnel"),
+                "a rough dielectric reflects by the Fresnel equations (\"exact\"), not Schlick's",
+            )),
+            Some(FresnelDesc::Exact) if self.refract_only => return Err(Invalid::new(
+                format!("{field}.refract_only"),
+                "is the notes' glass, which never reflects; the Fresnel equations (\"exact\") do",
+            )),
+            Some(f) => f == FresnelDesc::Exact,
+            None => rough,
+        };
         Ok(Material::new(Kind::Dielectric(Dielectric {
             ior: ior as f32,
             refract_only: self.refract_only,
             roughness: rough.then_some(roughness),
+            exact,
             multiscatter: self.multiscatter,
         })))
     }
@@ -81,8 +109,11 @@ pub struct Dielectric {
     /// (no Schlick term): the notes' "only refracting" figure.
     pub refract_only: bool,
     /// The microfacets of frosted glass, reflecting and refracting by the
-    /// exact Fresnel equations; `None` for the notes' glass.
+    /// exact Fresnel equations; `None` for a smooth one.
     pub roughness: Option<Roughness>,
+    /// Reflect by the Fresnel equations (always when rough); a smooth
+    /// surface without is the notes' glass, by Schlick's approximation.
+    pub exact: bool,
     /// Return the energy single scattering loses.
     pub multiscatter: bool,
 }
@@ -92,6 +123,11 @@ impl Dielectric {
     #[inline(always)]
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> Lobe {
         match &self.roughness {
+            None if self.exact => Lobe::ExactDielectric(ExactDielectric {
+                eta: crate::bsdf::fresnel::rough_eta(self.ior, hit.front_face),
+                roughness: None,
+                multiscatter: false,
+            }),
             None => Lobe::Dielectric(SmoothDielectric {
                 eta_ratio: if hit.front_face {
                     1.0 / self.ior

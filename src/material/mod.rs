@@ -116,6 +116,12 @@ macro_rules! material_desc {
             /// ray passes through with probability 1 − opacity (`BLEND`).
             #[serde(default, skip_serializing_if = "Option::is_none")]
             pub alpha_cutoff: Option<f64>,
+            /// Scatter light only on the side the outward normal points
+            /// to: seen from behind, the surface is black (Mitsuba's
+            /// surfaces but `twosided`'s). Otherwise both sides scatter
+            /// alike.
+            #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+            pub one_sided: bool,
         }
 
         impl $name {
@@ -131,6 +137,22 @@ macro_rules! material_desc {
                     bump_scale: self.bump_scale,
                     opacity: self.opacity.as_ref(),
                     alpha_cutoff: self.alpha_cutoff,
+                    one_sided: self.one_sided,
+                }
+            }
+
+            /// The fields every kind has, to be changed.
+            pub fn surface_mut(&mut self) -> $crate::material::SurfaceMut<'_> {
+                $crate::material::SurfaceMut {
+                    emission: &mut self.emission,
+                    two_sided: &mut self.two_sided,
+                    normal_map: &mut self.normal_map,
+                    normal_scale: &mut self.normal_scale,
+                    bump_map: &mut self.bump_map,
+                    bump_scale: &mut self.bump_scale,
+                    opacity: &mut self.opacity,
+                    alpha_cutoff: &mut self.alpha_cutoff,
+                    one_sided: &mut self.one_sided,
                 }
             }
         }
@@ -169,6 +191,13 @@ macro_rules! material_kinds {
             pub fn type_name(&self) -> &'static str {
                 match self {
                     $(MaterialDesc::$variant(_) => $name,)*
+                }
+            }
+
+            /// The fields every kind has, to be changed.
+            pub fn surface_mut(&mut self) -> SurfaceMut<'_> {
+                match self {
+                    $(MaterialDesc::$variant(d) => d.surface_mut(),)*
                 }
             }
 
@@ -280,6 +309,33 @@ pub struct SurfaceDesc<'a> {
     pub opacity: Option<&'a ScalarDesc>,
     /// Where it is cut off.
     pub alpha_cutoff: Option<f64>,
+    /// Scatter on the outward side only.
+    pub one_sided: bool,
+}
+
+/// The fields every kind of material has, borrowed to be changed (by a
+/// reader that learns them after the kind, as Mitsuba's `twosided` and
+/// `mask` wrap a BSDF).
+#[derive(Debug)]
+pub struct SurfaceMut<'a> {
+    /// Radiance given off, if any.
+    pub emission: &'a mut Option<ColorDesc>,
+    /// Emit from both sides.
+    pub two_sided: &'a mut bool,
+    /// A normal map's texture.
+    pub normal_map: &'a mut Option<String>,
+    /// Its strength.
+    pub normal_scale: &'a mut Option<f64>,
+    /// A bump map's texture.
+    pub bump_map: &'a mut Option<String>,
+    /// Its height.
+    pub bump_scale: &'a mut Option<f64>,
+    /// How much of the surface is there.
+    pub opacity: &'a mut Option<ScalarDesc>,
+    /// Where it is cut off.
+    pub alpha_cutoff: &'a mut Option<f64>,
+    /// Scatter on the outward side only.
+    pub one_sided: &'a mut bool,
 }
 
 impl SurfaceDesc<'_> {
@@ -327,6 +383,7 @@ impl SurfaceDesc<'_> {
         }
         material.shape = self.shape(field, textures)?;
         material.opacity = self.opacity(field, textures)?;
+        material.one_sided = self.one_sided;
         Ok(material)
     }
 
@@ -597,6 +654,8 @@ pub struct Material {
     pub shape: Option<Shape>,
     /// How much of the surface is there, where it is not all there.
     pub opacity: Option<Opacity>,
+    /// Scatters nothing seen from behind (the inward side).
+    pub one_sided: bool,
 }
 
 impl Material {
@@ -607,6 +666,7 @@ impl Material {
             emission: None,
             shape: None,
             opacity: None,
+            one_sided: false,
         }
     }
 
@@ -617,6 +677,7 @@ impl Material {
             emission: Some(emission),
             shape: None,
             opacity: None,
+            one_sided: false,
         }
     }
 
@@ -625,6 +686,9 @@ impl Material {
     /// scatters nothing.
     #[inline(always)]
     pub fn bsdf(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Option<Bsdf> {
+        if self.one_sided && !hit.front_face {
+            return None;
+        }
         let n = match &self.shape {
             None => hit.shading_normal,
             Some(shape) => visible(shape.normal(hit, textures), wo, hit.normal),

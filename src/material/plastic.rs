@@ -19,6 +19,11 @@ material_desc! {
         /// The coat's index of refraction, > 0; 1.5 when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub ior: Option<f64>,
+        /// Colour the light between base and coat at every bounce
+        /// (ρ / (1 − ρ Ri): true, the default) or once (ρ / (1 − Ri):
+        /// Mitsuba's `nonlinear = false`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub nonlinear: Option<bool>,
     }
 }
 
@@ -59,6 +64,7 @@ impl PlasticDesc {
             ior,
             roughness,
             multiscatter: self.multiscatter,
+            nonlinear: self.nonlinear.unwrap_or(true),
         }))))
     }
 }
@@ -74,6 +80,8 @@ pub struct Plastic {
     pub roughness: Roughness,
     /// Return the energy the coat's single scattering loses.
     pub multiscatter: bool,
+    /// Colour the light between base and coat at every bounce.
+    pub nonlinear: bool,
 }
 
 impl Plastic {
@@ -85,6 +93,7 @@ impl Plastic {
             eta: self.ior,
             roughness: self.roughness.at(hit, textures),
             multiscatter: self.multiscatter,
+            nonlinear: self.nonlinear,
         }
     }
 
