@@ -142,9 +142,24 @@ pub struct EnvironmentMap {
     rotation: (f32, f32),
     distribution: Distribution2D,
     integral: f64,
+    /// Whether the first and last rows lie at the poles (see
+    /// [`EnvironmentMap::with_rows_at_poles`]).
+    rows_at_poles: bool,
 }
 
 impl EnvironmentMap {
+    /// The map with its first row straight up and its last straight down,
+    /// the rows between spread evenly (Mitsuba's `envmap`), rather than
+    /// each row at its middle, half a row from the poles at the ends.
+    /// Only the look-up changes: the density of directions drawn still
+    /// follows the rows as they are, which leaves the image unbiased (it
+    /// weighs each texel by its brightest neighbour) and barely changes
+    /// its noise.
+    pub fn with_rows_at_poles(mut self) -> Self {
+        self.rows_at_poles = true;
+        self
+    }
+
     /// The environment of `image`, turned by `rotation_degrees` about +y
     /// (counter-clockwise seen from above) and scaled by `intensity` (≥ 0);
     /// `None` when the image is black everywhere or the intensity is 0.
@@ -185,6 +200,7 @@ impl EnvironmentMap {
             rotation: (sin, cos),
             distribution,
             integral,
+            rows_at_poles: false,
         })
     }
 
@@ -216,7 +232,13 @@ impl EnvironmentMap {
     }
 
     fn color(&self, direction: Vec3) -> Color {
-        let [u, v] = self.uv(direction);
+        let [u, mut v] = self.uv(direction);
+        if self.rows_at_poles {
+            // Row r at v = r / (h − 1), looked up where the centred rows
+            // have it: at (r + ½) / h.
+            let h = self.image.height() as f32;
+            v = (v * (h - 1.0) + 0.5) / h;
+        }
         self.intensity * self.image.bilinear_wrap_u(u, v)
     }
 

@@ -53,8 +53,9 @@ enum Command {
     #[command(after_help = RENDER_HELP)]
     Render {
         /// Name of a built-in scene (see `lumen scenes`) or a scene file
-        /// (.toml or .json, see docs/scene-format.md). Command-line settings
-        /// override the scene's own.
+        /// (.toml or .json, see docs/scene-format.md; .xml, a Mitsuba 3
+        /// scene, see docs/mitsuba.md). Command-line settings override the
+        /// scene's own.
         scene: OsString,
         /// Output image; the extension chooses the format.
         #[arg(short, long)]
@@ -63,6 +64,8 @@ enum Command {
         settings: SettingArgs,
         #[command(flatten)]
         progressive: ProgressiveArgs,
+        #[command(flatten)]
+        import: ImportArgs,
     },
     /// Merge the part files of a render split with `render --part K/N`
     /// (by samples or by tiles) or `render --tile` into its image (.ppm,
@@ -164,6 +167,8 @@ enum ScenesCommand {
         /// Format when writing to standard output.
         #[arg(long, value_enum, default_value_t = FormatArg::Toml)]
         format: FormatArg,
+        #[command(flatten)]
+        import: ImportArgs,
     },
 }
 
@@ -238,6 +243,39 @@ enum FormatArg {
     Json,
 }
 
+/// How a scene of another renderer's format (Mitsuba 3 `.xml`) is read.
+#[derive(Args, Clone, Default)]
+pub(crate) struct ImportArgs {
+    /// A parameter of a Mitsuba scene (`$NAME` in its attributes), as
+    /// Mitsuba's own -D.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
+    defines: Vec<(String, String)>,
+    /// Render what lumen lacks with the nearest it has (one warning each)
+    /// instead of refusing the scene.
+    #[arg(long)]
+    approximate: bool,
+}
+
+impl ImportArgs {
+    /// The options of a Mitsuba scene's reader; `allow_outside` lets its
+    /// `<include>`s come from outside its folder.
+    pub(crate) fn options(&self, allow_outside: bool) -> lumen::scene::file::mitsuba::Options {
+        lumen::scene::file::mitsuba::Options {
+            defines: self.defines.clone(),
+            approximate: self.approximate,
+            allow_outside,
+        }
+    }
+}
+
+/// `NAME=VALUE` of `-D`.
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, value)) if !name.is_empty() => Ok((name.to_string(), value.to_string())),
+        _ => Err(format!("expected NAME=VALUE, got `{s}`")),
+    }
+}
+
 #[derive(Args, Clone, Default)]
 struct SettingArgs {
     /// Image width in pixels (the height follows the aspect ratio).
@@ -270,7 +308,8 @@ struct SettingArgs {
     noise_target: Option<f64>,
     /// Let mesh files read files outside their folder (glTF buffers and
     /// images, MTL files and maps), as `allow_outside = true` on every mesh
-    /// object does.
+    /// object does, and a Mitsuba scene include files from outside its
+    /// folder.
     #[arg(long)]
     allow_outside: bool,
     /// Worker threads (default: one per core). The image does not depend on it.
@@ -442,8 +481,16 @@ fn run(cli: Cli) -> Result<ExitCode> {
             output,
             settings,
             progressive,
+            import,
         } => with_threads(settings.threads, || {
-            render_command(scene_name(&scene)?, &output, &settings, &progressive)
+            let import = import.options(settings.allow_outside);
+            render_command(
+                scene_name(&scene)?,
+                &output,
+                &settings,
+                &progressive,
+                &import,
+            )
         }),
         Command::Merge {
             parts,
@@ -464,9 +511,15 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     name,
                     output,
                     format,
+                    import,
                 }),
         } => {
-            export_command(scene_name(&name)?, output.as_deref(), format)?;
+            export_command(
+                scene_name(&name)?,
+                output.as_deref(),
+                format,
+                &import.options(false),
+            )?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Gallery { dir, settings } => {

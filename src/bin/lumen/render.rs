@@ -68,8 +68,9 @@ pub(crate) fn render_command(
     out: &Path,
     args: &SettingArgs,
     prog: &ProgressiveArgs,
+    import: &lumen::scene::file::mitsuba::Options,
 ) -> Result<ExitCode> {
-    let (desc, scene) = load_scene(name)?.resolve(name, &args.overrides())?;
+    let (desc, scene) = load_scene(name, import)?.resolve(name, &args.overrides())?;
     for report in &scene.reports {
         errln!("{report}");
         for warning in &report.warnings {

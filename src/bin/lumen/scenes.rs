@@ -5,6 +5,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use lumen::output;
 use lumen::scene::builtin::{self, BUILTINS};
 use lumen::scene::export;
+use lumen::scene::file::mitsuba::Options as ImportOptions;
 use lumen::scene::file::{Format, SceneFile};
 use lumen::scene::{hint, Overrides, Scene, SceneDesc};
 use std::path::Path;
@@ -40,17 +41,21 @@ impl SceneSource {
 }
 
 /// A built-in scene by name, or else a scene file by path.
-pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
+pub(crate) fn load_scene(name: &str, import: &ImportOptions) -> Result<SceneSource> {
     if let Some(b) = builtin::find(name) {
         return Ok(SceneSource::Builtin(b.desc()));
     }
     let path = Path::new(name);
     let looks_like_file = Format::from_extension(path).is_some()
+        || lumen::scene::file::is_mitsuba(path)
         || name.contains(std::path::MAIN_SEPARATOR)
         || name.contains('/')
         || path.exists();
     if looks_like_file {
-        let file = SceneFile::read(path)?;
+        let file = SceneFile::read_with(path, import)?;
+        for warning in &file.import_warnings {
+            errln!("lumen: warning: {warning}");
+        }
         for warning in file.desc.warnings() {
             errln!("lumen: warning: {}: {warning}", file.name);
         }
@@ -61,16 +66,21 @@ pub(crate) fn load_scene(name: &str) -> Result<SceneSource> {
         .unwrap_or_default();
     bail!(
         "unknown scene '{name}'{closest}; `lumen scenes` lists the built-in scenes, \
-         and scene files end in .toml or .json"
+         and scene files end in .toml, .json or .xml (Mitsuba 3)"
     )
 }
 
-pub(crate) fn export_command(name: &str, out: Option<&Path>, format: FormatArg) -> Result<()> {
+pub(crate) fn export_command(
+    name: &str,
+    out: Option<&Path>,
+    format: FormatArg,
+    import: &ImportOptions,
+) -> Result<()> {
     // Checked before the file is read: a large scene takes a while.
     if let (None, Some(path)) = (builtin::find(name), out) {
         export::check_not_source(Path::new(name), path)?;
     }
-    let source = load_scene(name)?;
+    let source = load_scene(name, import)?;
     let format = match out {
         Some(path) => Format::from_extension(path)
             .ok_or_else(|| anyhow!("{}: scene files must end in .toml or .json", path.display()))?,

@@ -66,6 +66,7 @@ pub fn materials() -> SceneDesc {
             file: "lumen:sky.hdr".to_string(),
             rotation: 0.0,
             intensity: 1.0,
+            rows_at_poles: false,
         })
         .camera(CameraDesc {
             vfov: 25.0,

@@ -228,6 +228,7 @@ fn compile_background(
             file,
             rotation,
             intensity,
+            rows_at_poles,
         } => {
             finite("background.rotation", &[*rotation])?;
             finite("background.intensity", &[*intensity])?;
@@ -239,6 +240,7 @@ fn compile_background(
             }
             let image = read_image("background.file", base, file, sources)?;
             match EnvironmentMap::new(image, *rotation as f32, *intensity as f32) {
+                Some(map) if *rows_at_poles => Environment::Map(Arc::new(map.with_rows_at_poles())),
                 Some(map) => Environment::Map(Arc::new(map)),
                 // Black everywhere: it sheds no light.
                 None => Environment::Solid(Color::ZERO),

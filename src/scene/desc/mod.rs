@@ -352,6 +352,10 @@ pub enum BackgroundDesc {
         /// Factor on every texel, ≥ 0.
         #[serde(default = "one", skip_serializing_if = "is_one")]
         intensity: f64,
+        /// The first and last rows lie exactly at the poles (Mitsuba's
+        /// convention) rather than half a row from them.
+        #[serde(default, skip_serializing_if = "is_false")]
+        rows_at_poles: bool,
     },
 }
 

@@ -634,7 +634,7 @@ const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
         name: "image",
         kind: BackgroundKind::Image,
         what: "an image background",
-        fields: &["type", "file", "rotation", "intensity"],
+        fields: &["type", "file", "rotation", "intensity", "rows_at_poles"],
         elsewhere: &[
             ("color", "a solid background"),
             ("bottom", "a gradient background"),
@@ -657,6 +657,7 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
             file: t.require("file", what, string)?.to_string(),
             rotation: t.optional("rotation", float)?.unwrap_or(0.0),
             intensity: t.optional("intensity", float)?.unwrap_or(1.0),
+            rows_at_poles: t.optional("rows_at_poles", boolean)?.unwrap_or(false),
         },
     })
 }

@@ -22,6 +22,7 @@
 mod decode;
 pub mod export;
 mod fast;
+pub mod mitsuba;
 pub use crate::hint;
 mod node_de;
 mod plain_toml;
@@ -160,6 +161,13 @@ pub fn export(desc: &SceneDesc, format: Format) -> Result<String, ExportError> {
     Ok(String::from_utf8(text).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into()))
 }
 
+/// Whether `path` names a Mitsuba scene (`.xml`).
+pub fn is_mitsuba(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
 /// A parsed scene file, kept with its text so that errors found later (when
 /// compiling, after overrides) can still point into it.
 #[derive(Clone, Debug)]
@@ -172,15 +180,36 @@ pub struct SceneFile {
     pub desc: SceneDesc,
     /// The directory mesh files are relative to: the file's own.
     pub dir: std::path::PathBuf,
+    /// What reading a scene of another renderer's format made do with
+    /// (`--approximate`), one line each.
+    pub import_warnings: Vec<String>,
     source: String,
     root: OnceLock<Node>,
 }
 
 impl SceneFile {
-    /// Reads and parses the file at `path`; the extension (`.toml`, `.json`)
-    /// gives the format.
+    /// Reads and parses the file at `path`; the extension (`.toml`, `.json`,
+    /// or `.xml` for a Mitsuba 3 scene) gives the format.
     pub fn read(path: &Path) -> Result<SceneFile, SceneFileError> {
+        Self::read_with(path, &mitsuba::Options::default())
+    }
+
+    /// [`SceneFile::read`], a Mitsuba scene read with `import`.
+    pub fn read_with(path: &Path, import: &mitsuba::Options) -> Result<SceneFile, SceneFileError> {
         let name = path.display().to_string();
+        if is_mitsuba(path) {
+            let imported = mitsuba::read(path, import)?;
+            return Ok(SceneFile {
+                name,
+                // Imported scenes are what they export as.
+                format: Format::Toml,
+                desc: imported.desc,
+                dir: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+                import_warnings: imported.warnings,
+                source: String::new(),
+                root: OnceLock::new(),
+            });
+        }
         let fail = |message: String| Diagnostic::plain(&name, message);
         let meta = std::fs::metadata(path).map_err(|e| {
             fail(match e.kind() {
@@ -194,7 +223,10 @@ impl SceneFile {
             );
         }
         let format = Format::from_extension(path).ok_or_else(|| {
-            fail("unknown scene file type: the name must end in .toml or .json".into())
+            fail(
+                "unknown scene file type: the name must end in .toml, .json or .xml (Mitsuba 3)"
+                    .into(),
+            )
         })?;
         let bytes = crate::input::read(path, crate::input::MAX_SCENE_BYTES)
             .map_err(|e| fail(format!("the scene file {e}")))?;
@@ -233,6 +265,7 @@ impl SceneFile {
                 format,
                 desc,
                 dir: std::path::PathBuf::new(),
+                import_warnings: Vec::new(),
                 source: text,
                 root: OnceLock::new(),
             }),
@@ -271,6 +304,7 @@ impl SceneFile {
             format,
             desc,
             dir: std::path::PathBuf::new(),
+            import_warnings: Vec::new(),
             source: text,
             root: OnceLock::from(root),
         })
