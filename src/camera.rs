@@ -115,9 +115,18 @@ pub struct Camera {
     shutter_span: f32,
     /// The orthonormal basis (u, v, w).
     pub basis: [Vec3; 3],
+    /// Where about its pixel a camera ray goes.
+    filter: crate::filter::PixelFilter,
 }
 
 impl Camera {
+    /// The camera with its rays spread about their pixels by `filter`
+    /// (a box, each pixel's square, when not set).
+    pub fn with_filter(mut self, filter: crate::filter::PixelFilter) -> Self {
+        self.filter = filter;
+        self
+    }
+
     /// Builds the camera for a `width`×`height` image, refusing impossible set-ups.
     pub fn new(settings: &CameraSettings, width: u32, height: u32) -> Result<Self, CameraError> {
         let s = settings;
@@ -234,6 +243,7 @@ impl Camera {
             shutter_open: open,
             shutter_span: close - open,
             basis: [u, v, w],
+            filter: crate::filter::PixelFilter::Box,
         })
     }
 
@@ -254,6 +264,7 @@ impl Camera {
     /// the shutter interval drawn from `sampler`.
     #[inline]
     pub fn ray(&self, x: u32, y: u32, dx: f32, dy: f32, sampler: &mut impl Sampler) -> Ray {
+        let (dx, dy) = (self.filter.offset(dx), self.filter.offset(dy));
         let target =
             self.pixel00 + (x as f32 + dx) * self.pixel_du + (y as f32 + dy) * self.pixel_dv;
         let origin = if self.defocus_u == Vec3::ZERO {

@@ -60,6 +60,7 @@ pub mod checkpoint;
 pub mod distribution;
 pub mod files;
 pub mod film;
+pub mod filter;
 pub mod gallery;
 pub mod geometry;
 pub mod halt;

@@ -160,6 +160,8 @@ pub struct Settings {
     pub offset: bool,
     /// What camera rays show.
     pub shading: Shading,
+    /// The pixel filter, and a Gaussian's standard deviation.
+    pub pixel_filter: (desc::PixelFilterDesc, Option<f64>),
 }
 
 /// A scene compiled for rendering: validated, with a BVH over its objects.

@@ -4,7 +4,7 @@
 
 use super::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, GltfCamera, MaterialDesc, ObjectDesc,
-    ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
+    PixelFilterDesc, ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
 };
 use super::world::{Group, Mesh, PlacedGroup, Rounding, Shapes, Surface, World};
 use super::{
@@ -12,6 +12,7 @@ use super::{
     MAX_COORDINATE, MAX_PIXELS,
 };
 use crate::camera::{Camera, CameraError, CameraSettings};
+use crate::filter::PixelFilter;
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Sphere};
@@ -275,6 +276,7 @@ fn compile_camera(
             d as f32
         }
     };
+    let filter = compile_filter(&settings.pixel_filter)?;
     Ok(Camera::new(
         &CameraSettings {
             vfov: cam.vfov as f32,
@@ -291,7 +293,29 @@ fn compile_camera(
         },
         settings.width,
         settings.height,
-    )?)
+    )?
+    .with_filter(filter))
+}
+
+/// The pixel filter `[render]` asks for.
+fn compile_filter(desc: &(PixelFilterDesc, Option<f64>)) -> Result<PixelFilter, SceneError> {
+    match *desc {
+        (PixelFilterDesc::Box, None) => Ok(PixelFilter::Box),
+        (PixelFilterDesc::Box, Some(_)) => Err(invalid(
+            "render.filter_stddev",
+            "is a Gaussian filter's; give pixel_filter = \"gaussian\"",
+        )),
+        (PixelFilterDesc::Gaussian, stddev) => {
+            let s = stddev.unwrap_or(0.5);
+            if !(s > 0.0 && s <= 16.0) {
+                return Err(invalid(
+                    "render.filter_stddev",
+                    format!("must be above 0 and at most 16 pixels, got {s}"),
+                ));
+            }
+            Ok(PixelFilter::gaussian(s as f32))
+        }
+    }
 }
 
 /// A loaded mesh file, shared by every object that names it.
@@ -1211,6 +1235,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         epsilon: r.epsilon.map_or(0.0, |e| e as f32),
         offset: r.epsilon != Some(0.0),
         shading: r.shading,
+        pixel_filter: (r.pixel_filter, r.filter_stddev),
     })
 }
 

@@ -163,6 +163,28 @@ pub struct RenderDesc {
     pub epsilon: Option<f64>,
     /// What a camera ray's colour shows.
     pub shading: ShadingDesc,
+    /// How much each point near a pixel counts towards it.
+    #[serde(skip_serializing_if = "is_box")]
+    pub pixel_filter: PixelFilterDesc,
+    /// A Gaussian filter's standard deviation in pixels, > 0 (its radius
+    /// is four times it); ½ when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub filter_stddev: Option<f64>,
+}
+
+/// A pixel filter (see [`crate::filter`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PixelFilterDesc {
+    /// The pixel's square, evenly: the default.
+    #[default]
+    Box,
+    /// A Gaussian of `filter_stddev` pixels, out to four times it.
+    Gaussian,
+}
+
+fn is_box(f: &PixelFilterDesc) -> bool {
+    *f == PixelFilterDesc::Box
 }
 
 impl RenderDesc {
@@ -201,6 +223,8 @@ impl Default for RenderDesc {
             gamma: 2.0,
             epsilon: None,
             shading: ShadingDesc::Path,
+            pixel_filter: PixelFilterDesc::Box,
+            filter_stddev: None,
         }
     }
 }

@@ -15,9 +15,9 @@ use crate::light::LightSelection;
 use crate::material::KindInfo;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc, FilterDesc,
-    GltfCamera, IntegratorDesc, LightDesc, MaterialDesc, NoisePatternDesc, ObjectDesc, RenderDesc,
-    SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc,
-    MAX_SEED,
+    GltfCamera, IntegratorDesc, LightDesc, MaterialDesc, NoisePatternDesc, ObjectDesc,
+    PixelFilterDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc,
+    TransformDesc, Triple, WrapDesc, MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -483,6 +483,8 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "gamma",
             "epsilon",
             "shading",
+            "pixel_filter",
+            "filter_stddev",
         ],
         &[],
     )?;
@@ -511,8 +513,17 @@ fn render(node: &Node) -> Result<RenderDesc> {
         shading: t
             .optional("shading", |n, p| keyword(n, p, SHADINGS))?
             .unwrap_or(d.shading),
+        pixel_filter: t
+            .optional("pixel_filter", |n, p| keyword(n, p, PIXEL_FILTERS))?
+            .unwrap_or(d.pixel_filter),
+        filter_stddev: t.optional("filter_stddev", float)?,
     })
 }
+
+const PIXEL_FILTERS: &[(&str, PixelFilterDesc)] = &[
+    ("box", PixelFilterDesc::Box),
+    ("gaussian", PixelFilterDesc::Gaussian),
+];
 
 /// The render's sampler: `sampler`, or `sampling` as older scene files
 /// name it, not both.

@@ -240,6 +240,7 @@ fn render(r: &RenderDesc) -> bool {
         && r.seed <= MAX_SEED
         && finite(&[r.aspect_ratio, r.gamma, r.epsilon.unwrap_or(0.0)])
         && r.noise_target.is_none_or(f64::is_finite)
+        && r.filter_stddev.is_none_or(f64::is_finite)
 }
 
 fn camera(c: &CameraDesc) -> bool {

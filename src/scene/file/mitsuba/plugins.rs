@@ -19,7 +19,8 @@ use crate::material::{
 };
 use crate::scene::desc::{
     BackgroundDesc, CameraDesc, ColorDesc, EncodingDesc, FilterDesc, LightDesc, ObjectDesc,
-    RoughnessDesc, SamplingDesc, ScalarDesc, SceneDesc, TextureDesc, TransformDesc, WrapDesc,
+    PixelFilterDesc, RoughnessDesc, SamplingDesc, ScalarDesc, SceneDesc, TextureDesc,
+    TransformDesc, WrapDesc,
 };
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -556,21 +557,28 @@ impl<'d> Convert<'d> {
         let _ = p.boolean("banner", self)?;
         let _ = p.boolean("high_quality_edges", self)?;
         let filters = p.objects("rfilter");
-        match filters[..] {
-            [] => self.lacks(
-                e,
-                "Mitsuba's default pixel filter (gaussian)",
-                "a box filter",
-            )?,
-            [f] => match self.type_of(f)? {
-                "box" => {
-                    Props::of(f, self)?.finish(&[], self)?;
+        let (filter, stddev) = match filters[..] {
+            // Mitsuba's default.
+            [] => (PixelFilterDesc::Gaussian, None),
+            [f] => {
+                let fp = Props::of(f, self)?;
+                match self.type_of(f)? {
+                    "box" => {
+                        fp.finish(&[], self)?;
+                        (PixelFilterDesc::Box, None)
+                    }
+                    "gaussian" => {
+                        let s = fp.float("stddev", self)?;
+                        fp.finish(&["stddev"], self)?;
+                        (PixelFilterDesc::Gaussian, s)
+                    }
+                    _ => return Err(self.unknown_type(f, "rfilter", &["box", "gaussian"])),
                 }
-                "gaussian" => self.lacks(f, "a gaussian pixel filter", "a box filter")?,
-                _ => return Err(self.unknown_type(f, "rfilter", &["box", "gaussian"])),
-            },
+            }
             _ => return Err(self.fail(e, "a film has one <rfilter>".into())),
-        }
+        };
+        self.desc.render.pixel_filter = filter;
+        self.desc.render.filter_stddev = stddev;
         p.finish(
             &[
                 "width",
