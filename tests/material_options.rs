@@ -109,3 +109,44 @@ fn a_plastic_coloured_once_is_brighter_than_one_coloured_at_every_bounce() {
         "{linear:?} {nonlinear:?}"
     );
 }
+
+#[test]
+fn the_bumps_shadow_grazing_light_and_none_from_above_or_when_untilted() {
+    use lumen::bsdf::Terminator;
+    use lumen::math::Vec3;
+    let up = Vec3::Z;
+    let tilted = Vec3::new(0.5, 0.0, 1.0).normalize();
+    let t = Terminator::new(up, tilted);
+    // α² = ⅛ tan² of the tilt.
+    assert!((t.alpha2 - 0.125 * 0.25).abs() < 1e-6, "{}", t.alpha2);
+    let from = |deg: f32| {
+        let r = deg.to_radians();
+        Vec3::new(r.sin(), 0.0, r.cos())
+    };
+    assert!((t.factor(tilted, from(0.0)) - 1.0).abs() < 1e-6);
+    let (mid, low) = (t.factor(tilted, from(60.0)), t.factor(tilted, from(85.0)));
+    // Smith's G₁ for α² = 1/32: 2 / (1 + √(1 + α² tan²θ)).
+    let g1 = |deg: f32| 2.0 / (1.0 + (1.0 + t.alpha2 * deg.to_radians().tan().powi(2)).sqrt());
+    assert!((mid - g1(60.0)).abs() < 1e-5 && (low - g1(85.0)).abs() < 1e-5);
+    assert!(1.0 > mid && mid > low && low > 0.0);
+    // Below either normal: nothing.
+    assert_eq!(t.factor(tilted, from(100.0)), 0.0);
+    assert_eq!(t.factor(tilted, from(-80.0)), 0.0);
+    // An untilted surface is not shadowed.
+    assert_eq!(Terminator::new(up, up).factor(up, from(80.0)), 1.0);
+}
+
+#[test]
+fn bump_shadowing_needs_a_map() {
+    let dir = scratch_dir("material_options-bump");
+    let message = common::scene_file_error(
+        &dir,
+        "[materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\nbump_shadowing = true\n\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, -2]\nradius = 1\nmaterial = \"m\"\n",
+    );
+    assert!(
+        message.contains("materials.m.bump_shadowing")
+            && message.contains("normal_map or bump_map"),
+        "{message}"
+    );
+}

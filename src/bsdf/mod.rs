@@ -277,6 +277,82 @@ pub struct Bsdf {
     pub ng: Vec3,
     /// The lobe.
     pub lobe: Lobe,
+    /// Where a normal or bump map tilted the frame and the surface is
+    /// darkened by the shadowing of its bumps ([`Terminator::NONE`]
+    /// elsewhere).
+    pub terminator: Terminator,
+}
+
+/// The shadowing of a bumpy surface whose shading normal a map tilted
+/// (Conty Estevez et al. 2019, "A microfacet-based shadowing function to
+/// solve the bump terminator problem", as Mitsuba 3 and Cycles apply it):
+/// the bumps are taken as microfacets of width α² = min(⅛ tan²θ, 1), θ the
+/// tilt, and light arriving at θi from the untilted normal is let through
+/// by Smith's G₁ = 2 / (1 + √(1 + α² tan²θi)). Light on different sides
+/// of the untilted normal and the tilted one is none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Terminator {
+    /// The shading normal before the map tilted it (unit, on the side the
+    /// ray came from). Kept unaligned: the BSDF is copied at every bounce.
+    pub normal: [f32; 3],
+    /// The bumps' α²; 0 where nothing is tilted, and nothing shadowed.
+    pub alpha2: f32,
+}
+
+impl Terminator {
+    /// No shadowing.
+    pub const NONE: Terminator = Terminator {
+        normal: [0.0; 3],
+        alpha2: 0.0,
+    };
+
+    /// Whether it shadows anything.
+    #[inline(always)]
+    pub fn is_some(&self) -> bool {
+        self.alpha2 > 0.0
+    }
+
+    /// The terminator of a surface whose shading normal `untilted` a map
+    /// tilted to `tilted` (both unit, on the side the ray came from).
+    pub fn new(untilted: Vec3, tilted: Vec3) -> Terminator {
+        let cos2 = untilted.dot(tilted).powi(2).min(1.0);
+        let tan2 = (1.0 - cos2) / cos2.max(1e-12);
+        Terminator {
+            normal: untilted.to_array(),
+            alpha2: (0.125 * tan2).min(1.0),
+        }
+    }
+
+    /// A sample off the surface whose tilted normal is `tilted`, shadowed.
+    #[cold]
+    #[inline(never)]
+    fn shadow_sample(&self, tilted: Vec3, sample: BsdfSample) -> Option<BsdfSample> {
+        let factor = self.factor(tilted, sample.wi);
+        (factor > 0.0).then(|| BsdfSample {
+            value: sample.value * factor,
+            ..sample
+        })
+    }
+
+    /// `value`, the light arriving from `wi`, shadowed.
+    #[cold]
+    #[inline(never)]
+    fn shadow(&self, tilted: Vec3, wi: Vec3, value: Color) -> Color {
+        value * self.factor(tilted, wi)
+    }
+
+    /// The fraction of light arriving from unit `wi` (reflected off a
+    /// surface whose tilted normal is `tilted`) that its bumps let through.
+    #[inline]
+    pub fn factor(&self, tilted: Vec3, wi: Vec3) -> f32 {
+        let cos = wi.dot(Vec3::from_array(self.normal));
+        if !(cos * wi.dot(tilted) > 0.0) {
+            return 0.0;
+        }
+        let cos2 = cos * cos;
+        let tan2 = (1.0 - cos2).max(0.0) / cos2;
+        2.0 / (1.0 + (1.0 + self.alpha2 * tan2).sqrt())
+    }
 }
 
 impl Bsdf {
@@ -285,7 +361,19 @@ impl Bsdf {
     /// side).
     #[inline(always)]
     pub fn new(frame: Frame, ng: Vec3, lobe: Lobe) -> Bsdf {
-        Bsdf { frame, ng, lobe }
+        Bsdf {
+            frame,
+            ng,
+            lobe,
+            terminator: Terminator::NONE,
+        }
+    }
+
+    /// The BSDF darkened by the shadowing of its surface's bumps.
+    #[inline]
+    pub fn with_terminator(mut self, terminator: Terminator) -> Bsdf {
+        self.terminator = terminator;
+        self
     }
 
     /// Whether the shading normal differs from the geometric one.
@@ -312,6 +400,17 @@ impl Bsdf {
     /// path is absorbed.
     #[inline(always)]
     pub fn sample(&self, wo: Vec3, sampler: &mut impl Sampler) -> Option<BsdfSample> {
+        let sample = self.sample_lobe(wo, sampler)?;
+        if self.terminator.is_some() {
+            self.terminator.shadow_sample(self.frame.n, sample)
+        } else {
+            Some(sample)
+        }
+    }
+
+    /// [`Bsdf::sample`] without the terminator.
+    #[inline(always)]
+    fn sample_lobe(&self, wo: Vec3, sampler: &mut impl Sampler) -> Option<BsdfSample> {
         match &self.lobe {
             Lobe::Diffuse(d) => d.sample(self, sampler),
             Lobe::Metal(m) => m.sample(self, wo, sampler),
@@ -356,6 +455,17 @@ impl Bsdf {
     /// [`eval`](Self::eval) and [`pdf`](Self::pdf) together.
     #[inline(always)]
     pub fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        let (value, pdf) = self.eval_and_pdf_lobe(wo, wi);
+        if self.terminator.is_some() {
+            (self.terminator.shadow(self.frame.n, wi, value), pdf)
+        } else {
+            (value, pdf)
+        }
+    }
+
+    /// [`Bsdf::eval_and_pdf`] without the terminator.
+    #[inline(always)]
+    fn eval_and_pdf_lobe(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
         match &self.lobe {
             Lobe::Diffuse(d) => d.eval_and_pdf(self, wi),
             Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),

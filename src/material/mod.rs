@@ -122,6 +122,12 @@ macro_rules! material_desc {
             /// alike.
             #[serde(default, skip_serializing_if = "std::ops::Not::not")]
             pub one_sided: bool,
+            /// With a normal or bump map: darken the surface by its bumps'
+            /// shadowing and mirror a tilted normal the view is below
+            /// (Mitsuba 3's way), rather than bend it back towards the view
+            /// (Cycles').
+            #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+            pub bump_shadowing: bool,
         }
 
         impl $name {
@@ -138,6 +144,7 @@ macro_rules! material_desc {
                     opacity: self.opacity.as_ref(),
                     alpha_cutoff: self.alpha_cutoff,
                     one_sided: self.one_sided,
+                    bump_shadowing: self.bump_shadowing,
                 }
             }
 
@@ -153,6 +160,7 @@ macro_rules! material_desc {
                     opacity: &mut self.opacity,
                     alpha_cutoff: &mut self.alpha_cutoff,
                     one_sided: &mut self.one_sided,
+                    bump_shadowing: &mut self.bump_shadowing,
                 }
             }
         }
@@ -254,7 +262,7 @@ pub use param::{ColorDesc, ColorParam, Invalid, ScalarDesc, ScalarParam, Texture
 pub use plastic::{Plastic, PlasticDesc};
 pub use principled::{Principled, PrincipledDesc};
 
-use crate::bsdf::{Bsdf, Frame, Lobe};
+use crate::bsdf::{Bsdf, Frame, Lobe, Terminator};
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
 use crate::texture::Texture;
@@ -311,6 +319,8 @@ pub struct SurfaceDesc<'a> {
     pub alpha_cutoff: Option<f64>,
     /// Scatter on the outward side only.
     pub one_sided: bool,
+    /// Shadow a normal or bump map's bumps.
+    pub bump_shadowing: bool,
 }
 
 /// The fields every kind of material has, borrowed to be changed (by a
@@ -336,6 +346,8 @@ pub struct SurfaceMut<'a> {
     pub alpha_cutoff: &'a mut Option<f64>,
     /// Scatter on the outward side only.
     pub one_sided: &'a mut bool,
+    /// Shadow a normal or bump map's bumps.
+    pub bump_shadowing: &'a mut bool,
 }
 
 impl SurfaceDesc<'_> {
@@ -384,6 +396,13 @@ impl SurfaceDesc<'_> {
         material.shape = self.shape(field, textures)?;
         material.opacity = self.opacity(field, textures)?;
         material.one_sided = self.one_sided;
+        if self.bump_shadowing && material.shape.is_none() {
+            return Err(Invalid::new(
+                format!("{field}.bump_shadowing"),
+                "shadows the bumps of a normal_map or bump_map, which the material does not have",
+            ));
+        }
+        material.bump_shadowing = self.bump_shadowing;
         Ok(material)
     }
 
@@ -656,6 +675,9 @@ pub struct Material {
     pub opacity: Option<Opacity>,
     /// Scatters nothing seen from behind (the inward side).
     pub one_sided: bool,
+    /// A normal or bump map's bumps shadow the light (see
+    /// [`Terminator`](crate::bsdf::Terminator)).
+    pub bump_shadowing: bool,
 }
 
 impl Material {
@@ -667,6 +689,7 @@ impl Material {
             shape: None,
             opacity: None,
             one_sided: false,
+            bump_shadowing: false,
         }
     }
 
@@ -678,6 +701,7 @@ impl Material {
             shape: None,
             opacity: None,
             one_sided: false,
+            bump_shadowing: false,
         }
     }
 
@@ -689,10 +713,31 @@ impl Material {
         if self.one_sided && !hit.front_face {
             return None;
         }
-        let n = match &self.shape {
-            None => hit.shading_normal,
-            Some(shape) => visible(shape.normal(hit, textures), wo, hit.normal),
+        let (n, terminator) = match &self.shape {
+            None => (hit.shading_normal, None),
+            Some(shape) if self.bump_shadowing => {
+                let (untilted, tilted) = (hit.shading_normal, shape.normal(hit, textures));
+                // Seen from below the tilted normal, it is mirrored about
+                // the untilted one.
+                let tilted = if wo.dot(tilted) <= 0.0 {
+                    (2.0 * tilted.dot(untilted) * untilted - tilted).normalize()
+                } else {
+                    tilted
+                };
+                (tilted, Some(Terminator::new(untilted, tilted)))
+            }
+            Some(shape) => (visible(shape.normal(hit, textures), wo, hit.normal), None),
         };
+        let bsdf = self.lobe_at(hit, n, textures);
+        match terminator {
+            Some(t) => bsdf.map(|b| b.with_terminator(t)),
+            None => bsdf,
+        }
+    }
+
+    /// The BSDF of the material's kind at `hit` about shading normal `n`.
+    #[inline(always)]
+    fn lobe_at(&self, hit: &HitRecord, n: Vec3, textures: &[Texture]) -> Option<Bsdf> {
         // The notes' lobes scatter about the normal alone.
         let notes = |lobe| Some(Bsdf::new(Frame::normal_only(n), hit.normal, lobe));
         // The others in the frame of the surface's tangent.

@@ -1182,8 +1182,10 @@ impl<'d> Convert<'d> {
                 } else {
                     None
                 };
-                let _ = p.boolean("flip_invalid_normals", self)?;
-                let _ = p.boolean("use_shadowing_function", self)?;
+                if p.boolean("flip_invalid_normals", self)? == Some(false) {
+                    self.lacks(e, "flip_invalid_normals = false", "flipped normals")?;
+                }
+                let shadowing = p.boolean("use_shadowing_function", self)?.unwrap_or(true);
                 let mut d = self.nested(e, &p)?;
                 p.finish(
                     &[
@@ -1195,6 +1197,7 @@ impl<'d> Convert<'d> {
                     self,
                 )?;
                 let s = d.surface_mut();
+                *s.bump_shadowing = shadowing;
                 if t == "normalmap" {
                     *s.normal_map = Some(map);
                 } else {
