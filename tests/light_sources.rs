@@ -348,6 +348,16 @@ fn mistakes_in_lights_are_refused_with_the_field_and_a_hint() {
             "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nirradiance = [1, 1, 1]",
             &["lights[0].irradiance", "directional lights"],
         ),
+        (
+            "[[lights]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             intensity = [1, 1, 1]\nup = [0, 0, 1]",
+            &["lights[0].up", "projected `texture`"],
+        ),
+        (
+            "[[lights]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             intensity = [1, 1, 1]\ntexture = \"nothing\"",
+            &["lights[0].texture", "nothing"],
+        ),
     ];
     for (text, wanted) in cases {
         let message = scene_file_error(&dir, text);
@@ -374,5 +384,60 @@ fn lights_survive_export_and_json() {
         let again = lumen::scene::file::SceneFile::parse("again", written, format)
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(again.desc, desc, "{format:?}");
+    }
+}
+
+#[test]
+fn a_spot_projects_its_texture_upright_through_its_cone() {
+    // A 2 × 2 image, red on the left, blue on the right, nearest texels.
+    let dir = scratch_dir("light_sources-projected");
+    let mut img = image::RgbImage::new(2, 2);
+    for y in 0..2 {
+        img.put_pixel(0, y, image::Rgb([255, 0, 0]));
+        img.put_pixel(1, y, image::Rgb([0, 0, 255]));
+    }
+    img.save(dir.join("slide.png")).unwrap();
+    // Up the image -z puts its left at -x; turned about, at +x.
+    for (up, red_side) in [(-1.0, -1.0), (1.0, 1.0)] {
+        let text = format!(
+            "[render]\nwidth = {SIZE}\nheight = {SIZE}\nsampler = \"center\"\n\
+             samples_per_pixel = 1\nmax_depth = 2\n\n\
+             [camera]\nvfov = 100\nlookfrom = [0, 4, 0]\nlookat = [0, 0, 0]\nvup = [0, 0, -1]\n\n\
+             [background]\ntype = \"solid\"\ncolor = [0, 0, 0]\n\n\
+             [textures.slide]\ntype = \"image\"\nfile = \"slide.png\"\nfilter = \"nearest\"\n\n\
+             [materials.floor]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n\n\
+             [[objects]]\ntype = \"quad\"\ncorner = [-8, 0, 8]\nu = [16, 0, 0]\nv = [0, 0, -16]\n\
+             material = \"floor\"\n\n\
+             [[lights]]\ntype = \"spot\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\n\
+             intensity = [4, 4, 4]\ncutoff_angle = 40\nbeam_width = 40\ntexture = \"slide\"\n\
+             up = [0, 0, {up}]\n"
+        );
+        let scene = compile_file(&dir, "s.toml", &text);
+        let stats = pixel_stats(&scene);
+        let (mut red, mut blue) = (0, 0);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let p = floor_point(&scene, x, y);
+                let c = stats.pixel(x, y);
+                let reach = 2.0 * 40f64.to_radians().tan() - 0.1;
+                if (p[0] * p[0] + p[2] * p[2]).sqrt() > reach || p[0].abs() < 0.1 {
+                    continue;
+                }
+                if p[0] * red_side > 0.0 {
+                    assert!(
+                        c[0] > 0.0 && c[1] == 0.0 && c[2] == 0.0,
+                        "({x}, {y}) at {p:?}: {c:?}"
+                    );
+                    red += 1;
+                } else {
+                    assert!(
+                        c[2] > 0.0 && c[0] == 0.0 && c[1] == 0.0,
+                        "({x}, {y}) at {p:?}: {c:?}"
+                    );
+                    blue += 1;
+                }
+            }
+        }
+        assert!(red > 20 && blue > 20, "{red} red and {blue} blue pixels");
     }
 }

@@ -210,3 +210,8 @@ fn bsdf_spheres_normal_and_bump_maps_close() {
     close("bsdf_spheres", "test_normalmap_path.xml", 0.01);
     close("bsdf_spheres", "test_bumpmap_path.xml", 0.01);
 }
+
+#[test]
+fn spot_light_projecting_a_texture() {
+    check("spot_light", "test_spot_direct.xml");
+}

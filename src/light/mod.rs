@@ -296,7 +296,9 @@ impl Lights {
             return Lights::default();
         };
         // Only the textures of textured lights are looked up.
-        let textures = if lights.iter().any(|l| l.texture.is_some()) {
+        let textures = if lights.iter().any(|l| l.texture.is_some())
+            || sources.iter().any(LightSource::is_textured)
+        {
             textures
         } else {
             Vec::new()
@@ -337,7 +339,7 @@ impl Lights {
         let uv = sampler.get_2d(Dim::Light);
         let Some(light) = self.lights.get(i) else {
             if let Some(source) = self.sources.get(i - self.lights.len()) {
-                let incident = source.illuminate(point, uv)?;
+                let incident = source.illuminate(point, uv, &self.textures)?;
                 let pdf = chance * incident.pdf;
                 return (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
                     point: incident.point,

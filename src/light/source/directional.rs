@@ -42,7 +42,11 @@ pub struct DirectionalLight {
 
 impl DirectionalLightDesc {
     /// The light described; `field` is its path for messages.
-    pub fn compile(&self, field: &str) -> Result<DirectionalLight, Invalid> {
+    pub fn compile(
+        &self,
+        field: &str,
+        _textures: &mut dyn crate::material::param::Textures,
+    ) -> Result<DirectionalLight, Invalid> {
         let travels = check_vector(&format!("{field}.direction"), self.direction)?;
         let irradiance = check_color(&format!("{field}.irradiance"), self.irradiance)?;
         let radius = self.angular_radius.unwrap_or(0.0);

@@ -18,8 +18,10 @@ pub use directional::{DirectionalLight, DirectionalLightDesc};
 pub use point::{PointLight, PointLightDesc};
 pub use spot::{SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
 
+use crate::material::param::Textures;
 use crate::material::{Invalid, KindInfo};
 use crate::math::{Color, Point3, Vec3};
+use crate::texture::Texture;
 
 /// Lists the kinds once: the description enum (tagged by `type` in scene
 /// files), the table of kinds and their fields, and compilation.
@@ -72,10 +74,15 @@ macro_rules! source_kinds {
             }
 
             /// The light described, compiled: `field` is its path
-            /// (`lights[3]`) for messages.
-            pub fn compile(&self, field: &str) -> Result<LightSource, Invalid> {
+            /// (`lights[3]`) for messages, `textures` resolves texture
+            /// names.
+            pub fn compile(
+                &self,
+                field: &str,
+                textures: &mut dyn Textures,
+            ) -> Result<LightSource, Invalid> {
                 Ok(match self {
-                    $(LightDesc::$variant(d) => LightSource::$variant(d.compile(field)?),)*
+                    $(LightDesc::$variant(d) => LightSource::$variant(d.compile(field, textures)?),)*
                 })
             }
         }
@@ -147,14 +154,20 @@ impl Incident {
 
 impl LightSource {
     /// The light it sheds on `from`, its direction drawn from `u` where it
-    /// has more than one; `None` where it sheds none.
+    /// has more than one (`textures` holding a spot's projected image);
+    /// `None` where it sheds none.
     #[inline]
-    pub fn illuminate(&self, from: Point3, u: [f32; 2]) -> Option<Incident> {
+    pub fn illuminate(&self, from: Point3, u: [f32; 2], textures: &[Texture]) -> Option<Incident> {
         match self {
             LightSource::Point(l) => l.illuminate(from),
-            LightSource::Spot(l) => l.illuminate(from),
+            LightSource::Spot(l) => l.illuminate(from, textures),
             LightSource::Directional(l) => l.illuminate(from, u),
         }
+    }
+
+    /// Whether it looks textures up.
+    pub fn is_textured(&self) -> bool {
+        matches!(self, LightSource::Spot(l) if l.is_textured())
     }
 
     /// The radiance an escaping ray sees looking along unit `direction`,

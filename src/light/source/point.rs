@@ -29,7 +29,11 @@ pub struct PointLight {
 
 impl PointLightDesc {
     /// The light described; `field` is its path for messages.
-    pub fn compile(&self, field: &str) -> Result<PointLight, Invalid> {
+    pub fn compile(
+        &self,
+        field: &str,
+        _textures: &mut dyn crate::material::param::Textures,
+    ) -> Result<PointLight, Invalid> {
         Ok(PointLight {
             position: check_point(&format!("{field}.position"), self.position)?,
             intensity: check_color(&format!("{field}.intensity"), self.intensity)?,

@@ -3,9 +3,11 @@
 //! `cutoff_angle` (Mitsuba's `spot`).
 
 use super::{check_color, check_point, check_vector, Incident};
+use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
+use crate::texture::{TexCoords, Texture};
 use std::f64::consts::PI;
 
 /// A spot light as a scene describes it.
@@ -31,6 +33,15 @@ pub struct SpotLightDesc {
     /// intensity, in (0, `cutoff_angle`]; ¾ of `cutoff_angle` when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beam_width: Option<f64>,
+    /// An image (the name of a colour texture) projected through the
+    /// cone, as a slide projector does: its square fills the cone's
+    /// cut-off, and it multiplies the intensity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<String>,
+    /// Which way is up in the projected image (any direction not along
+    /// the axis); +y when absent, or +z when the axis is vertical.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Triple>,
 }
 
 /// The cut-off angle of a spot light that gives none, in degrees.
@@ -53,11 +64,14 @@ pub struct SpotLight {
     /// 1 / (cutoff − beam width), per radian.
     inv_transition: f32,
     beam: f32,
+    /// The projected image's texture, and its right and up directions
+    /// (unit, perpendicular to the axis) over tan(cutoff).
+    projection: Option<(u32, Vec3, Vec3)>,
 }
 
 impl SpotLightDesc {
     /// The light described; `field` is its path for messages.
-    pub fn compile(&self, field: &str) -> Result<SpotLight, Invalid> {
+    pub fn compile(&self, field: &str, textures: &mut dyn Textures) -> Result<SpotLight, Invalid> {
         let position = check_point(&format!("{field}.position"), self.position)?;
         let axis = match (self.direction, self.target) {
             (Some(d), None) => check_vector(&format!("{field}.direction"), d)?,
@@ -99,7 +113,49 @@ impl SpotLightDesc {
             ));
         }
         let (cutoff, beam) = (cutoff.to_radians() as f32, beam.to_radians() as f32);
+        let projection = match &self.texture {
+            None => {
+                if self.up.is_some() {
+                    return Err(Invalid::new(
+                        format!("{field}.up"),
+                        "orients a projected `texture`, which the light does not have",
+                    ));
+                }
+                None
+            }
+            Some(name) => {
+                let at = format!("{field}.texture");
+                let ColorParam::Texture(t) = textures.color(
+                    &at,
+                    &ColorDesc::Texture(name.clone()),
+                    ColorRange::NonNegative,
+                )?
+                else {
+                    return Err(Invalid::new(at, "must name a texture"));
+                };
+                let up = match self.up {
+                    Some(u) => check_vector(&format!("{field}.up"), u)?,
+                    None if axis.y.abs() > 0.999 => Vec3::Z,
+                    None => Vec3::Y,
+                };
+                let right = axis.cross(up).normalize_or_zero();
+                if right == Vec3::ZERO || cutoff >= std::f32::consts::FRAC_PI_2 {
+                    return Err(Invalid::new(
+                        format!("{field}.up"),
+                        if cutoff >= std::f32::consts::FRAC_PI_2 {
+                            "a projected texture needs a cutoff_angle below 90 degrees"
+                        } else {
+                            "lies along the light's axis"
+                        },
+                    ));
+                }
+                let up = right.cross(axis);
+                let tan = cutoff.tan();
+                Some((t, right / tan, up / tan))
+            }
+        };
         Ok(SpotLight {
+            projection,
             position,
             axis,
             intensity: check_color(&format!("{field}.intensity"), self.intensity)?,
@@ -132,14 +188,30 @@ impl SpotLight {
         }
     }
 
-    /// The light arriving at `from`.
+    /// The light arriving at `from` (`textures` holding its projected
+    /// image).
     #[inline]
-    pub fn illuminate(&self, from: Point3) -> Option<Incident> {
-        let falloff = self.falloff((from - self.position).normalize_or_zero());
+    pub fn illuminate(&self, from: Point3, textures: &[Texture]) -> Option<Incident> {
+        let d = (from - self.position).normalize_or_zero();
+        let falloff = self.falloff(d);
         if falloff == 0.0 {
             return None;
         }
-        Incident::from_point(from, self.position, self.intensity * falloff)
+        let mut intensity = self.intensity * falloff;
+        if let Some((t, right, up)) = self.projection {
+            // The image's square spans ±tan(cutoff) across the axis at
+            // unit distance along it.
+            let z = d.dot(self.axis);
+            let uv = [0.5 + 0.5 * d.dot(right) / z, 0.5 + 0.5 * d.dot(up) / z];
+            let c = textures[t as usize].value(textures, &TexCoords::new(uv, from));
+            intensity *= c.max(Color::ZERO);
+        }
+        Incident::from_point(from, self.position, intensity)
+    }
+
+    /// Whether it projects an image (and so looks textures up).
+    pub fn is_textured(&self) -> bool {
+        self.projection.is_some()
     }
 
     /// Its power's luminance, as if the intensity fell off at the middle

@@ -110,16 +110,18 @@ impl Scene {
             let field = format!("materials.{name}");
             materials.push(compile_material(&field, m, &mut table, &mut sources)?);
         }
+        let mut light_sources = Vec::with_capacity(desc.lights.len());
+        for (i, l) in desc.lights.iter().enumerate() {
+            let mut textures = MaterialTextures {
+                textures: &mut table,
+                sources: &mut sources,
+            };
+            light_sources.push(
+                l.compile(&format!("lights[{i}]"), &mut textures)
+                    .map_err(|e| invalid(e.field, e.message))?,
+            );
+        }
         let textures = table.textures;
-        let light_sources = desc
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                l.compile(&format!("lights[{i}]"))
-                    .map_err(|e| invalid(e.field, e.message))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
         let mut objects = Objects {
             desc,
             base,

@@ -128,6 +128,8 @@ impl<'d> Convert<'d> {
         cx.desc.render.sampler = SamplingDesc::Independent;
         cx.desc.render.samples_per_pixel = 4;
         cx.desc.render.max_depth = UNLIMITED_DEPTH;
+        // Mitsuba 3 chooses among its emitters uniformly.
+        cx.desc.render.light_selection = crate::light::LightSelection::Uniform;
         Ok(cx)
     }
 
@@ -718,10 +720,13 @@ impl<'d> Convert<'d> {
                 let m = p.transform("to_world", self)?.unwrap_or(IDENTITY);
                 let cutoff = p.float("cutoff_angle", self)?;
                 let beam = p.float("beam_width", self)?;
-                if p.has("texture") {
-                    let _ = p.colour("texture", Use::Reflectance, self)?;
-                    self.lacks(e, "a spot light's projected texture", "an untextured spot")?;
-                }
+                let texture = match p.colour("texture", Use::Reflectance, self)? {
+                    None => None,
+                    Some(Colour::Texture(t)) => Some(self.texture(t, false)?),
+                    Some(Colour::Rgb(_)) => {
+                        return Err(self.fail(e, "a spot light's `texture` is an image".into()))
+                    }
+                };
                 p.finish(
                     &[
                         "to_world",
@@ -739,6 +744,12 @@ impl<'d> Convert<'d> {
                     intensity,
                     cutoff_angle: cutoff,
                     beam_width: beam,
+                    // Mitsuba's image has its top towards the light's -y
+                    // and its u along +x: lumen's, seen up = -y.
+                    up: texture
+                        .is_some()
+                        .then(|| transform::vector(&m, [0.0, -1.0, 0.0])),
+                    texture,
                 }));
                 Ok(())
             }
