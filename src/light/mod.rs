@@ -339,16 +339,9 @@ impl Lights {
         let uv = sampler.get_2d(Dim::Light);
         let Some(light) = self.lights.get(i) else {
             if let Some(source) = self.sources.get(i - self.lights.len()) {
-                let incident = source.illuminate(point, uv, &self.textures)?;
-                let pdf = chance * incident.pdf;
-                return (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
-                    point: incident.point,
-                    direction: incident.direction,
-                    distance: incident.distance,
-                    radiance: incident.radiance,
-                    pdf,
-                    delta: incident.delta,
-                });
+                let mut sample = source.illuminate(point, uv, &self.textures)?;
+                sample.pdf *= chance;
+                return (sample.pdf > 0.0 && sample.pdf.is_finite()).then_some(sample);
             }
             let sky = self.environment.as_ref()?.sample(uv)?;
             let pdf = chance * sky.pdf;

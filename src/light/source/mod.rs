@@ -109,26 +109,10 @@ impl LightDesc {
     }
 }
 
-/// The light a source sheds on a point.
-#[derive(Clone, Copy, Debug)]
-pub struct Incident {
-    /// Where it comes from (for light from infinitely far: the shaded point
-    /// moved one unit along `direction`).
-    pub point: Point3,
-    /// Unit direction from the shaded point towards it.
-    pub direction: Vec3,
-    /// The distance to `point` (infinite for light from infinitely far).
-    pub distance: f32,
-    /// For a delta light, the irradiance it brings to a surface facing it
-    /// (intensity / d² for a point); otherwise the radiance along
-    /// `direction`.
-    pub radiance: Color,
-    /// The density of `direction` per unit solid angle; 1 for a delta
-    /// light, whose direction is certain.
-    pub pdf: f32,
-    /// Whether the light has a single direction here (no ray can meet it).
-    pub delta: bool,
-}
+/// The light a source sheds on a point: a light sample whose `pdf` is
+/// that of the direction alone (1 for a delta light), before the choice of
+/// the light.
+pub type Incident = super::LightSample;
 
 impl Incident {
     /// The light of intensity `intensity` at `position` arriving at `from`;

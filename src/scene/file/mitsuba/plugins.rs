@@ -5,7 +5,7 @@
 //! it does not know.
 
 use super::props::{describe, Colour, Props};
-use super::spectrum::{named_ior, Use};
+use super::spectrum::Use;
 use super::transform::{self, Mat4, IDENTITY};
 use super::xml::{Document, Element};
 use super::{located, Failure, Imported, Options};
@@ -53,6 +53,15 @@ const BSDFS: &[&str] = &[
 const EMITTERS: &[&str] = &["area", "constant", "envmap", "point", "spot", "directional"];
 const INTEGRATORS: &[&str] = &["path", "direct", "volpath", "volpathmis", "moment"];
 const TEXTURES: &[&str] = &["bitmap"];
+
+/// The parameters of a rough BSDF's microfacets.
+const MICROFACET_PARAMS: [&str; 5] = [
+    "distribution",
+    "alpha",
+    "alpha_u",
+    "alpha_v",
+    "sample_visible",
+];
 
 /// Mitsuba's `max_depth = -1` (no limit), as lumen's largest practical
 /// depth: Russian roulette ends paths long before.
@@ -1056,13 +1065,7 @@ impl<'d> Convert<'d> {
                     self.lacks(e, "a thin dielectric", "a solid dielectric")?;
                 }
                 if t == "roughdielectric" {
-                    known.extend([
-                        "distribution",
-                        "alpha",
-                        "alpha_u",
-                        "alpha_v",
-                        "sample_visible",
-                    ]);
+                    known.extend(MICROFACET_PARAMS);
                     let (alpha, distribution) = self.microfacets(e, &p)?;
                     d.alpha = Some(alpha);
                     d.distribution = Some(distribution);
@@ -1104,13 +1107,7 @@ impl<'d> Convert<'d> {
                 self.unit_factor(e, &p, "specular_reflectance")?;
                 let mut known = vec!["material", "eta", "k", "specular_reflectance"];
                 if t == "roughconductor" {
-                    known.extend([
-                        "distribution",
-                        "alpha",
-                        "alpha_u",
-                        "alpha_v",
-                        "sample_visible",
-                    ]);
+                    known.extend(MICROFACET_PARAMS);
                     let (alpha, distribution) = self.microfacets(e, &p)?;
                     d.alpha = Some(alpha);
                     d.distribution = Some(distribution);
@@ -1322,21 +1319,23 @@ impl<'d> Convert<'d> {
                 return Ok(v);
             }
             let name = p.string(n, self)?.unwrap_or("");
-            named_ior(name).ok_or_else(|| {
-                let names: Vec<&str> = super::spectrum::NAMED_IORS
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect();
-                self.fail_hint(
-                    e,
-                    format!(
-                        "unknown index of refraction `{name}`; the named ones: {}",
-                        names.join(", ")
-                    ),
-                    hint::closest(name, names.iter().copied())
-                        .map(|k| format!("did you mean `{k}`?")),
-                )
-            })
+            crate::material::metals::find_ior(name)
+                .map(f64::from)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = crate::material::metals::IORS
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect();
+                    self.fail_hint(
+                        e,
+                        format!(
+                            "unknown index of refraction `{name}`; the named ones: {}",
+                            names.join(", ")
+                        ),
+                        hint::closest(name, names.iter().copied())
+                            .map(|k| format!("did you mean `{k}`?")),
+                    )
+                })
         };
         let int = ior("int_ior", int_default)?;
         let ext = ior("ext_ior", 1.000277)?;

@@ -132,42 +132,6 @@ pub fn number(t: &str) -> Result<f64, String> {
     }
 }
 
-/// The indices of refraction Mitsuba knows by name (lower case).
-pub const NAMED_IORS: &[(&str, f64)] = &[
-    ("vacuum", 1.0),
-    ("helium", 1.000036),
-    ("hydrogen", 1.000132),
-    ("air", 1.000277),
-    ("carbon dioxide", 1.00045),
-    ("water", 1.3330),
-    ("acetone", 1.36),
-    ("ethanol", 1.361),
-    ("carbon tetrachloride", 1.461),
-    ("glycerol", 1.4729),
-    ("benzene", 1.501),
-    ("silicone oil", 1.52045),
-    ("bromine", 1.661),
-    ("water ice", 1.31),
-    ("fused quartz", 1.458),
-    ("pyrex", 1.470),
-    ("acrylic glass", 1.49),
-    ("polypropylene", 1.49),
-    ("bk7", 1.5046),
-    ("sodium chloride", 1.544),
-    ("amber", 1.55),
-    ("pet", 1.5750),
-    ("diamond", 2.419),
-];
-
-/// The index of refraction named `name` (any case).
-pub fn named_ior(name: &str) -> Option<f64> {
-    let lower = name.to_ascii_lowercase();
-    NAMED_IORS
-        .iter()
-        .find(|(n, _)| *n == lower)
-        .map(|(_, v)| *v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
