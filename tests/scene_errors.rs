@@ -430,7 +430,7 @@ fn missing_file_and_directory() {
     let m = SceneFile::read(&dir.join("scene.txt"))
         .unwrap_err()
         .to_string();
-    assert_mentions(&m, &["scene.txt", "must end in .toml or .json"]);
+    assert_mentions(&m, &["scene.txt", "must end in .toml, .json or .xml"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
