@@ -676,7 +676,7 @@ pub struct Material {
     /// Scatters nothing seen from behind (the inward side).
     pub one_sided: bool,
     /// A normal or bump map's bumps shadow the light (see
-    /// [`Terminator`](crate::bsdf::Terminator)).
+    /// [`Terminator`]).
     pub bump_shadowing: bool,
 }
 

@@ -2,8 +2,8 @@
 //! every lumen scene has, so that a Mitsuba scene renders as it is and
 //! exports to lumen's TOML unchanged.
 //!
-//! The XML layer ([`xml`]) reads the files; [`props`] reads a plugin's
-//! parameters by type; [`plugins`] turns each plugin into lumen's
+//! The XML layer (`xml`) reads the files; `props` reads a plugin's
+//! parameters by type; `plugins` turns each plugin into lumen's
 //! description, one function a tag. Colours are read as Mitsuba's RGB
 //! variants read them ([`spectrum`]). What lumen does not have is refused
 //! with the element's file, line and column and the list of what it has,
