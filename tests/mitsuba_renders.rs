@@ -215,3 +215,11 @@ fn bsdf_spheres_normal_and_bump_maps_close() {
 fn spot_light_projecting_a_texture() {
     check("spot_light", "test_spot_direct.xml");
 }
+
+#[test]
+fn bsdf_spheres_identity_normal_map_anisotropic_conductor() {
+    check(
+        "bsdf_spheres",
+        "test_normalmap_identity_roughconductor_path.xml",
+    );
+}

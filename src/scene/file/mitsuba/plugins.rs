@@ -1166,6 +1166,23 @@ impl<'d> Convert<'d> {
                 *d.surface_mut().opacity = Some(opacity);
                 d
             }
+            "normalmap" if self.identity_normals(&p) => {
+                // A constant normal of (0, 0, 1) tilts nothing: the nested
+                // BSDF as it is.
+                let _ = p.objects("texture");
+                let _ = p.boolean("flip_invalid_normals", self)?;
+                let _ = p.boolean("use_shadowing_function", self)?;
+                let d = self.nested(e, &p)?;
+                p.finish(
+                    &[
+                        "normalmap",
+                        "flip_invalid_normals",
+                        "use_shadowing_function",
+                    ],
+                    self,
+                )?;
+                d
+            }
             "bumpmap" | "normalmap" => {
                 let map = if t == "normalmap" {
                     match p.colour("normalmap", Use::Unbounded, self)? {
@@ -1230,6 +1247,26 @@ impl<'d> Convert<'d> {
             _ => return Err(self.unknown_type(e, "bsdf", BSDFS)),
         };
         Ok(desc)
+    }
+
+    /// Whether a normal map's `normalmap` is a `rawconstant` texture of
+    /// the untilted normal, (0.5, 0.5, 1) (taking the parameter if so).
+    fn identity_normals(&self, p: &Props<'d>) -> bool {
+        let Some(tex) = p.peek("normalmap") else {
+            return false;
+        };
+        if tex.tag != "texture" || tex.attr("type") != Some("rawconstant") {
+            return false;
+        }
+        let Ok(inner) = Props::of(tex, self) else {
+            return false;
+        };
+        let value = inner.point("value", self).ok().flatten();
+        let identity = value == Some([0.5, 0.5, 1.0]) && inner.finish(&["value"], self).is_ok();
+        if identity {
+            p.take("normalmap");
+        }
+        identity
     }
 
     /// Mitsuba's Disney-style `principled` as lumen's glTF principled, as

@@ -109,6 +109,19 @@ impl<'e> Props<'e> {
         Some((self.named[i].1, self.named[i].2))
     }
 
+    /// The element parameter `name` resolves to, without taking it.
+    pub fn peek(&self, name: &str) -> Option<&'e Element> {
+        self.named
+            .iter()
+            .find(|(n, _, _)| *n == name)
+            .map(|(_, _, e)| *e)
+    }
+
+    /// Marks parameter `name` taken.
+    pub fn take(&self, name: &str) {
+        let _ = self.get(name);
+    }
+
     /// Whether parameter `name` is given (without taking it).
     pub fn has(&self, name: &str) -> bool {
         self.named.iter().any(|(n, _, _)| *n == name)
