@@ -436,14 +436,10 @@ impl Lights {
     /// (its choice included).
     pub fn seen_along(&self, direction: Vec3) -> impl Iterator<Item = (Color, f32)> + '_ {
         let first = self.lights.len();
-        self.sources
-            .iter()
-            .enumerate()
-            .filter(|_| self.sources_seen)
-            .filter_map(move |(j, s)| {
-                let (radiance, pdf) = s.seen_along(direction)?;
-                Some((radiance, self.choice.chance(first + j) * pdf))
-            })
+        self.sources.iter().enumerate().filter_map(move |(j, s)| {
+            let (radiance, pdf) = s.seen_along(direction)?;
+            Some((radiance, self.choice.chance(first + j) * pdf))
+        })
     }
 }
 

@@ -192,21 +192,23 @@ impl SpotLight {
     /// image).
     #[inline]
     pub fn illuminate(&self, from: Point3, textures: &[Texture]) -> Option<Incident> {
-        let d = (from - self.position).normalize_or_zero();
+        let mut sample = Incident::from_point(from, self.position, self.intensity)?;
+        // The direction the light leaves in.
+        let d = -sample.direction;
         let falloff = self.falloff(d);
         if falloff == 0.0 {
             return None;
         }
-        let mut intensity = self.intensity * falloff;
+        sample.radiance *= falloff;
         if let Some((t, right, up)) = self.projection {
             // The image's square spans ±tan(cutoff) across the axis at
             // unit distance along it.
             let z = d.dot(self.axis);
             let uv = [0.5 + 0.5 * d.dot(right) / z, 0.5 + 0.5 * d.dot(up) / z];
             let c = textures[t as usize].value(textures, &TexCoords::new(uv, from));
-            intensity *= c.max(Color::ZERO);
+            sample.radiance *= c.max(Color::ZERO);
         }
-        Incident::from_point(from, self.position, intensity)
+        Some(sample)
     }
 
     /// Whether it projects an image (and so looks textures up).

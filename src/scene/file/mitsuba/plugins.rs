@@ -257,9 +257,10 @@ impl<'d> Convert<'d> {
         for e in &doc.elements {
             match e.tag.as_str() {
                 "sensor" => {
-                    if sensor.replace(e).is_some() {
+                    if sensor.is_some() {
                         self.lacks(e, "a second <sensor>", "the first sensor")?;
-                        sensor = Some(sensor.unwrap());
+                    } else {
+                        sensor = Some(e);
                     }
                 }
                 "integrator" => {
@@ -1026,11 +1027,11 @@ impl<'d> Convert<'d> {
     /// A child BSDF of wrapper `e`.
     fn nested(&mut self, e: &'d Element, p: &Props<'d>) -> Result<MaterialDesc, Failure> {
         match p.objects("bsdf")[..] {
-            [one] => self.bsdf_desc(one),
             [] => Err(self.fail(e, format!("{} wraps a <bsdf>", describe(e)))),
-            _ => {
-                self.lacks(e, &format!("{} with two BSDFs", describe(e)), "the first")?;
-                let first = p.objects("bsdf")[0];
+            [first, ref rest @ ..] => {
+                if !rest.is_empty() {
+                    self.lacks(e, &format!("{} with two BSDFs", describe(e)), "the first")?;
+                }
                 self.bsdf_desc(first)
             }
         }

@@ -29,8 +29,9 @@ pub struct At {
 /// The files a scene was read from, for messages.
 #[derive(Clone, Debug, Default)]
 pub struct Files {
-    /// Each file's name as messages show it, and its text.
-    pub files: Vec<(String, String)>,
+    /// Each file's name as messages show it, and its text (shared, so
+    /// that a file is parsed without a copy while includes are added).
+    pub files: Vec<(String, std::sync::Arc<str>)>,
 }
 
 /// An element: its tag, attributes (after substitution), children, and
@@ -176,7 +177,7 @@ impl Loader<'_> {
         let text = String::from_utf8(bytes)
             .map_err(|_| fail_at(self, format!("{name}: is not UTF-8 text")))?;
         let index = self.files.files.len() as u32;
-        self.files.files.push((name.clone(), text));
+        self.files.files.push((name.clone(), text.into()));
         self.stack.push(canon);
         let result = self.document(index, path);
         self.stack.pop();
@@ -189,7 +190,7 @@ impl Loader<'_> {
 
     /// The elements of file number `index` (read from `path`).
     fn document(&mut self, index: u32, path: &Path) -> Result<Vec<Element>, Failure> {
-        let text = self.files.files[index as usize].1.clone();
+        let text = std::sync::Arc::clone(&self.files.files[index as usize].1);
         let options = roxmltree::ParsingOptions {
             allow_dtd: false,
             nodes_limit: (MAX_ELEMENTS - self.count.min(MAX_ELEMENTS)) as u32,
