@@ -33,6 +33,8 @@ pub struct CameraSettings {
     /// [0, 1]; each ray is traced at a time drawn uniformly between them
     /// (at `open` when they are equal).
     pub shutter: [f32; 2],
+    /// Mirror the image left to right (a left-handed camera).
+    pub mirror: bool,
 }
 
 impl Default for CameraSettings {
@@ -45,6 +47,7 @@ impl Default for CameraSettings {
             defocus_angle: 0.0,
             focus_dist: 1.0,
             shutter: [0.0, 0.0],
+            mirror: false,
         }
     }
 }
@@ -176,6 +179,8 @@ impl Camera {
         }
         let u = side.normalize();
         let v = w.cross(u);
+        // Mirrored, the image's x runs the other way; up stays up.
+        let u = if s.mirror { -u } else { u };
 
         let h = (s.vfov.to_radians() / 2.0).tan();
         let viewport_height = 2.0 * h * s.focus_dist;
@@ -296,7 +301,32 @@ mod tests {
             defocus_angle: 0.0,
             focus_dist: 1.0,
             shutter: [0.0, 0.0],
+            mirror: false,
         }
+    }
+
+    #[test]
+    fn a_mirrored_camera_sees_the_image_flipped_left_to_right() {
+        let s = CameraSettings {
+            lookfrom: Vec3::new(3.0, 2.0, 1.0),
+            lookat: Vec3::new(0.0, 0.5, -1.0),
+            vfov: 40.0,
+            ..settings()
+        };
+        let plain = Camera::new(&s, 64, 48).unwrap();
+        let mirrored = Camera::new(&CameraSettings { mirror: true, ..s }, 64, 48).unwrap();
+        let [u, v, w] = mirrored.basis;
+        assert!((u.cross(v) + w).length() < 1e-6, "left-handed");
+        assert!(v.y > 0.0, "up stays up");
+        for (x, y) in [(0, 0), (5, 40), (63, 47), (31, 10)] {
+            let a = mirrored.central_ray(x, y).direction;
+            let b = plain.central_ray(63 - x, y).direction;
+            assert!((a - b).length() < 1e-5, "pixel ({x}, {y}): {a} vs {b}");
+        }
+        assert!(
+            (mirrored.central_ray(0, 0).direction - plain.central_ray(0, 0).direction).length()
+                > 0.1
+        );
     }
 
     /// A focus plane so close that the pixels' points round together is

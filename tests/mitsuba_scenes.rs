@@ -311,3 +311,24 @@ fn a_render_of_a_bad_scene_writes_nothing_and_fails() {
     assert!(!run.status.success());
     assert!(!dir.join("x.png").exists());
 }
+
+#[test]
+fn a_sensor_whose_transform_mirrors_mirrors_the_image() {
+    let dir = scratch_dir("mitsuba_scenes_mirror");
+    let read = |scale: &str| {
+        let text = scene(&format!(
+            "  <sensor type=\"perspective\"><transform name=\"to_world\"><scale {scale}/>\
+             <lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>"
+        ));
+        let path = dir.join("s.xml");
+        std::fs::write(&path, &text).unwrap();
+        SceneFile::read_with(&path, &mitsuba::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
+            .desc
+            .camera
+    };
+    let (plain, mirrored) = (read("x=\"1\""), read("x=\"-1\""));
+    assert!(!plain.mirror && mirrored.mirror);
+    assert_eq!(plain.lookfrom, [0.0, 0.0, 5.0]);
+    assert_eq!(mirrored.lookfrom, [0.0, 0.0, 5.0]);
+}

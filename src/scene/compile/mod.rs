@@ -292,6 +292,7 @@ fn compile_camera(
             } else {
                 [cam.shutter[0] as f32; 2]
             },
+            mirror: cam.mirror,
         },
         settings.width,
         settings.height,

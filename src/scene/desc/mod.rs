@@ -309,6 +309,11 @@ pub struct CameraDesc {
     /// `vfov`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gltf: Option<GltfCamera>,
+    /// Show the image mirrored left to right: +x of the image is
+    /// `vup × view` instead of `view × vup`, as a left-handed camera (pbrt's
+    /// `LookAt`, a Mitsuba sensor whose transform mirrors) sees it.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub mirror: bool,
 }
 
 /// Which camera of the scene's glTF models.
@@ -343,6 +348,7 @@ impl Default for CameraDesc {
             focus_dist: None,
             shutter: FULL_SHUTTER,
             gltf: None,
+            mirror: false,
         }
     }
 }

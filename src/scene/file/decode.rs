@@ -554,6 +554,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "focus_dist",
             "shutter",
             "gltf",
+            "mirror",
         ],
         &[],
     )?;
@@ -569,6 +570,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         focus_dist: t.optional("focus_dist", float)?,
         shutter: t.optional("shutter", pair)?.unwrap_or(d.shutter),
         gltf: t.optional("gltf", gltf_camera)?,
+        mirror: t.optional("mirror", boolean)?.unwrap_or(false),
     })
 }
 

@@ -498,13 +498,6 @@ impl<'d> Convert<'d> {
                     .into(),
             ));
         }
-        if transform::det3(&to_world) < 0.0 {
-            self.lacks(
-                e,
-                "a sensor transform that mirrors the image",
-                "the image unmirrored",
-            )?;
-        }
         let mut camera = CameraDesc {
             vfov: vfov.to_degrees(),
             lookfrom: origin,
@@ -514,6 +507,9 @@ impl<'d> Convert<'d> {
                 origin[2] + forward[2],
             ],
             vup: up,
+            // Mitsuba's image runs along −x of the sensor's frame: a frame
+            // that mirrors mirrors the image.
+            mirror: transform::det3(&to_world) < 0.0,
             ..CameraDesc::default()
         };
         if t == "thinlens" {
