@@ -131,6 +131,63 @@ impl TriangleMesh {
     }
 }
 
+impl Model {
+    /// A model of one mesh given by its arrays (a mesh written out in a
+    /// scene file), placed once as it is; triangles of zero area are
+    /// skipped and counted. What is wrong is said in a sentence.
+    pub fn from_arrays(
+        positions: Vec<[f32; 3]>,
+        triangles: &[[u32; 3]],
+        normals: Option<Vec<[f32; 3]>>,
+        uvs: Option<Vec<[f32; 2]>>,
+    ) -> Result<Model, String> {
+        let n = positions.len();
+        if let Some(normals) = &normals {
+            if normals.len() != n {
+                return Err(format!(
+                    "`normals` has {} entries for {n} positions: give one per position",
+                    normals.len()
+                ));
+            }
+        }
+        if let Some(uvs) = &uvs {
+            if uvs.len() != n {
+                return Err(format!(
+                    "`uvs` has {} entries for {n} positions: give one per position",
+                    uvs.len()
+                ));
+            }
+        }
+        if let Some((t, i)) = triangles
+            .iter()
+            .enumerate()
+            .find_map(|(t, tri)| tri.iter().find(|&&i| i as usize >= n).map(|&i| (t, i)))
+        {
+            return Err(format!(
+                "`indices[{t}]` names vertex {i}, but there are {n} positions (0 to {})",
+                n.saturating_sub(1)
+            ));
+        }
+        let mut mesh = TriangleMesh {
+            positions,
+            normals,
+            uvs,
+            ..TriangleMesh::default()
+        };
+        let mut skipped = 0;
+        for &tri in triangles {
+            skipped += usize::from(!mesh.push_triangle(tri, NO_MATERIAL));
+        }
+        mesh.shrink_to_fit();
+        Ok(Model {
+            meshes: vec![mesh],
+            instances: vec![(0, Mat4::IDENTITY)],
+            skipped_degenerate: skipped,
+            ..Model::default()
+        })
+    }
+}
+
 /// Whether triangle `tri` of vertices `positions` has an area: no repeated
 /// index, vertices not on one line. The indices must be in range.
 fn has_area(positions: &[[f32; 3]], tri: [u32; 3]) -> bool {

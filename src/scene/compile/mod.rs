@@ -391,7 +391,12 @@ impl<'a> Objects<'a> {
 
     fn add(&mut self, i: usize, object: &'a ObjectDesc) -> Result<(), SceneError> {
         let (transform, motion) = compile_transform(i, object.transform())?;
-        if motion == Vec3::ZERO || matches!(object, ObjectDesc::Mesh { .. }) {
+        if motion == Vec3::ZERO
+            || matches!(
+                object,
+                ObjectDesc::Mesh { .. } | ObjectDesc::Triangles { .. }
+            )
+        {
             return self.add_placed(i, object, &transform, motion);
         }
         if matches!(object, ObjectDesc::Medium { .. }) {
@@ -628,57 +633,116 @@ impl<'a> Objects<'a> {
                     allow_outside: *allow_outside,
                 };
                 let path = self.load(i, file, options)?;
-                let model = &self.models[&path].model;
-                // Counted before they are taken: a file of many nodes placed
-                // by many objects multiplies.
-                let more = model.instances.len() as u64;
-                let total = self.placements.len() as u64 + more;
-                if total > MAX_INSTANCES {
-                    return Err(invalid(
-                        format!("objects[{i}].file"),
-                        format!(
-                            "{file}: with the objects before it, the scene places {total} meshes, \
+                self.place(
+                    i,
+                    file,
+                    path,
+                    override_material,
+                    *smooth,
+                    &transform,
+                    motion,
+                )?;
+            }
+            ObjectDesc::Triangles {
+                positions,
+                indices,
+                normals,
+                uvs,
+                material,
+                ..
+            } => {
+                let material = self.material(i, material)?;
+                let model = mesh::Model::from_arrays(
+                    positions.iter().map(|p| p.map(|x| x as f32)).collect(),
+                    indices,
+                    normals
+                        .as_ref()
+                        .map(|n| n.iter().map(|p| p.map(|x| x as f32)).collect()),
+                    uvs.as_ref()
+                        .map(|t| t.iter().map(|t| t.map(|x| x as f32)).collect()),
+                )
+                .map_err(|e| invalid(format!("objects[{i}]"), e))?;
+                self.stats.skipped_degenerate += model.skipped_degenerate as u64;
+                // No file has this name: a path cannot hold a NUL.
+                let path = PathBuf::from(format!("\0objects[{i}]"));
+                self.models.insert(
+                    path.clone(),
+                    LoadedModel {
+                        model,
+                        materials: vec![None],
+                    },
+                );
+                let label = format!("the triangles of objects[{i}]");
+                let smooth = normals.is_some();
+                self.place(i, &label, path, Some(material), smooth, &transform, motion)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Places every mesh of the loaded model at `path` (`file` names it in
+    /// messages) by `transform`, moving by `motion`, in `material` or the
+    /// model's own.
+    #[allow(clippy::too_many_arguments)]
+    fn place(
+        &mut self,
+        i: usize,
+        file: &str,
+        path: PathBuf,
+        override_material: Option<u32>,
+        smooth: bool,
+        transform: &Transform,
+        motion: Vec3,
+    ) -> Result<(), SceneError> {
+        let model = &self.models[&path].model;
+        // Counted before they are taken: a file of many nodes placed
+        // by many objects multiplies.
+        let more = model.instances.len() as u64;
+        let total = self.placements.len() as u64 + more;
+        if total > MAX_INSTANCES {
+            return Err(invalid(
+                format!("objects[{i}].file"),
+                format!(
+                    "{file}: with the objects before it, the scene places {total} meshes, \
                              more than the {MAX_INSTANCES} lumen holds"
-                        ),
-                    ));
-                }
-                let room = crate::memory::check(more * BYTES_PER_PLACEMENT, "")
-                    .is_ok()
-                    .then(|| self.placements.try_reserve(more as usize).ok())
-                    .flatten();
-                if room.is_none() {
-                    let e = crate::memory::MemoryError {
-                        what: format!("placing {total} meshes"),
-                        bytes: total * BYTES_PER_PLACEMENT,
-                        available: crate::memory::available(),
-                    };
-                    return Err(invalid(
-                        format!("objects[{i}].file"),
-                        format!("{file}: {e}"),
-                    ));
-                }
-                for (mesh, node) in &model.instances {
-                    let node = mat4_transform(node).ok_or_else(|| {
-                        invalid(
-                            format!("objects[{i}].file"),
-                            format!("{file}: a node's transform is singular or out of range"),
-                        )
-                    })?;
-                    let placed = transform.compose(&node).ok_or_else(|| {
+                ),
+            ));
+        }
+        let room = crate::memory::check(more * BYTES_PER_PLACEMENT, "")
+            .is_ok()
+            .then(|| self.placements.try_reserve(more as usize).ok())
+            .flatten();
+        if room.is_none() {
+            let e = crate::memory::MemoryError {
+                what: format!("placing {total} meshes"),
+                bytes: total * BYTES_PER_PLACEMENT,
+                available: crate::memory::available(),
+            };
+            return Err(invalid(
+                format!("objects[{i}].file"),
+                format!("{file}: {e}"),
+            ));
+        }
+        for (mesh, node) in &model.instances {
+            let node = mat4_transform(node).ok_or_else(|| {
+                invalid(
+                    format!("objects[{i}].file"),
+                    format!("{file}: a node's transform is singular or out of range"),
+                )
+            })?;
+            let placed = transform.compose(&node).ok_or_else(|| {
                         invalid(
                             format!("objects[{i}].transform"),
                             "together with the file's own node transforms, the transform is singular or out of range",
                         )
                     })?;
-                    self.placements.push(Placement {
-                        key: (path.clone(), *mesh, *smooth),
-                        transform: placed,
-                        material: override_material,
-                        motion,
-                        object: i,
-                    });
-                }
-            }
+            self.placements.push(Placement {
+                key: (path.clone(), *mesh, smooth),
+                transform: placed,
+                material: override_material,
+                motion,
+                object: i,
+            });
         }
         Ok(())
     }

@@ -623,6 +623,27 @@ pub enum ObjectDesc {
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
     },
+    /// A triangle mesh written out in the scene itself (as pbrt's
+    /// `trianglemesh`), rather than read from a file.
+    Triangles {
+        /// Vertex positions.
+        positions: Vec<Triple>,
+        /// Each triangle's three vertices, indices into `positions`,
+        /// counter-clockwise seen from the front.
+        indices: Vec<[u32; 3]>,
+        /// A normal per vertex, for smooth shading; flat shading when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        normals: Option<Vec<Triple>>,
+        /// Texture coordinates (u, v) per vertex; when absent, a triangle's
+        /// corners have (0, 0), (1, 0) and (0, 1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uvs: Option<Vec<[f64; 2]>>,
+        /// Name of a material in `materials`.
+        material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
     /// Fog or smoke of constant density filling a sphere or a box, which
     /// scatters light equally in every direction. The boundary is not a
     /// surface.
@@ -679,6 +700,7 @@ impl ObjectDesc {
             | ObjectDesc::Quad { transform, .. }
             | ObjectDesc::Box { transform, .. }
             | ObjectDesc::Mesh { transform, .. }
+            | ObjectDesc::Triangles { transform, .. }
             | ObjectDesc::Medium { transform, .. } => transform,
         }
     }

@@ -226,6 +226,43 @@ fn triple(node: &Node, path: &str) -> Result<Triple> {
     numbers(node, path, "an array of 3 numbers [x, y, z]")
 }
 
+/// An array whose every item `item` reads.
+fn list<T>(node: &Node, path: &str, item: impl Fn(&Node, &str) -> Result<T>) -> Result<Vec<T>> {
+    let Value::Array(items) = &node.value else {
+        return Err(error(
+            path,
+            &node.span,
+            format!("expected an array, got {}", node.value.describe()),
+        ));
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, n)| item(n, &format!("{path}[{i}]")))
+        .collect()
+}
+
+/// A triangle's three vertex indices.
+fn index_triple(node: &Node, path: &str) -> Result<[u32; 3]> {
+    match &node.value {
+        Value::Array(items) if items.len() == 3 => {
+            let mut t = [0; 3];
+            for (i, item) in items.iter().enumerate() {
+                t[i] = u32_field(item, &format!("{path}[{i}]"), 0)?;
+            }
+            Ok(t)
+        }
+        other => Err(error(
+            path,
+            &node.span,
+            format!(
+                "expected an array of 3 vertex indices [a, b, c], got {}",
+                other.describe()
+            ),
+        )),
+    }
+}
+
 /// A shutter interval.
 fn pair(node: &Node, path: &str) -> Result<[f64; 2]> {
     numbers(node, path, "an array of 2 numbers [open, close]")
@@ -880,6 +917,7 @@ enum ObjectKind {
     Quad,
     Box,
     Mesh,
+    Triangles,
     Medium,
 }
 
@@ -948,6 +986,26 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             ("v", "quads"),
             ("min", "boxes"),
             ("max", "boxes"),
+        ],
+    },
+    Kind {
+        name: "triangles",
+        kind: ObjectKind::Triangles,
+        what: "a triangle mesh",
+        fields: &[
+            "type",
+            "positions",
+            "indices",
+            "normals",
+            "uvs",
+            "material",
+            "transform",
+        ],
+        elsewhere: &[
+            ("file", "meshes"),
+            ("smooth", "meshes"),
+            ("center", "spheres"),
+            ("corner", "quads"),
         ],
     },
     Kind {
@@ -1027,6 +1085,16 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             material: t.optional("material", string)?.map(str::to_string),
             smooth: t.optional("smooth", boolean)?.unwrap_or(true),
             allow_outside: t.optional("allow_outside", boolean)?.unwrap_or(false),
+            transform,
+        },
+        ObjectKind::Triangles => ObjectDesc::Triangles {
+            positions: t.require("positions", what, |n, p| list(n, p, triple))?,
+            indices: t.require("indices", what, |n, p| list(n, p, index_triple))?,
+            normals: t.optional("normals", |n, p| list(n, p, triple))?,
+            uvs: t.optional("uvs", |n, p| {
+                list(n, p, |n, p| numbers(n, p, "an array of 2 numbers [u, v]"))
+            })?,
+            material: material()?,
             transform,
         },
         ObjectKind::Medium => ObjectDesc::Medium {

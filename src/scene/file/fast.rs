@@ -285,6 +285,16 @@ fn object(o: &ObjectDesc) -> bool {
         ObjectDesc::Quad { corner, u, v, .. } => finite(corner) && finite(u) && finite(v),
         ObjectDesc::Box { min, max, .. } => finite(min) && finite(max),
         ObjectDesc::Mesh { .. } => true,
+        ObjectDesc::Triangles {
+            positions,
+            normals,
+            uvs,
+            ..
+        } => {
+            positions.iter().all(|p| finite(p))
+                && normals.iter().flatten().all(|n| finite(n))
+                && uvs.iter().flatten().all(|t| finite(t))
+        }
         ObjectDesc::Medium {
             boundary,
             density,
