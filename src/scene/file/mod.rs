@@ -22,6 +22,8 @@
 mod decode;
 pub mod export;
 mod fast;
+pub mod import;
+pub(crate) mod matrix;
 pub mod mitsuba;
 pub use crate::hint;
 mod node_de;

@@ -19,34 +19,12 @@ mod transform;
 mod xml;
 
 use super::{excerpt, Diagnostic, SceneFileError};
-use crate::scene::desc::SceneDesc;
 use std::path::Path;
 use xml::{At, Files};
 
 pub(crate) use plugins::Convert;
 
-/// How a Mitsuba scene is read.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Options {
-    /// Values of the scene's parameters (`$name`), as Mitsuba's `-D
-    /// name=value`; each must be used.
-    pub defines: Vec<(String, String)>,
-    /// Render what lumen lacks with the nearest it has, with a warning
-    /// for each substitution, rather than refuse the scene.
-    pub approximate: bool,
-    /// Read `<include>`d files outside the scene file's folder.
-    pub allow_outside: bool,
-}
-
-/// A Mitsuba scene read: its description, and a warning for every
-/// substitution `--approximate` made.
-#[derive(Clone, Debug)]
-pub struct Imported {
-    /// The scene.
-    pub desc: SceneDesc,
-    /// One line each.
-    pub warnings: Vec<String>,
-}
+pub use super::import::{Imported, Options};
 
 /// What went wrong, located.
 pub(super) type Failure = SceneFileError;
