@@ -138,16 +138,33 @@ fn a_point_light_lights_a_floor_by_the_inverse_square_and_the_cosine() {
 
 #[test]
 fn a_spot_light_is_full_in_its_beam_and_falls_off_linearly_in_angle_to_its_cutoff() {
+    spot_falloff("", |angle, cutoff, beam| (cutoff - angle) / (cutoff - beam));
+}
+
+#[test]
+fn a_smoothstep_spot_light_falls_off_as_pbrts() {
+    spot_falloff("\nfalloff = \"smoothstep\"", |angle, cutoff, beam| {
+        let t = (angle.cos() - cutoff.cos()) / (beam.cos() - cutoff.cos());
+        t * t * (3.0 - 2.0 * t)
+    });
+}
+
+/// A spot light (with `extra` fields) on a floor, checked pixel by pixel
+/// against `falloff(angle, cutoff, beam)` between its beam and cut-off.
+fn spot_falloff(extra: &str, falloff: impl Fn(f64, f64, f64) -> f64) {
     let position = [0.5, 2.0, 0.0];
     // Aimed at a point of the floor off to the side, so that the cone's
     // section is an ellipse across the image.
     let target = [-0.5, 0.0, 0.5];
     let (cutoff, beam) = (40f64.to_radians(), 25f64.to_radians());
+    // Each variant in a folder of its own: the tests run at once.
     let scene = floor(
-        "spot",
+        &format!("spot{}", extra.len()),
         CENTRE,
-        "[[lights]]\ntype = \"spot\"\nposition = [0.5, 2, 0]\ntarget = [-0.5, 0, 0.5]\n\
-         intensity = [4, 4, 2]\ncutoff_angle = 40\nbeam_width = 25",
+        &format!(
+            "[[lights]]\ntype = \"spot\"\nposition = [0.5, 2, 0]\ntarget = [-0.5, 0, 0.5]\n\
+             intensity = [4, 4, 2]\ncutoff_angle = 40\nbeam_width = 25{extra}"
+        ),
         "",
     );
     let axis = sub(target, position);
@@ -165,7 +182,7 @@ fn a_spot_light_is_full_in_its_beam_and_falls_off_linearly_in_angle_to_its_cutof
             1.0
         } else if angle < cutoff {
             between.set(between.get() + 1);
-            (cutoff - angle) / (cutoff - beam)
+            falloff(angle, cutoff, beam)
         } else {
             0.0
         };

@@ -16,7 +16,7 @@ mod spot;
 
 pub use directional::{DirectionalLight, DirectionalLightDesc};
 pub use point::{PointLight, PointLightDesc};
-pub use spot::{SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
+pub use spot::{SpotFalloffDesc, SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
 
 use crate::material::param::Textures;
 use crate::material::{Invalid, KindInfo};

@@ -42,6 +42,23 @@ pub struct SpotLightDesc {
     /// the axis); +y when absent, or +z when the axis is vertical.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub up: Option<Triple>,
+    /// How the intensity falls from the beam to the cut-off: "linear" in
+    /// angle (Mitsuba's, the default) or "smoothstep" in the angle's
+    /// cosine (pbrt's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub falloff: Option<SpotFalloffDesc>,
+}
+
+/// How a spot light's intensity falls from its beam to its cut-off.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpotFalloffDesc {
+    /// Linearly in angle, as Mitsuba's `spot`.
+    #[default]
+    Linear,
+    /// As the smooth step t²(3 − 2t) of t = (cos θ − cos cutoff) / (cos
+    /// beam − cos cutoff), as pbrt's `spot`.
+    Smoothstep,
 }
 
 /// The cut-off angle of a spot light that gives none, in degrees.
@@ -64,6 +81,8 @@ pub struct SpotLight {
     /// 1 / (cutoff − beam width), per radian.
     inv_transition: f32,
     beam: f32,
+    /// Fall off as pbrt's smooth step in cosine, not linearly in angle.
+    smoothstep: bool,
     /// The projected image's texture, and its right and up directions
     /// (unit, perpendicular to the axis) over tan(cutoff).
     projection: Option<(u32, Vec3, Vec3)>,
@@ -168,14 +187,15 @@ impl SpotLightDesc {
                 0.0
             },
             beam,
+            smoothstep: self.falloff == Some(SpotFalloffDesc::Smoothstep),
         })
     }
 }
 
 impl SpotLight {
     /// The fraction of its axial intensity the light sends along unit
-    /// `direction`: 1 within the beam, falling linearly in angle to 0 at
-    /// the cut-off.
+    /// `direction`: 1 within the beam, falling (linearly in angle, or by
+    /// the smooth step) to 0 at the cut-off.
     #[inline]
     pub fn falloff(&self, direction: Vec3) -> f32 {
         let cos = direction.dot(self.axis);
@@ -183,6 +203,9 @@ impl SpotLight {
             0.0
         } else if cos >= self.cos_beam {
             1.0
+        } else if self.smoothstep {
+            let t = ((cos - self.cos_cutoff) / (self.cos_beam - self.cos_cutoff)).clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
         } else {
             ((self.cutoff - cos.min(1.0).acos()) * self.inv_transition).clamp(0.0, 1.0)
         }

@@ -756,6 +756,7 @@ impl<'d> Convert<'d> {
                         .is_some()
                         .then(|| transform::vector(&m, [0.0, -1.0, 0.0])),
                     texture,
+                    falloff: None,
                 }));
                 Ok(())
             }
