@@ -54,8 +54,8 @@ enum Command {
     Render {
         /// Name of a built-in scene (see `lumen scenes`) or a scene file
         /// (.toml or .json, see docs/scene-format.md; .xml, a Mitsuba 3
-        /// scene, see docs/mitsuba.md). Command-line settings override the
-        /// scene's own.
+        /// scene, see docs/mitsuba.md; .pbrt, a pbrt-v4 scene, see
+        /// docs/pbrt.md). Command-line settings override the scene's own.
         scene: OsString,
         /// Output image; the extension chooses the format.
         #[arg(short, long)]
@@ -243,7 +243,8 @@ enum FormatArg {
     Json,
 }
 
-/// How a scene of another renderer's format (Mitsuba 3 `.xml`) is read.
+/// How a scene of another renderer's format (Mitsuba 3 `.xml`, pbrt-v4
+/// `.pbrt`) is read.
 #[derive(Args, Clone, Default)]
 pub(crate) struct ImportArgs {
     /// A parameter of a Mitsuba scene (`$NAME` in its attributes), as
@@ -257,8 +258,8 @@ pub(crate) struct ImportArgs {
 }
 
 impl ImportArgs {
-    /// The options of a Mitsuba scene's reader; `allow_outside` lets its
-    /// `<include>`s come from outside its folder.
+    /// The options of a Mitsuba or pbrt scene's reader; `allow_outside`
+    /// lets its includes come from outside its folder.
     pub(crate) fn options(&self, allow_outside: bool) -> lumen::scene::file::mitsuba::Options {
         lumen::scene::file::mitsuba::Options {
             defines: self.defines.clone(),

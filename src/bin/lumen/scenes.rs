@@ -48,6 +48,7 @@ pub(crate) fn load_scene(name: &str, import: &ImportOptions) -> Result<SceneSour
     let path = Path::new(name);
     let looks_like_file = Format::from_extension(path).is_some()
         || lumen::scene::file::is_mitsuba(path)
+        || lumen::scene::file::pbrt::is_pbrt(path)
         || name.contains(std::path::MAIN_SEPARATOR)
         || name.contains('/')
         || path.exists();
@@ -66,7 +67,7 @@ pub(crate) fn load_scene(name: &str, import: &ImportOptions) -> Result<SceneSour
         .unwrap_or_default();
     bail!(
         "unknown scene '{name}'{closest}; `lumen scenes` lists the built-in scenes, \
-         and scene files end in .toml, .json or .xml (Mitsuba 3)"
+         and scene files end in .toml, .json, .xml (Mitsuba 3) or .pbrt (pbrt-v4)"
     )
 }
 

@@ -25,6 +25,7 @@ mod fast;
 pub mod import;
 pub(crate) mod matrix;
 pub mod mitsuba;
+pub mod pbrt;
 pub use crate::hint;
 mod node_de;
 mod plain_toml;
@@ -191,7 +192,8 @@ pub struct SceneFile {
 
 impl SceneFile {
     /// Reads and parses the file at `path`; the extension (`.toml`, `.json`,
-    /// or `.xml` for a Mitsuba 3 scene) gives the format.
+    /// `.xml` for a Mitsuba 3 scene, `.pbrt` for a pbrt-v4 scene) gives the
+    /// format.
     pub fn read(path: &Path) -> Result<SceneFile, SceneFileError> {
         Self::read_with(path, &mitsuba::Options::default())
     }
@@ -199,8 +201,12 @@ impl SceneFile {
     /// [`SceneFile::read`], a Mitsuba scene read with `import`.
     pub fn read_with(path: &Path, import: &mitsuba::Options) -> Result<SceneFile, SceneFileError> {
         let name = path.display().to_string();
-        if is_mitsuba(path) {
-            let imported = mitsuba::read(path, import)?;
+        if is_mitsuba(path) || pbrt::is_pbrt(path) {
+            let imported = if is_mitsuba(path) {
+                mitsuba::read(path, import)?
+            } else {
+                pbrt::read(path, import)?
+            };
             return Ok(SceneFile {
                 name,
                 // Imported scenes are what they export as.
@@ -226,7 +232,7 @@ impl SceneFile {
         }
         let format = Format::from_extension(path).ok_or_else(|| {
             fail(
-                "unknown scene file type: the name must end in .toml, .json or .xml (Mitsuba 3)"
+                "unknown scene file type: the name must end in .toml, .json, .xml (Mitsuba 3) or .pbrt (pbrt-v4)"
                     .into(),
             )
         })?;

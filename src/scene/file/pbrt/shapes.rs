@@ -1,0 +1,327 @@
+//! pbrt's shapes as lumen's objects: spheres, triangle meshes written in
+//! the scene, PLY meshes, and bilinear patches that are flat
+//! parallelograms (two triangles each).
+
+use super::lex::At;
+use super::params::{Params, Problem};
+use super::scene::Builder;
+use super::Input;
+use crate::scene::desc::ObjectDesc;
+use crate::scene::file::matrix;
+
+/// The shapes lumen reads.
+const SHAPES: &[&str] = &["sphere", "trianglemesh", "plymesh", "bilinearmesh"];
+
+impl Builder {
+    pub(super) fn shape(
+        &mut self,
+        ty: &str,
+        at: At,
+        p: &Params,
+        input: &Input,
+    ) -> Result<(), Problem> {
+        // What changes nothing in lumen's image.
+        p.ignore(&["emissionfilename"]);
+        match ty {
+            "sphere" => {
+                let radius = p.float("radius")?.unwrap_or(1.0);
+                if !(radius > 0.0) {
+                    return Err((
+                        at,
+                        format!("a sphere's `radius` must be above 0, got {radius}"),
+                        None,
+                    ));
+                }
+                let zmin = p.float("zmin")?.unwrap_or(-radius);
+                let zmax = p.float("zmax")?.unwrap_or(radius);
+                let phimax = p.float("phimax")?.unwrap_or(360.0);
+                if zmin > -radius || zmax < radius || phimax < 360.0 {
+                    self.lacks(
+                        at,
+                        "part of a sphere (zmin, zmax, phimax)",
+                        "the whole sphere",
+                    )?;
+                }
+                let material = self.surface(p, at)?;
+                p.finish("a sphere", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
+                if self.state.reverse && self.state.area.is_some() {
+                    self.lacks(
+                        at,
+                        "sphere that shines inwards (ReverseOrientation)",
+                        "one that shines outwards",
+                    )?;
+                }
+                let transform = self.placement();
+                self.add(ObjectDesc::Sphere {
+                    center: [0.0; 3],
+                    radius,
+                    material,
+                    transform,
+                });
+            }
+            "trianglemesh" => {
+                let (positions, pat) = p.tuples::<3>("P", &["point3"])?.ok_or((
+                    at,
+                    "a trianglemesh needs its points `P`".into(),
+                    None,
+                ))?;
+                let indices = match p.indices("indices")? {
+                    Some((i, _)) => i,
+                    None if positions.len() == 3 => vec![0, 1, 2],
+                    None => {
+                        return Err((
+                            at,
+                            "a trianglemesh of more than 3 points needs `indices`".into(),
+                            None,
+                        ))
+                    }
+                };
+                let normals = p.tuples::<3>("N", &["normal", "normal3"])?.map(|(n, _)| n);
+                let uvs = self.uvs(p)?;
+                self.triangles(
+                    positions,
+                    pat,
+                    &indices,
+                    3,
+                    normals,
+                    uvs,
+                    p,
+                    at,
+                    "a trianglemesh",
+                )?;
+            }
+            "bilinearmesh" => {
+                let (positions, pat) = p.tuples::<3>("P", &["point3"])?.ok_or((
+                    at,
+                    "a bilinearmesh needs its points `P`".into(),
+                    None,
+                ))?;
+                let quads = match p.indices("indices")? {
+                    Some((i, _)) => i,
+                    None if positions.len() == 4 => vec![0, 1, 2, 3],
+                    None => {
+                        return Err((
+                            at,
+                            "a bilinearmesh of more than 4 points needs `indices`".into(),
+                            None,
+                        ))
+                    }
+                };
+                if !quads.len().is_multiple_of(4) {
+                    return Err((
+                        at,
+                        format!(
+                            "a bilinearmesh's `indices` hold {} numbers, not 4 a patch",
+                            quads.len()
+                        ),
+                        None,
+                    ));
+                }
+                if let Some(&i) = quads.iter().find(|&&i| i as usize >= positions.len()) {
+                    return Err((
+                        at,
+                        format!(
+                            "`indices` names point {i}, but there are {} points",
+                            positions.len()
+                        ),
+                        None,
+                    ));
+                }
+                // Each patch p00 p10 p01 p11 is two triangles; exact when it
+                // is a flat parallelogram.
+                let mut curved = false;
+                let mut triangles = Vec::with_capacity(quads.len() / 4 * 6);
+                for q in quads.chunks_exact(4) {
+                    let [p00, p10, p01, p11] =
+                        [q[0], q[1], q[2], q[3]].map(|i| positions[i as usize]);
+                    let expected = [0, 1, 2].map(|k| p10[k] + p01[k] - p00[k]);
+                    let size = [0, 1, 2]
+                        .map(|k| (p10[k] - p00[k]).abs() + (p01[k] - p00[k]).abs())
+                        .iter()
+                        .fold(0.0f64, |a, b| a.max(*b));
+                    if (0..3)
+                        .any(|k| (expected[k] - p11[k]).abs() > 1e-6 * size.max(f64::MIN_POSITIVE))
+                    {
+                        curved = true;
+                    }
+                    triangles.extend([q[0], q[1], q[3], q[0], q[3], q[2]]);
+                }
+                if curved {
+                    self.lacks(at, "curved bilinear patch", "two flat triangles a patch")?;
+                }
+                let normals = p.tuples::<3>("N", &["normal", "normal3"])?.map(|(n, _)| n);
+                let uvs = self.uvs(p)?;
+                self.triangles(
+                    positions,
+                    pat,
+                    &triangles,
+                    4,
+                    normals,
+                    uvs,
+                    p,
+                    at,
+                    "a bilinearmesh",
+                )?;
+            }
+            "plymesh" => {
+                let (file, fat) = p.string_of("filename", "string")?.ok_or((
+                    at,
+                    "a plymesh needs a `filename`".into(),
+                    None,
+                ))?;
+                let file = input.file(file, fat)?;
+                if p.has("displacement") {
+                    let _ = p.get("displacement");
+                    p.ignore(&["edgelength"]);
+                    self.lacks(
+                        at,
+                        "displacement of a mesh's vertices",
+                        "the undisplaced mesh",
+                    )?;
+                }
+                let material = self.surface(p, at)?;
+                p.finish(
+                    "a plymesh",
+                    &["filename", "displacement", "edgelength", "alpha"],
+                )?;
+                // Only a light's side depends on the winding.
+                let mirrored = matrix::det3(&self.state.ctm) < 0.0;
+                if self.state.area.is_some() && (self.state.reverse != mirrored) {
+                    self.lacks(
+                        at,
+                        "PLY mesh light turned to its other side (by ReverseOrientation or a mirroring transform)",
+                        "the side its file's winding gives",
+                    )?;
+                }
+                let transform = self.placement();
+                self.add(ObjectDesc::Mesh {
+                    file,
+                    material: Some(material),
+                    smooth: true,
+                    allow_outside: false,
+                    transform,
+                });
+            }
+            "disk" | "cylinder" | "loopsubdiv" | "curve" | "cone" | "paraboloid"
+            | "hyperboloid" => {
+                p.ignore_all();
+                self.lacks(at, &format!("`{ty}` shape"), "no shape")?;
+            }
+            other => {
+                return Err((
+                    at,
+                    format!(
+                        "shape `{other}` is not one lumen reads; it reads {}",
+                        SHAPES.join(", ")
+                    ),
+                    crate::hint::closest(other, SHAPES.iter().copied())
+                        .map(|k| format!("did you mean `{k}`?")),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// A mesh's texture coordinates: "point2 uv" (or pbrt-v3's "float uv").
+    fn uvs(&self, p: &Params) -> Result<Option<Vec<[f64; 2]>>, Problem> {
+        Ok(p.tuples::<2>("uv", &["point2", "float"])?.map(|(t, _)| t))
+    }
+
+    /// Adds a triangle mesh of `indices` (`per` of them a face, for
+    /// messages) over `positions`.
+    #[allow(clippy::too_many_arguments)]
+    fn triangles(
+        &mut self,
+        positions: Vec<[f64; 3]>,
+        pat: At,
+        indices: &[u32],
+        per: usize,
+        normals: Option<Vec<[f64; 3]>>,
+        uvs: Option<Vec<[f64; 2]>>,
+        p: &Params,
+        at: At,
+        what: &str,
+    ) -> Result<(), Problem> {
+        if !indices.len().is_multiple_of(3) {
+            return Err((
+                at,
+                format!("`indices` hold {} numbers, not 3 a triangle", indices.len()),
+                None,
+            ));
+        }
+        let n = positions.len();
+        if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
+            return Err((
+                at,
+                format!("`indices` names point {i}, but there are {n} points `P`"),
+                None,
+            ));
+        }
+        for (name, len) in [
+            ("N", normals.as_ref().map(Vec::len)),
+            ("uv", uvs.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|l| *l != n) {
+                return Err((
+                    pat,
+                    format!("`{name}` has {len} entries for {n} points `P`: give one a point"),
+                    None,
+                ));
+            }
+        }
+        let _ = per;
+        p.ignore(&["S", "faceIndices"]);
+        let material = self.surface(p, at)?;
+        p.finish(
+            what,
+            &["P", "indices", "N", "uv", "S", "faceIndices", "alpha"],
+        )?;
+        let mut triangles: Vec<[u32; 3]> = indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        // The side that shines: with normals, theirs (turned by
+        // ReverseOrientation); otherwise the winding's, so turned.
+        let reverse = self.state.reverse;
+        let mirrored = matrix::det3(&self.state.ctm) < 0.0;
+        let normals = normals.map(|nv| {
+            if reverse {
+                nv.iter().map(|v| v.map(|x| -x)).collect::<Vec<_>>()
+            } else {
+                nv
+            }
+        });
+        for t in &mut triangles {
+            let flip = match &normals {
+                Some(nv) => {
+                    let [a, b, c] = t.map(|i| positions[i as usize]);
+                    let u = [0, 1, 2].map(|k| b[k] - a[k]);
+                    let v = [0, 1, 2].map(|k| c[k] - a[k]);
+                    let g = [
+                        u[1] * v[2] - u[2] * v[1],
+                        u[2] * v[0] - u[0] * v[2],
+                        u[0] * v[1] - u[1] * v[0],
+                    ];
+                    let s: [f64; 3] = [0, 1, 2].map(|k| t.iter().map(|&i| nv[i as usize][k]).sum());
+                    g[0] * s[0] + g[1] * s[1] + g[2] * s[2] < 0.0
+                }
+                None => reverse,
+            };
+            // lumen's side is the winding's as placed, pbrt's as written:
+            // a mirroring transform turns lumen's.
+            if flip != mirrored {
+                t.swap(1, 2);
+            }
+        }
+        let transform = self.placement();
+        self.add(ObjectDesc::Triangles {
+            positions,
+            indices: triangles,
+            normals,
+            uvs,
+            material,
+            transform,
+        });
+        Ok(())
+    }
+}

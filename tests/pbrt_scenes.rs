@@ -1,0 +1,381 @@
+//! Reading pbrt-v4 scenes: each directive becomes the lumen description
+//! pbrt's conventions call for (cameras, transforms, instances, lights,
+//! materials, textures); a scene exported to lumen's TOML renders to the
+//! same bits as the scene read directly; bad input is refused with the
+//! file, line and column, and a render of it writes nothing.
+
+mod common;
+
+use common::scratch_dir;
+use lumen::scene::desc::{
+    BackgroundDesc, ColorDesc, LightDesc, MaterialDesc, ObjectDesc, SceneDesc, TextureDesc,
+    TransformDesc,
+};
+use lumen::scene::file::{import::Options, Format, SceneFile};
+use lumen::scene::Overrides;
+use std::path::{Path, PathBuf};
+
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/pbrt")
+}
+
+/// Reads `text` as a pbrt scene in `dir`.
+fn read_in(dir: &Path, text: &str, options: &Options) -> Result<SceneFile, String> {
+    let path = dir.join("s.pbrt");
+    std::fs::write(&path, text).unwrap();
+    SceneFile::read_with(&path, options).map_err(|e| e.to_string())
+}
+
+fn read(name: &str, text: &str) -> SceneDesc {
+    let dir = scratch_dir(&format!("pbrt_scenes_{name}"));
+    let image = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/khronos/TextureTransformTest/Correct.png");
+    std::fs::copy(image, dir.join("t.png")).unwrap();
+    read_in(&dir, text, &Options::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .desc
+}
+
+fn close(a: [f64; 3], b: [f64; 3]) -> bool {
+    (0..3).all(|i| (a[i] - b[i]).abs() < 1e-9 * (1.0 + b[i].abs()))
+}
+
+#[test]
+fn a_scene_exported_to_toml_renders_to_the_same_bits() {
+    let path = assets().join("box.pbrt");
+    let direct = SceneFile::read(&path).unwrap_or_else(|e| panic!("{e}"));
+    let text = lumen::scene::file::export(&direct.desc, Format::Toml).unwrap();
+    let mut exported =
+        SceneFile::parse("exported.toml", text, Format::Toml).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(exported.desc, direct.desc);
+    exported.dir = direct.dir.clone();
+    let overrides = Overrides {
+        width: Some(40),
+        samples_per_pixel: Some(4),
+        ..Overrides::default()
+    };
+    let render = |f: &SceneFile| {
+        let scene = f.compile(&overrides).unwrap();
+        lumen::render::render(&scene, &|_| {}).0.linear()
+    };
+    let (a, b) = (render(&direct), render(&exported));
+    assert!(a.iter().any(|c| c.max_element() > 0.05), "black");
+    assert!(a == b, "the exported scene renders differently");
+}
+
+#[test]
+fn cameras_follow_pbrts_conventions() {
+    // LookAt alone: pbrt's image runs along up × forward, mirrored to
+    // lumen's; a Scale -1 1 1 before it (as converted scenes have) is not.
+    let plain = read(
+        "camera_plain",
+        "LookAt 1 2 3  1 2 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 200 \"integer yresolution\" 100\nWorldBegin\n",
+    );
+    assert!(plain.camera.mirror);
+    assert!(close(plain.camera.lookfrom, [1.0, 2.0, 3.0]));
+    assert!(close(plain.camera.lookat, [1.0, 2.0, 2.0]));
+    assert!(close(plain.camera.vup, [0.0, 1.0, 0.0]));
+    // fov spans the shorter side: here the height.
+    assert!((plain.camera.vfov - 30.0).abs() < 1e-9);
+    assert_eq!((plain.render.width, plain.render.height), (200, Some(100)));
+    let flipped = read(
+        "camera_flipped",
+        "Scale -1 1 1\nLookAt 1 2 3  1 2 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200\nWorldBegin\n",
+    );
+    assert!(!flipped.camera.mirror);
+    assert!(close(flipped.camera.lookfrom, [1.0, 2.0, 3.0]));
+    // A portrait image: fov spans the width.
+    let want = 2.0 * ((15f64.to_radians()).tan() * 2.0).atan();
+    assert!((flipped.camera.vfov - want.to_degrees()).abs() < 1e-9);
+    // Defaults: pbrt's film, sampler and depth (5 bounces: 6 segments).
+    assert_eq!(plain.render.samples_per_pixel, 16);
+    assert_eq!(plain.render.max_depth, 6);
+}
+
+#[test]
+fn transforms_instances_and_materials_are_placed_as_pbrt_places_them() {
+    let d = read(
+        "transforms",
+        r#"WorldBegin
+MakeNamedMaterial "gold" "string type" "conductor" "spectrum eta" "metal-Au-eta" "spectrum k" "metal-Au-k" "float roughness" 0.04
+Texture "checks" "spectrum" "imagemap" "string filename" "t.png" "float uscale" 2 "float vdelta" 0.25
+Material "diffuse" "texture reflectance" "checks"
+AttributeBegin
+  Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]
+  Shape "sphere" "float radius" 2
+AttributeEnd
+ObjectBegin "thing"
+  NamedMaterial "gold"
+  Translate 1 0 0
+  Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ]
+ObjectEnd
+AttributeBegin
+  Rotate 90 0 0 1
+  ObjectInstance "thing"
+AttributeEnd
+ObjectInstance "thing"
+AttributeBegin
+  ReverseOrientation
+  Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ] "normal N" [ 0 0 -1  0 0 -1  0 0 -1 ]
+AttributeEnd
+"#,
+    );
+    assert_eq!(d.objects.len(), 4);
+    // Transform is written column by column.
+    let ObjectDesc::Sphere {
+        radius,
+        transform,
+        material,
+        ..
+    } = &d.objects[0]
+    else {
+        panic!("{:?}", d.objects[0])
+    };
+    assert_eq!(*radius, 2.0);
+    let TransformDesc::Matrix(m) = &transform[0] else {
+        panic!("{transform:?}")
+    };
+    assert_eq!([m[0][3], m[1][3], m[2][3]], [5.0, 6.0, 7.0]);
+    // The textured diffuse, its image mapped with t up the image.
+    let MaterialDesc::Diffuse(diffuse) = &d.materials[material] else {
+        panic!()
+    };
+    let ColorDesc::Texture(t) = &diffuse.albedo else {
+        panic!()
+    };
+    let TextureDesc::Image {
+        uv_scale,
+        uv_offset,
+        ..
+    } = &d.textures[t]
+    else {
+        panic!()
+    };
+    assert_eq!(*uv_scale, Some([2.0, 1.0]));
+    assert_eq!(*uv_offset, Some([0.0, 1.0 - 1.0 - 0.25]));
+    // An instance: the shape's own transform, then the instance's.
+    let ObjectDesc::Triangles {
+        transform,
+        material,
+        ..
+    } = &d.objects[1]
+    else {
+        panic!()
+    };
+    assert_eq!(transform.len(), 2, "{transform:?}");
+    let MaterialDesc::Conductor(gold) = &d.materials[material] else {
+        panic!()
+    };
+    assert_eq!(gold.metal.as_deref(), Some("Au"));
+    assert!(gold.alpha.is_some(), "α = √0.04");
+    let ObjectDesc::Triangles { transform, .. } = &d.objects[2] else {
+        panic!()
+    };
+    assert_eq!(transform.len(), 1, "placed where defined");
+    // Reversed, with normals: the winding follows the negated normals
+    // (+z), so the triangle stays counter-clockwise from +z.
+    let ObjectDesc::Triangles {
+        indices, normals, ..
+    } = &d.objects[3]
+    else {
+        panic!()
+    };
+    assert_eq!(indices, &vec![[0, 1, 2]]);
+    assert_eq!(normals.as_ref().unwrap()[0], [0.0, 0.0, 1.0]);
+}
+
+#[test]
+fn lights_carry_pbrts_units() {
+    let d = read(
+        "lights",
+        r#"WorldBegin
+LightSource "point" "rgb I" [ 1 2 3 ] "float scale" 2 "point3 from" [ 0 1 0 ]
+LightSource "point" "float power" 100
+Translate 0 5 0
+LightSource "spot" "point3 from" [ 0 0 0 ] "point3 to" [ 0 -1 0 ] "float coneangle" 40 "float conedeltaangle" 10
+LightSource "distant" "point3 from" [ 0 0 0 ] "point3 to" [ 1 -1 0 ] "blackbody L" 6500 "float scale" 3
+LightSource "infinite" "rgb L" [ 0.5 0.5 0.5 ] "float illuminance" 3.14159265358979
+AttributeBegin
+  AreaLightSource "diffuse" "blackbody L" 2700 "float scale" 4 "bool twosided" true
+  Shape "sphere"
+AttributeEnd
+"#,
+    );
+    let [LightDesc::Point(a), LightDesc::Point(b), LightDesc::Spot(s), LightDesc::Directional(sun)] =
+        &d.lights[..]
+    else {
+        panic!("{:?}", d.lights)
+    };
+    assert_eq!(
+        (a.position, a.intensity),
+        ([0.0, 1.0, 0.0], [2.0, 4.0, 6.0])
+    );
+    let i = 100.0 / (4.0 * std::f64::consts::PI);
+    assert!(close(b.intensity, [i; 3]));
+    assert!(close(s.position, [0.0, 5.0, 0.0]));
+    assert_eq!((s.cutoff_angle, s.beam_width), (Some(40.0), Some(30.0)));
+    assert_eq!(
+        s.falloff,
+        Some(lumen::light::source::SpotFalloffDesc::Smoothstep)
+    );
+    assert!(close(sun.direction, [1.0, -1.0, 0.0]));
+    // A blackbody light has the luminance `scale` gives it.
+    let y = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    assert!((y(sun.irradiance) - 3.0).abs() < 1e-9);
+    let BackgroundDesc::Solid { color } = d.background else {
+        panic!()
+    };
+    assert!(close(color, [0.5; 3]), "illuminance / π × L: {color:?}");
+    let ObjectDesc::Sphere { material, .. } = &d.objects[0] else {
+        panic!()
+    };
+    let surface = d.materials[material].clone();
+    let MaterialDesc::Diffuse(glow) = surface else {
+        panic!()
+    };
+    let Some(ColorDesc::Rgb(e)) = glow.emission else {
+        panic!()
+    };
+    assert!((y(e) - 4.0).abs() < 1e-9 && e[0] > e[2], "warm: {e:?}");
+    assert!(glow.two_sided);
+}
+
+#[test]
+fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
+    let dir = scratch_dir("pbrt_scenes_bad");
+    std::fs::write(dir.join("loop.pbrt"), "Include \"loop.pbrt\"\n").unwrap();
+    let cases: &[(&str, &str)] = &[
+        ("WorldBegin\nShap \"sphere\"\n", "s.pbrt:2:1: unknown directive `Shap`"),
+        ("WorldBegin\nShap \"sphere\"\n", "did you mean `Shape`?"),
+        ("WorldBegin\nShape \"sphere\" \"float radius\" [ 1 2 ]\n", "`radius` takes one number, got 2"),
+        ("WorldBegin\nShape \"sphere\" \"integer radius\" 1\n", "expected \"float radius\""),
+        ("WorldBegin\nShape \"sphere\" \"float radus\" 1\n", "did you mean `radius`?"),
+        ("WorldBegin\nShape \"spere\"\n", "did you mean `sphere`?"),
+        ("WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n", "s.pbrt:2:31: `1e999` is not a finite number"),
+        ("WorldBegin\nShape \"sphere\n", "s.pbrt:2:7: this string is not closed"),
+        ("Shape \"sphere\"\n", "Shape must come after WorldBegin"),
+        ("WorldBegin\nCamera \"perspective\"\n", "Camera must come before WorldBegin"),
+        ("WorldBegin\nAttributeEnd\n", "AttributeEnd without an AttributeBegin"),
+        ("WorldBegin\nAttributeBegin\n", "s.pbrt:2:1: this AttributeBegin is never closed"),
+        ("WorldBegin\nNamedMaterial \"glod\"\n", "no material is named `glod`"),
+        ("WorldBegin\nMaterial \"diffuse\" \"texture reflectance\" \"nope\"\n", "no spectrum texture is named `nope`"),
+        ("WorldBegin\nMaterial \"difuse\"\n", "did you mean `diffuse`?"),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 3 ]\n", "names point 3, but there are 3 points"),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 ] \"integer indices\" [ 0 1 2 ]\n", "not a multiple of 3"),
+        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"missing.ply\"\n", "s.pbrt:2:17: file `missing.ply` not found"),
+        ("Include \"loop.pbrt\"\n", "loop.pbrt: includes itself"),
+        ("Include \"../outside.pbrt\"\n", "no such file"),
+        ("ConcatTransform [ 1 0 0 1  0 1 0 0  0 0 1 0  0 0 0 1 ]\n", "a projective matrix"),
+        ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "is not among lumen's conductors"),
+        ("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-BK8\"\n", "did you mean `glass-BK7`?"),
+        ("WorldBegin\nShape \"disk\"\n", "--approximate renders no shape instead"),
+        ("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "equal-area octahedral"),
+        ("WorldBegin\nCoordSysTransform \"camra\"\n", "no coordinate system `camra`"),
+        ("WorldBegin\n\"float x\" 1\n", "expected a directive"),
+        ("WorldBegin\nTranslate 1 2\n", "expected a number, but the file ends"),
+    ];
+    for (text, expected) in cases {
+        let message = read_in(&dir, text, &Options::default())
+            .and_then(|f| {
+                f.compile(&Overrides::default())
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            })
+            .err()
+            .unwrap_or_else(|| panic!("accepted:\n{text}"));
+        assert!(
+            message.contains(expected),
+            "{text}\n{message}\nlacks: {expected}"
+        );
+    }
+    // Includes outside the scene's folder only when asked.
+    let inner = dir.join("inner");
+    std::fs::create_dir_all(&inner).unwrap();
+    std::fs::write(dir.join("shared.pbrt"), "WorldBegin\n").unwrap();
+    let outside = read_in(&inner, "Include \"../shared.pbrt\"\n", &Options::default()).unwrap_err();
+    assert!(
+        outside.contains("lies outside the scene's folder"),
+        "{outside}"
+    );
+    let allowed = Options {
+        allow_outside: true,
+        ..Options::default()
+    };
+    read_in(&inner, "Include \"../shared.pbrt\"\n", &allowed).unwrap();
+    // -D is for Mitsuba's parameters.
+    let defined = Options {
+        defines: vec![("x".into(), "1".into())],
+        ..Options::default()
+    };
+    assert!(read_in(&dir, "WorldBegin\n", &defined)
+        .unwrap_err()
+        .contains("-D x"));
+}
+
+#[test]
+fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
+    let dir = scratch_dir("pbrt_scenes_approximate");
+    let options = Options {
+        approximate: true,
+        ..Options::default()
+    };
+    let file = read_in(
+        &dir,
+        "WorldBegin\nShape \"disk\"\nMaterial \"thindielectric\"\nShape \"sphere\"\n",
+        &options,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(file.import_warnings.len(), 2, "{:?}", file.import_warnings);
+    assert!(file.import_warnings[0].contains("s.pbrt:2:7: `disk` shape"));
+    assert!(file.import_warnings[1].contains("thin dielectric"));
+    file.compile(&Overrides::default()).unwrap();
+}
+
+#[test]
+fn a_render_of_a_bad_scene_writes_nothing_and_fails() {
+    let dir = scratch_dir("pbrt_scenes_cli");
+    let path = dir.join("bad.pbrt");
+    std::fs::write(&path, "WorldBegin\nShape \"spere\"\n").unwrap();
+    let out = dir.join("out.png");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_lumen"))
+        .args([
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("bad.pbrt:2:7") && stderr.contains("spere"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_light_shines_from_the_side_pbrt_gives_it_whatever_the_transform() {
+    // A square facing +z (counter-clockwise seen from +z) shines towards
+    // the camera at +z; mirrored by Scale -1 1 1, it still does in pbrt;
+    // ReverseOrientation turns it away.
+    let dir = scratch_dir("pbrt_scenes_sides");
+    let brightness = |before: &str| {
+        let text = format!(
+            "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+             Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+             Sampler \"independent\" \"integer pixelsamples\" 2\nWorldBegin\n{before}\n\
+             AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\nMaterial \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n\
+             Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\n"
+        );
+        let file = read_in(&dir, &text, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = file.compile(&Overrides::default()).unwrap();
+        let image = lumen::render::render(&scene, &|_| {}).0.linear();
+        image.iter().map(|c| f64::from(c.x)).sum::<f64>() / image.len() as f64
+    };
+    assert!((brightness("") - 1.0).abs() < 1e-6);
+    assert!((brightness("Scale -1 1 1") - 1.0).abs() < 1e-6);
+    assert_eq!(brightness("ReverseOrientation"), 0.0);
+    assert_eq!(brightness("Scale -1 1 1\nReverseOrientation"), 0.0);
+}
