@@ -36,8 +36,9 @@ pub struct Lexer {
     text: Arc<str>,
     pos: usize,
     line: u32,
-    /// Byte offset where the current line starts.
-    line_start: usize,
+    /// A byte offset on the current line and its column (0-based), so
+    /// that columns are counted once however long the line.
+    mark: (usize, usize),
     file: u32,
 }
 
@@ -48,17 +49,20 @@ impl Lexer {
             text,
             pos: 0,
             line: 1,
-            line_start: 0,
+            mark: (0, 0),
             file,
         }
     }
 
-    fn at(&self, pos: usize) -> At {
-        let col = self.text[self.line_start..pos].chars().count() + 1;
+    /// Where byte `pos` of the current line is.
+    fn at(text: &str, mark: &mut (usize, usize), line: u32, file: u32, pos: usize) -> At {
+        let (from, col) = *mark;
+        let col = col + text[from..pos].chars().count();
+        *mark = (pos, col);
         At {
-            file: self.file,
-            line: self.line,
-            col: col.min(u32::MAX as usize) as u32,
+            file,
+            line,
+            col: (col + 1).min(u32::MAX as usize) as u32,
         }
     }
 
@@ -72,7 +76,7 @@ impl Lexer {
                 Some(b'\n') => {
                     self.pos += 1;
                     self.line += 1;
-                    self.line_start = self.pos;
+                    self.mark = (self.pos, 0);
                 }
                 Some(b' ' | b'\t' | b'\r') => self.pos += 1,
                 Some(b'#') => {
@@ -87,7 +91,7 @@ impl Lexer {
         let Some(&first) = bytes.get(start) else {
             return Ok(None);
         };
-        let at = self.at(start);
+        let at = Self::at(&self.text, &mut self.mark, self.line, self.file, start);
         match first {
             b'[' => {
                 self.pos += 1;

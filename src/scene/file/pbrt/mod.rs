@@ -354,76 +354,59 @@ impl Input {
         }
     }
 
-    /// A parameter's value or bracketed values.
+    /// A parameter's value or bracketed values, read as they come (a
+    /// mesh's millions of numbers are not held as tokens).
     fn values(&mut self, ty: &str, name: &str, at: At) -> Result<Values, Problem> {
-        let mut items = Vec::new();
-        match self.next()? {
-            Some((Token::Open, _)) => loop {
-                match self.next()? {
-                    Some((Token::Close, _)) => break,
-                    Some((t @ (Token::Num(_) | Token::Str(_) | Token::Word(_)), tat)) => {
-                        items.push((t, tat))
-                    }
-                    other => {
-                        return Err(self.expected(
-                            &format!("a value of `{name}` or `]`"),
-                            other,
-                            at,
-                        ))
-                    }
-                }
-            },
-            Some((t @ (Token::Num(_) | Token::Str(_) | Token::Word(_)), tat)) => {
-                items.push((t, tat))
+        let bracketed = match self.next()? {
+            Some((Token::Open, _)) => true,
+            Some(t @ (Token::Num(_) | Token::Str(_) | Token::Word(_), _)) => {
+                self.peeked = Some(t);
+                false
             }
             other => return Err(self.expected(&format!("a value for `{name}`"), other, at)),
-        }
-        let boolean = |t: &Token| match t {
-            Token::Word(w) | Token::Str(w) if w == "true" => Some(true),
-            Token::Word(w) | Token::Str(w) if w == "false" => Some(false),
-            _ => None,
         };
-        if ty == "bool" {
-            return items
-                .iter()
-                .map(|(t, tat)| {
-                    boolean(t).ok_or_else(|| {
-                        (
-                            *tat,
-                            format!("`{name}` takes true or false, got {}", t.describe()),
-                            None,
-                        )
-                    })
-                })
-                .collect::<Result<_, _>>()
-                .map(Values::Bools);
-        }
-        match items.first() {
-            Some((Token::Num(_), _)) | None => items
-                .into_iter()
-                .map(|(t, tat)| match t {
-                    Token::Num(n) => Ok(n),
-                    t => Err((
+        let mut values: Option<Values> = None;
+        loop {
+            let (t, tat) = match self.next()? {
+                Some((Token::Close, _)) if bracketed => break,
+                Some(t @ (Token::Num(_) | Token::Str(_) | Token::Word(_), _)) => t,
+                other => {
+                    return Err(self.expected(&format!("a value of `{name}` or `]`"), other, at))
+                }
+            };
+            let boolean = match &t {
+                Token::Word(w) | Token::Str(w) if ty == "bool" && w == "true" => Some(true),
+                Token::Word(w) | Token::Str(w) if ty == "bool" && w == "false" => Some(false),
+                _ => None,
+            };
+            let values = values.get_or_insert_with(|| match (&t, boolean) {
+                (_, Some(_)) => Values::Bools(Vec::new()),
+                (Token::Num(_), _) => Values::Nums(Vec::new()),
+                _ => Values::Strs(Vec::new()),
+            });
+            match (values, t, boolean) {
+                (Values::Bools(v), _, Some(b)) => v.push(b),
+                (Values::Nums(v), Token::Num(n), None) => v.push(n),
+                (Values::Strs(v), Token::Str(s), None) if ty != "bool" => v.push(s),
+                (_, t, _) if ty == "bool" => {
+                    return Err((
                         tat,
-                        format!("`{name}` mixes numbers with {}", t.describe()),
+                        format!("`{name}` takes true or false, got {}", t.describe()),
                         None,
-                    )),
-                })
-                .collect::<Result<_, _>>()
-                .map(Values::Nums),
-            Some((Token::Str(_), _)) => items
-                .into_iter()
-                .map(|(t, tat)| match t {
-                    Token::Str(s) => Ok(s),
-                    t => Err((
+                    ))
+                }
+                (_, t, _) => {
+                    return Err((
                         tat,
-                        format!("`{name}` mixes strings with {}", t.describe()),
+                        format!("`{name}` mixes values of different kinds: {}", t.describe()),
                         None,
-                    )),
-                })
-                .collect::<Result<_, _>>()
-                .map(Values::Strs),
-            Some((t, tat)) => Err((*tat, format!("`{name}`: unexpected {}", t.describe()), None)),
+                    ))
+                }
+            }
+            if !bracketed {
+                break;
+            }
         }
+        Ok(values.unwrap_or(Values::Nums(Vec::new())))
     }
 }
