@@ -379,3 +379,29 @@ fn a_light_shines_from_the_side_pbrt_gives_it_whatever_the_transform() {
     assert_eq!(brightness("ReverseOrientation"), 0.0);
     assert_eq!(brightness("Scale -1 1 1\nReverseOrientation"), 0.0);
 }
+
+#[test]
+fn a_loop_subdivision_surface_becomes_its_limit_mesh() {
+    let d = read(
+        "loop",
+        "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" 2 \
+         \"point3 P\" [ 1 0 0  -1 0 0  0 1 0  0 -1 0  0 0 1  0 0 -1 ] \
+         \"integer indices\" [ 0 2 4  2 1 4  1 3 4  3 0 4  2 0 5  1 2 5  3 1 5  0 3 5 ]\n",
+    );
+    let ObjectDesc::Triangles {
+        positions,
+        indices,
+        normals,
+        ..
+    } = &d.objects[0]
+    else {
+        panic!("{:?}", d.objects)
+    };
+    assert_eq!(indices.len(), 8 * 16);
+    let normals = normals.as_ref().expect("the limit surface's normals");
+    for (p, n) in positions.iter().zip(normals) {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!(r > 0.4 && r < 1.0, "{p:?}");
+        assert!(p[0] * n[0] + p[1] * n[1] + p[2] * n[2] > 0.0, "outwards");
+    }
+}

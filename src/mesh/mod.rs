@@ -21,6 +21,7 @@
 //! ```
 
 mod gltf;
+pub mod loop_subdivision;
 pub mod material;
 mod obj;
 mod ply;

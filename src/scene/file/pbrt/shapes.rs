@@ -1,6 +1,7 @@
 //! pbrt's shapes as lumen's objects: spheres, triangle meshes written in
-//! the scene, PLY meshes, and bilinear patches that are flat
-//! parallelograms (two triangles each).
+//! the scene, PLY meshes, bilinear patches that are flat parallelograms
+//! (two triangles each), and Loop subdivision surfaces (subdivided here,
+//! onto their limit surface).
 
 use super::lex::At;
 use super::params::{Params, Problem};
@@ -10,7 +11,13 @@ use crate::scene::desc::ObjectDesc;
 use crate::scene::file::matrix;
 
 /// The shapes lumen reads.
-const SHAPES: &[&str] = &["sphere", "trianglemesh", "plymesh", "bilinearmesh"];
+const SHAPES: &[&str] = &[
+    "sphere",
+    "trianglemesh",
+    "plymesh",
+    "bilinearmesh",
+    "loopsubdiv",
+];
 
 impl Builder {
     pub(super) fn shape(
@@ -202,8 +209,63 @@ impl Builder {
                     transform,
                 });
             }
-            "disk" | "cylinder" | "loopsubdiv" | "curve" | "cone" | "paraboloid"
-            | "hyperboloid" => {
+            "loopsubdiv" => {
+                let (positions, pat) = p.tuples::<3>("P", &["point3"])?.ok_or((
+                    at,
+                    "a loopsubdiv needs its points `P`".into(),
+                    None,
+                ))?;
+                let (indices, iat) = p.indices("indices")?.ok_or((
+                    at,
+                    "a loopsubdiv needs `indices`".into(),
+                    None,
+                ))?;
+                let levels = p.int("levels")?.unwrap_or(3);
+                let levels = u32::try_from(levels).map_err(|_| {
+                    (
+                        at,
+                        format!("`levels` must be a whole number ≥ 0, got {levels}"),
+                        None,
+                    )
+                })?;
+                if !indices.len().is_multiple_of(3) {
+                    return Err((
+                        iat,
+                        format!("`indices` hold {} numbers, not 3 a triangle", indices.len()),
+                        None,
+                    ));
+                }
+                if let Some(&i) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                    return Err((
+                        iat,
+                        format!(
+                            "`indices` names point {i}, but there are {} points `P`",
+                            positions.len()
+                        ),
+                        None,
+                    ));
+                }
+                let triangles: Vec<[u32; 3]> = indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0], t[1], t[2]])
+                    .collect();
+                let (positions, triangles, normals) =
+                    crate::mesh::loop_subdivision::subdivide(&positions, &triangles, levels)
+                        .map_err(|m| (at, format!("loopsubdiv: {m}"), None))?;
+                let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
+                self.triangles(
+                    positions,
+                    pat,
+                    &indices,
+                    3,
+                    Some(normals),
+                    None,
+                    p,
+                    at,
+                    "a loopsubdiv",
+                )?;
+            }
+            "disk" | "cylinder" | "curve" | "cone" | "paraboloid" | "hyperboloid" => {
                 p.ignore_all();
                 self.lacks(at, &format!("`{ty}` shape"), "no shape")?;
             }
