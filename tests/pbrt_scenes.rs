@@ -269,7 +269,7 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "is not among lumen's conductors"),
         ("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-BK8\"\n", "did you mean `glass-BK7`?"),
         ("WorldBegin\nShape \"disk\"\n", "--approximate renders no shape instead"),
-        ("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "equal-area octahedral"),
+        ("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "file `sky.exr` not found"),
         ("WorldBegin\nCoordSysTransform \"camra\"\n", "no coordinate system `camra`"),
         ("WorldBegin\n\"float x\" 1\n", "expected a directive"),
         ("WorldBegin\nTranslate 1 2\n", "expected a number, but the file ends"),
@@ -404,4 +404,56 @@ fn a_loop_subdivision_surface_becomes_its_limit_mesh() {
         assert!(r > 0.4 && r < 1.0, "{p:?}");
         assert!(p[0] * n[0] + p[1] * n[1] + p[2] * n[2] > 0.0, "outwards");
     }
+}
+
+#[test]
+fn an_environment_image_is_an_equal_area_map_in_the_lights_frame() {
+    let dir = scratch_dir("pbrt_scenes_sky");
+    // A white square sky: a grey ball under it is as bright as its
+    // albedo (a white furnace), and the sky itself is 1 wherever seen.
+    exr::prelude::write_rgb_file(dir.join("sky.exr"), 4, 4, |_, _| (1.0f32, 1.0f32, 1.0f32))
+        .unwrap();
+    let text = "LookAt 0 0 4  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+                Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24\n\
+                PixelFilter \"box\"\nSampler \"independent\" \"integer pixelsamples\" 64\n\
+                Integrator \"path\" \"integer maxdepth\" 20\nWorldBegin\n\
+                AttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 1\nAttributeEnd\n\
+                Material \"diffuse\" \"rgb reflectance\" [ 0.8 0.8 0.8 ]\nShape \"sphere\" \"float radius\" 0.6\n";
+    let file = read_in(&dir, text, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let BackgroundDesc::Image { layout, frame, .. } = &file.desc.background else {
+        panic!("{:?}", file.desc.background)
+    };
+    assert_eq!(
+        *layout,
+        lumen::scene::desc::EnvironmentLayoutDesc::EqualArea
+    );
+    let frame = frame.unwrap();
+    assert!(
+        close(frame[1], [0.0, 0.0, -1.0]) && close(frame[2], [0.0, 1.0, 0.0]),
+        "{frame:?}"
+    );
+    let scene = file.compile(&Overrides::default()).unwrap();
+    let image = lumen::render::render(&scene, &|_| {}).0.linear();
+    assert!(
+        close(image[0].as_dvec3().to_array(), [1.0; 3]),
+        "{:?}",
+        image[0]
+    );
+    let centre = image[12 * 24 + 12];
+    for c in [centre.x, centre.y, centre.z] {
+        assert!((c - 0.8).abs() < 0.03, "{centre:?}");
+    }
+    // Not square: refused when the scene is compiled.
+    exr::prelude::write_rgb_file(dir.join("sky.exr"), 4, 2, |_, _| (1.0f32, 1.0f32, 1.0f32))
+        .unwrap();
+    let file = read_in(&dir, text, &Options::default()).unwrap();
+    let message = file
+        .compile(&Overrides::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        message.contains("is square; this image is 4 × 2"),
+        "{message}"
+    );
 }

@@ -1,7 +1,7 @@
 //! The environment: the light arriving from infinitely far away along every
-//! direction a ray escapes by. A gradient, one colour, or an
-//! equirectangular image; each can be sampled as a light, with a density in
-//! proportion to its brightness.
+//! direction a ray escapes by. A gradient, one colour, or an image
+//! (equirectangular, or pbrt's equal-area octahedral square); each can be
+//! sampled as a light, with a density in proportion to its brightness.
 
 use super::luminance;
 use crate::distribution::Distribution2D;
@@ -145,6 +145,52 @@ pub struct EnvironmentMap {
     /// Whether the first and last rows lie at the poles (see
     /// [`EnvironmentMap::with_rows_at_poles`]).
     rows_at_poles: bool,
+    /// For a square map in the equal-area octahedral layout (see
+    /// [`EnvironmentMap::equal_area`]): the map's x, y and z axes in the
+    /// world.
+    equal_area: Option<[Vec3; 3]>,
+}
+
+/// The point of the unit square of the equal-area octahedral layout
+/// (Clarberg 2008) that unit `d` maps to: +z at the centre, −z at the
+/// corners, +x at the middle of the right edge, +y at the middle of the
+/// bottom edge (v grows down the image).
+pub fn equal_area_square(d: Vec3) -> [f32; 2] {
+    let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    let (a, b) = (x.max(y), x.min(y));
+    let b = if a == 0.0 { 0.0 } else { b / a };
+    let mut phi = b.atan() * (2.0 / PI);
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        std::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    let u = u.copysign(d.x);
+    let v = v.copysign(d.y);
+    [
+        (0.5 * (u + 1.0)).clamp(0.0, 1.0),
+        (0.5 * (v + 1.0)).clamp(0.0, 1.0),
+    ]
+}
+
+/// The unit direction of point `[u, v]` of the unit square in the
+/// equal-area octahedral layout (the inverse of [`equal_area_square`]).
+pub fn equal_area_sphere([u, v]: [f32; 2]) -> Vec3 {
+    let (u, v) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    let signed = 1.0 - (up + vp);
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * (PI / 4.0);
+    let z = (1.0 - r * r).copysign(signed);
+    let (sin, cos) = phi.sin_cos();
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    Vec3::new(cos.copysign(u) * s, sin.copysign(v) * s, z)
 }
 
 impl EnvironmentMap {
@@ -201,12 +247,56 @@ impl EnvironmentMap {
             distribution,
             integral,
             rows_at_poles: false,
+            equal_area: None,
         })
+    }
+
+    /// The environment of a square `image` in the equal-area octahedral
+    /// layout (pbrt's): every texel covers the same solid angle, 4π / its
+    /// number, and is looked up as it is (nearest, as pbrt does). `frame`
+    /// is the map's x, y and z axes in the world (orthonormal); the image's
+    /// centre looks along z. `Err` when the image is not square; `None`
+    /// when it is black everywhere or the intensity is 0.
+    pub fn equal_area(
+        image: Image,
+        frame: [Vec3; 3],
+        intensity: f32,
+    ) -> Result<Option<Self>, String> {
+        let (w, h) = (image.width(), image.height());
+        if w != h {
+            return Err(format!(
+                "an equal-area environment map is square; this image is {w} × {h}"
+            ));
+        }
+        if !(intensity > 0.0) {
+            return Ok(None);
+        }
+        let weights: Vec<f64> = (0..w * h)
+            .map(|i| f64::from(luminance(image.texel(i % w, i / w))))
+            .collect();
+        let total: f64 = weights.iter().sum();
+        let integral = total * 4.0 * std::f64::consts::PI / (w * h) as f64 * f64::from(intensity);
+        let Some(distribution) = Distribution2D::new(&weights, w) else {
+            return Ok(None);
+        };
+        Ok(Some(EnvironmentMap {
+            image,
+            intensity,
+            rotation: (0.0, 1.0),
+            distribution,
+            integral,
+            rows_at_poles: false,
+            equal_area: Some(frame),
+        }))
     }
 
     /// The image's (u, v) seen along unit world `direction`.
     #[inline]
     fn uv(&self, direction: Vec3) -> [f32; 2] {
+        if let Some([x, y, z]) = self.equal_area {
+            let d = Vec3::new(x.dot(direction), y.dot(direction), z.dot(direction));
+            return equal_area_square(d);
+        }
         // Into the image's frame: turned back by the rotation.
         let (s, c) = self.rotation;
         let x = c * direction.x - s * direction.z;
@@ -233,6 +323,12 @@ impl EnvironmentMap {
 
     fn color(&self, direction: Vec3) -> Color {
         let [u, mut v] = self.uv(direction);
+        if self.equal_area.is_some() {
+            let (w, h) = (self.image.width(), self.image.height());
+            let x = ((u * w as f32) as usize).min(w - 1);
+            let y = ((v * h as f32) as usize).min(h - 1);
+            return self.intensity * self.image.texel(x, y);
+        }
         if self.rows_at_poles {
             // Row r at v = r / (h − 1), looked up where the centred rows
             // have it: at (r + ½) / h.
@@ -244,6 +340,12 @@ impl EnvironmentMap {
 
     fn sample(&self, u: [f32; 2]) -> Option<(Vec3, f32)> {
         let (uv, density) = self.distribution.sample(u);
+        if let Some([x, y, z]) = self.equal_area {
+            // The layout keeps areas: the square covers the sphere at 4π.
+            let d = equal_area_sphere(uv);
+            let world = (x * d.x + y * d.y + z * d.z).normalize();
+            return Some((world, density / (4.0 * PI)));
+        }
         let (direction, sin_theta) = self.direction(uv);
         if !(sin_theta > 0.0) {
             return None;
@@ -253,6 +355,9 @@ impl EnvironmentMap {
     }
 
     fn pdf(&self, direction: Vec3) -> f32 {
+        if self.equal_area.is_some() {
+            return self.distribution.density(self.uv(direction)) / (4.0 * PI);
+        }
         let sin_theta = (direction.x * direction.x + direction.z * direction.z).sqrt();
         if !(sin_theta > 0.0) {
             return 0.0;

@@ -212,3 +212,94 @@ fn a_black_image_or_no_intensity_sheds_no_light() {
     let grey = Image::new(4, 2, vec![Color::splat(0.5); 8]);
     assert!(EnvironmentMap::new(grey, 0.0, 0.0).is_none());
 }
+
+/// A square map in the equal-area layout with structure (a sun, black
+/// texels), its frame turned so that its z is not the world's.
+fn equal_area_map() -> EnvironmentMap {
+    let n = 16;
+    let texels = (0..n * n)
+        .map(|i| {
+            let (x, y) = (i % n, i / n);
+            if (x, y) == (3, 12) {
+                Color::new(300.0, 200.0, 100.0)
+            } else if (x + y) % 7 == 0 {
+                Color::ZERO
+            } else {
+                Color::new(0.1 + x as f32 * 0.05, 0.2 + y as f32 * 0.02, 0.3)
+            }
+        })
+        .collect();
+    // pbrt's usual sky: the map's z is the world's +y.
+    let frame = [Vec3::X, Vec3::NEG_Z, Vec3::Y];
+    EnvironmentMap::equal_area(Image::new(n, n, texels), frame, 2.0)
+        .unwrap()
+        .expect("a map of light")
+}
+
+#[test]
+fn the_equal_area_layout_is_pbrts_and_round_trips() {
+    // Landmarks: +z at the centre, −z at every corner, +x at the middle of
+    // the right edge, +y at the middle of the bottom edge (the last row).
+    let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+    assert!(close(equal_area_square(Vec3::Z), [0.5, 0.5]));
+    assert!(close(equal_area_square(Vec3::X), [1.0, 0.5]));
+    assert!(close(equal_area_square(Vec3::NEG_X), [0.0, 0.5]));
+    assert!(close(equal_area_square(Vec3::Y), [0.5, 1.0]));
+    assert!(close(equal_area_square(Vec3::NEG_Y), [0.5, 0.0]));
+    let corner = equal_area_square(Vec3::NEG_Z);
+    assert!([0.0, 1.0].contains(&corner[0]) && [0.0, 1.0].contains(&corner[1]));
+    let mut rng = Rng::new(3);
+    for _ in 0..10_000 {
+        let d = crate::sampling::unit_vector(rng.next_2d());
+        let back = equal_area_sphere(equal_area_square(d));
+        assert!((back - d).length() < 1e-5, "{d} → {back}");
+        let uv = [rng.next_f32(), rng.next_f32()];
+        let again = equal_area_square(equal_area_sphere(uv));
+        assert!(
+            close(again, uv) || (uv[0] - 0.5).abs() + (uv[1] - 0.5).abs() > 0.49999,
+            "{uv:?} → {again:?}"
+        );
+    }
+    // Equal area: as many uniform directions land in each texel of a
+    // 4 × 4 square, within the counts' noise.
+    let n = 160_000u64;
+    let mut counts = [0u64; 16];
+    for _ in 0..n {
+        let [u, v] = equal_area_square(crate::sampling::unit_vector(rng.next_2d()));
+        counts[((v * 4.0) as usize).min(3) * 4 + ((u * 4.0) as usize).min(3)] += 1;
+    }
+    let expected = vec![n as f64 / 16.0; 16];
+    let (chi2, cells) = chi_square(&counts, &expected);
+    assert!(chi2 < chi_square_bound(cells - 1), "χ² {chi2}: {counts:?}");
+    // Not square: refused.
+    let image = Image::new(4, 2, vec![Color::ONE; 8]);
+    assert!(EnvironmentMap::equal_area(image, [Vec3::X, Vec3::Y, Vec3::Z], 1.0).is_err());
+}
+
+#[test]
+fn an_equal_area_sky_is_sampled_by_its_brightness_and_integrates_to_its_integral() {
+    let env = Environment::Map(Arc::new(equal_area_map()));
+    assert_samples_follow_pdf("equal-area map", &env);
+    let n = 400_000;
+    let mut rng = Rng::new(9);
+    let (mut y, mut y2) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        let d = crate::sampling::unit_vector(rng.next_2d());
+        let a = 4.0 * std::f64::consts::PI * f64::from(luminance(env.color(d)));
+        y += a;
+        y2 += a * a;
+    }
+    let n = n as f64;
+    let (mean, se) = (y / n, ((y2 / n - (y / n).powi(2)) / n).sqrt());
+    // Texels looked up as they are: the integral is exact.
+    let exact = env.integral();
+    assert!(
+        (mean - exact).abs() < K * se,
+        "∫ Y = {mean} ± {se}, integral() = {exact}"
+    );
+    // The sun (texel 3, 12: below the centre, left) is seen towards the
+    // map's frame: z = world +y, x = world +x, y = world −z.
+    let sun = equal_area_sphere([3.5 / 16.0, 12.5 / 16.0]);
+    let world = Vec3::X * sun.x + Vec3::NEG_Z * sun.y + Vec3::Y * sun.z;
+    assert_eq!(env.color(world), Color::new(600.0, 400.0, 200.0));
+}

@@ -67,6 +67,8 @@ pub fn materials() -> SceneDesc {
             rotation: 0.0,
             intensity: 1.0,
             rows_at_poles: false,
+            layout: Default::default(),
+            frame: None,
         })
         .camera(CameraDesc {
             vfov: 25.0,

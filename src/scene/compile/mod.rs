@@ -3,8 +3,8 @@
 //! placed once in world space or shared by instances.
 
 use super::desc::{
-    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, GltfCamera, MaterialDesc, ObjectDesc,
-    PixelFilterDesc, ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, EnvironmentLayoutDesc, GltfCamera,
+    MaterialDesc, ObjectDesc, PixelFilterDesc, ScalarDesc, ScaleDesc, TransformDesc, MAX_SEED,
 };
 use super::world::{Group, Mesh, PlacedGroup, Rounding, Shapes, Surface, World};
 use super::{
@@ -232,6 +232,56 @@ fn compile_background(
             rotation,
             intensity,
             rows_at_poles,
+            layout: EnvironmentLayoutDesc::EqualArea,
+            frame,
+        } => {
+            finite("background.intensity", &[*intensity])?;
+            if *intensity < 0.0 {
+                return Err(invalid(
+                    "background.intensity",
+                    format!("must not be negative, got {intensity}"),
+                ));
+            }
+            if *rotation != 0.0 || *rows_at_poles {
+                return Err(invalid(
+                    "background.layout",
+                    "an equal-area map turns by its `frame`; `rotation` and `rows_at_poles` are for equirectangular maps",
+                ));
+            }
+            let axes = match frame {
+                None => [Vec3::X, Vec3::Y, Vec3::Z],
+                Some(f) => {
+                    finite("background.frame", &f.concat())?;
+                    let axes = f.map(vec3);
+                    let orthonormal = (0..3).all(|i| {
+                        (0..3).all(|j| {
+                            let want = if i == j { 1.0 } else { 0.0 };
+                            (axes[i].dot(axes[j]) - want).abs() < 1e-4
+                        })
+                    });
+                    if !orthonormal {
+                        return Err(invalid(
+                            "background.frame",
+                            "must be three unit axes at right angles (a rotation)",
+                        ));
+                    }
+                    axes
+                }
+            };
+            let image = read_image("background.file", base, file, sources)?;
+            match EnvironmentMap::equal_area(image, axes, *intensity as f32)
+                .map_err(|e| invalid("background.file", format!("{file}: {e}")))?
+            {
+                Some(map) => Environment::Map(Arc::new(map)),
+                None => Environment::Solid(Color::ZERO),
+            }
+        }
+        BackgroundDesc::Image {
+            file,
+            rotation,
+            intensity,
+            rows_at_poles,
+            ..
         } => {
             finite("background.rotation", &[*rotation])?;
             finite("background.intensity", &[*intensity])?;

@@ -386,7 +386,33 @@ pub enum BackgroundDesc {
         /// convention) rather than half a row from them.
         #[serde(default, skip_serializing_if = "is_false")]
         rows_at_poles: bool,
+        /// How the image wraps the scene: "equirectangular" (the
+        /// default) or "equal-area" (pbrt's square octahedral map).
+        #[serde(default, skip_serializing_if = "is_equirectangular")]
+        layout: EnvironmentLayoutDesc,
+        /// For an equal-area map: its x, y and z axes in the world (a
+        /// rotation; the image's centre looks along z). The world's axes
+        /// when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        frame: Option<[Triple; 3]>,
     },
+}
+
+/// How an environment image wraps the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvironmentLayoutDesc {
+    /// Longitude across, latitude down, +y up (see
+    /// [`EnvironmentMap`](crate::light::EnvironmentMap)).
+    #[default]
+    Equirectangular,
+    /// A square, the sphere's octahedron unfolded with equal areas (pbrt's
+    /// layout, [`equal_area_square`](crate::light::environment::equal_area_square)).
+    EqualArea,
+}
+
+fn is_equirectangular(l: &EnvironmentLayoutDesc) -> bool {
+    *l == EnvironmentLayoutDesc::Equirectangular
 }
 
 fn is_power(s: &LightSelection) -> bool {

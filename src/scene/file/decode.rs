@@ -14,10 +14,10 @@ use super::source::{Entry, Node, Value};
 use crate::light::LightSelection;
 use crate::material::KindInfo;
 use crate::scene::desc::{
-    BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc, FilterDesc,
-    GltfCamera, IntegratorDesc, LightDesc, MaterialDesc, NoisePatternDesc, ObjectDesc,
-    PixelFilterDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc,
-    TransformDesc, Triple, WrapDesc, MAX_SEED,
+    BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc,
+    EnvironmentLayoutDesc, FilterDesc, GltfCamera, IntegratorDesc, LightDesc, MaterialDesc,
+    NoisePatternDesc, ObjectDesc, PixelFilterDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc,
+    ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -684,7 +684,15 @@ const BACKGROUNDS: &[Kind<BackgroundKind>] = &[
         name: "image",
         kind: BackgroundKind::Image,
         what: "an image background",
-        fields: &["type", "file", "rotation", "intensity", "rows_at_poles"],
+        fields: &[
+            "type",
+            "file",
+            "rotation",
+            "intensity",
+            "rows_at_poles",
+            "layout",
+            "frame",
+        ],
         elsewhere: &[
             ("color", "a solid background"),
             ("bottom", "a gradient background"),
@@ -708,6 +716,28 @@ fn background(node: &Node) -> Result<BackgroundDesc> {
             rotation: t.optional("rotation", float)?.unwrap_or(0.0),
             intensity: t.optional("intensity", float)?.unwrap_or(1.0),
             rows_at_poles: t.optional("rows_at_poles", boolean)?.unwrap_or(false),
+            layout: t
+                .optional("layout", |n, p| {
+                    keyword(
+                        n,
+                        p,
+                        &[
+                            ("equirectangular", EnvironmentLayoutDesc::Equirectangular),
+                            ("equal-area", EnvironmentLayoutDesc::EqualArea),
+                        ],
+                    )
+                })?
+                .unwrap_or_default(),
+            frame: t.optional("frame", |n, p| {
+                let axes = list(n, p, triple)?;
+                <[Triple; 3]>::try_from(axes).map_err(|a| {
+                    error(
+                        p,
+                        &n.span,
+                        format!("expected 3 axes [x, y, z], got {}", a.len()),
+                    )
+                })
+            })?,
         },
     })
 }

@@ -259,8 +259,9 @@ fn background(b: &BackgroundDesc) -> bool {
         BackgroundDesc::Image {
             rotation,
             intensity,
+            frame,
             ..
-        } => finite(&[*rotation, *intensity]),
+        } => finite(&[*rotation, *intensity]) && frame.iter().flatten().all(|a| finite(a)),
     }
 }
 

@@ -698,6 +698,8 @@ impl<'d> Convert<'d> {
                         rotation: (180.0 + rotation).rem_euclid(360.0),
                         intensity: scale,
                         rows_at_poles: true,
+                        layout: Default::default(),
+                        frame: None,
                     };
                 }
                 // Mitsuba samples its environment as a light.

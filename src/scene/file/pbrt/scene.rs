@@ -858,7 +858,6 @@ impl Builder {
     }
 
     fn light(&mut self, ty: &str, at: At, p: &Params, input: &Input) -> Result<(), Problem> {
-        let _ = input;
         let point = |p: &Params, n: &str, default: [f64; 3]| -> Result<[f64; 3], Problem> {
             Ok(p.triple(n, &["point3"])?.unwrap_or(default))
         };
@@ -924,9 +923,45 @@ impl Builder {
             }
             "infinite" => {
                 if let Some((file, fat)) = p.string_of("filename", "string")? {
-                    let file = file.to_string();
-                    p.ignore_all();
-                    self.lacks(fat, &format!("environment map in pbrt's equal-area octahedral layout (`{file}`)"), "a black sky")?;
+                    let file = input.file(file, fat)?;
+                    if p.has("L") {
+                        return Err((fat, "an infinite light takes `L` or `filename`, not both".into(), None));
+                    }
+                    if p.float("illuminance")?.is_some() {
+                        self.lacks(at, "environment map scaled to an illuminance", "its `scale` alone")?;
+                    }
+                    let scale = p.float("scale")?.unwrap_or(1.0);
+                    p.ignore(&["portal"]);
+                    p.finish("an infinite light", &["L", "scale", "illuminance", "filename", "portal"])?;
+                    // The light's frame: the transform's axes, which must
+                    // turn and not stretch.
+                    let m = &{ self.state.ctm };
+                    let axes = [0, 1, 2].map(|j| matrix::normalize([m[0][j], m[1][j], m[2][j]]));
+                    let [Some(x), Some(y), Some(z)] = axes else {
+                        return Err((at, "the environment's transform is singular".into(), None));
+                    };
+                    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                    if dot(x, y).abs() > 1e-6 || dot(y, z).abs() > 1e-6 || dot(x, z).abs() > 1e-6 {
+                        return Err((at, "the environment's transform shears it: it may only turn it".into(), None));
+                    }
+                    // A mirroring transform: the map's axes as the
+                    // transform has them, which no rotation gives.
+                    if matrix::det3(m) < 0.0 {
+                        self.lacks(at, "environment map mirrored by its transform", "the map unmirrored")?;
+                    }
+                    let z = if matrix::det3(m) < 0.0 { z.map(|c| -c) } else { z };
+                    if !matches!(self.desc.background, BackgroundDesc::Solid { color: [0.0, 0.0, 0.0] }) {
+                        self.lacks(at, "second environment light", "the last one")?;
+                    }
+                    self.desc.background = BackgroundDesc::Image {
+                        file,
+                        rotation: 0.0,
+                        intensity: scale,
+                        rows_at_poles: false,
+                        layout: crate::scene::desc::EnvironmentLayoutDesc::EqualArea,
+                        frame: Some([x, y, z]),
+                    };
+                    self.desc.render.sample_background = Some(true);
                     return Ok(());
                 }
                 let mut radiance = self.emitted(p, "L")?;
@@ -939,7 +974,10 @@ impl Builder {
                 p.finish("an infinite light", &["L", "scale", "illuminance", "filename", "portal"])?;
                 let color = match &self.desc.background {
                     BackgroundDesc::Solid { color } => [0, 1, 2].map(|i| color[i] + radiance[i]),
-                    _ => radiance,
+                    _ => {
+                        self.lacks(at, "second environment light", "the last one")?;
+                        radiance
+                    }
                 };
                 self.desc.background = BackgroundDesc::Solid { color };
             }
