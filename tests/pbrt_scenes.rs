@@ -94,11 +94,14 @@ fn cameras_follow_pbrts_conventions() {
 
 #[test]
 fn transforms_instances_and_materials_are_placed_as_pbrt_places_them() {
-    let d = read(
+    let mut d = read(
         "transforms",
         r#"WorldBegin
 MakeNamedMaterial "gold" "string type" "conductor" "spectrum eta" "metal-Au-eta" "spectrum k" "metal-Au-k" "float roughness" 0.04
 Texture "checks" "spectrum" "imagemap" "string filename" "t.png" "float uscale" 2 "float vdelta" 0.25
+Texture "board" "spectrum" "checkerboard" "texture tex1" "checks" "rgb tex2" [ 0 0 1 ] "float uscale" 8 "float vscale" 4
+Material "diffuse" "texture reflectance" "board"
+Shape "sphere"
 Material "diffuse" "texture reflectance" "checks"
 AttributeBegin
   Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]
@@ -119,6 +122,31 @@ AttributeBegin
   Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ] "normal N" [ 0 0 -1  0 0 -1  0 0 -1 ]
 AttributeEnd
 "#,
+    );
+    // The checkerboard: its squares the image and blue.
+    let ObjectDesc::Sphere { material, .. } = d.objects.remove(0) else {
+        panic!()
+    };
+    let MaterialDesc::Diffuse(board) = &d.materials[&material] else {
+        panic!()
+    };
+    let ColorDesc::Texture(board) = &board.albedo else {
+        panic!()
+    };
+    let TextureDesc::Checkerboard {
+        even,
+        odd,
+        uv_scale,
+        uv_offset,
+    } = &d.textures[board]
+    else {
+        panic!("{:?}", d.textures[board])
+    };
+    assert!(matches!(even, ColorDesc::Texture(_)));
+    assert_eq!(*odd, ColorDesc::Rgb([0.0, 0.0, 1.0]));
+    assert_eq!(
+        (*uv_scale, *uv_offset),
+        (Some([8.0, 4.0]), Some([0.0, 0.0]))
     );
     assert_eq!(d.objects.len(), 4);
     // Transform is written column by column.

@@ -55,6 +55,18 @@ pub enum Texture {
         /// The texture of the odd cubes.
         odd: u32,
     },
+    /// Squares by the surface's (u, v): texture `even` where ⌊s⌋ + ⌊t⌋ is
+    /// even, (s, t) = scale · (u, v) + offset, `odd` elsewhere.
+    UvChecker {
+        /// Factors on u and v.
+        scale: [f32; 2],
+        /// Added after scaling.
+        offset: [f32; 2],
+        /// The texture of the even squares.
+        even: u32,
+        /// The texture of the odd squares.
+        odd: u32,
+    },
     /// An image, by the surface's (u, v): u rightwards, v upwards (the
     /// image's bottom row at v = 0), wrapped and filtered as the map says
     /// (by default repeating outside [0, 1]² and blended bilinearly).
@@ -112,6 +124,21 @@ impl Texture {
                 let which = if sum.rem_euclid(2) == 0 { even } else { odd };
                 table[*which as usize].value(table, at)
             }
+            Texture::UvChecker {
+                scale,
+                offset,
+                even,
+                odd,
+            } => {
+                let s = (scale[0] * at.uv[0] + offset[0]).floor() as i64;
+                let t = (scale[1] * at.uv[1] + offset[1]).floor() as i64;
+                let which = if (s + t).rem_euclid(2) == 0 {
+                    even
+                } else {
+                    odd
+                };
+                table[*which as usize].value(table, at)
+            }
             Texture::Map(map) => {
                 let [r, g, b, a] = map.rgba(at);
                 match map.channels {
@@ -148,7 +175,7 @@ impl Texture {
         let mut todo = vec![self];
         while let Some(t) = todo.pop() {
             let refs = match t {
-                Texture::Map(_) => return true,
+                Texture::Map(_) | Texture::UvChecker { .. } => return true,
                 Texture::Checker { even, odd, .. } => [Some(*even), Some(*odd)],
                 Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
                     [Some(*texture), None]
@@ -192,6 +219,28 @@ mod tests {
         assert_eq!(at(-0.1, 0.1, 0.1), Color::Y);
         assert_eq!(at(-0.1, -0.1, 0.1), Color::X);
         assert!(!table[2].uses_uv(&table));
+    }
+
+    #[test]
+    fn a_checkerboard_alternates_squares_of_u_and_v() {
+        let table = [
+            Texture::Solid(Color::X),
+            Texture::Solid(Color::Y),
+            Texture::UvChecker {
+                scale: [4.0, 2.0],
+                offset: [0.5, 0.0],
+                even: 0,
+                odd: 1,
+            },
+        ];
+        let at = |u: f32, v: f32| table[2].value(&table, &TexCoords::new([u, v], Vec3::ZERO));
+        // s = 4u + ½, t = 2v: (0.05, 0.1) is in square (0, 0), even.
+        assert_eq!(at(0.05, 0.1), Color::X);
+        assert_eq!(at(0.2, 0.1), Color::Y);
+        assert_eq!(at(0.2, 0.6), Color::X);
+        // Below zero, squares floor downwards.
+        assert_eq!(at(-0.2, 0.1), Color::Y);
+        assert!(table[2].uses_uv(&table));
     }
 
     #[test]

@@ -51,7 +51,7 @@ fn vec3(t: [f64; 3]) -> Vec3 {
 /// Accepts numbers that stay finite once converted to the renderer's `f32`.
 /// `field` is only formatted when a number is refused (scene files may hold
 /// millions of spheres).
-pub(super) fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
+pub(crate) fn finite(field: impl std::fmt::Display, values: &[f64]) -> Result<(), SceneError> {
     // `!(a <= b)` also catches NaN.
     match values.iter().find(|v| !(v.abs() <= f64::from(f32::MAX))) {
         None => Ok(()),

@@ -33,7 +33,9 @@ pub const MAX_TEXTURE_DEPTH: usize = 64;
 /// The names of the textures `desc` refers to.
 fn references(desc: &TextureDesc) -> impl Iterator<Item = &str> {
     let (even, odd) = match desc {
-        TextureDesc::Checker { even, odd, .. } => (Some(even), Some(odd)),
+        TextureDesc::Checker { even, odd, .. } | TextureDesc::Checkerboard { even, odd, .. } => {
+            (Some(even), Some(odd))
+        }
         _ => (None, None),
     };
     [even, odd].into_iter().flatten().filter_map(|c| match c {
@@ -218,6 +220,24 @@ impl<'a> TextureTable<'a> {
                 even: self.texture_of(&format!("{here}.even"), even, sources)?,
                 odd: self.texture_of(&format!("{here}.odd"), odd, sources)?,
             },
+            TextureDesc::Checkerboard {
+                even,
+                odd,
+                uv_scale,
+                uv_offset,
+            } => {
+                let pair = |field: &str, v: Option<[f64; 2]>, default: f64| {
+                    let v = v.unwrap_or([default; 2]);
+                    super::finite(format!("{here}.{field}"), &v)?;
+                    Ok::<_, SceneError>(v.map(|x| x as f32))
+                };
+                Texture::UvChecker {
+                    scale: pair("uv_scale", *uv_scale, 1.0)?,
+                    offset: pair("uv_offset", *uv_offset, 0.0)?,
+                    even: self.texture_of(&format!("{here}.even"), even, sources)?,
+                    odd: self.texture_of(&format!("{here}.odd"), odd, sources)?,
+                }
+            }
             TextureDesc::Image {
                 file,
                 channel,
@@ -327,7 +347,7 @@ impl TextureTable<'_> {
                     t = *texture;
                     continue;
                 }
-                Texture::Checker { .. } => TextureKind::Color,
+                Texture::Checker { .. } | Texture::UvChecker { .. } => TextureKind::Color,
                 Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
             };
         }

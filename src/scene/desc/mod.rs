@@ -454,6 +454,21 @@ pub enum TextureDesc {
         /// The colour (or texture) of the others.
         odd: ColorDesc,
     },
+    /// Squares on the surface by its texture coordinates: `even` where
+    /// ⌊s⌋ + ⌊t⌋ is even, (s, t) = uv_scale · (u, v) + uv_offset, `odd`
+    /// elsewhere (pbrt's and Mitsuba's `checkerboard`).
+    Checkerboard {
+        /// The colour (or texture) of the even squares.
+        even: ColorDesc,
+        /// The colour (or texture) of the others.
+        odd: ColorDesc,
+        /// Factors on (u, v): [2, 2] makes squares of ½; 1 when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_scale: Option<[f64; 2]>,
+        /// Added to (u, v) after scaling; 0 when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        uv_offset: Option<[f64; 2]>,
+    },
     /// An image wrapped by the surface's texture coordinates.
     Image {
         /// The image file, relative to the scene file.

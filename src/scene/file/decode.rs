@@ -809,11 +809,22 @@ fn and_list(items: &[&str]) -> String {
 #[derive(Clone, Copy)]
 enum TextureKind {
     Checker,
+    Checkerboard,
     Image,
     Noise,
 }
 
 const TEXTURES: &[Kind<TextureKind>] = &[
+    Kind {
+        name: "checkerboard",
+        kind: TextureKind::Checkerboard,
+        what: "a checkerboard texture",
+        fields: &["type", "even", "odd", "uv_scale", "uv_offset"],
+        elsewhere: &[
+            ("scale", "checker textures (squares in space)"),
+            ("file", "image textures"),
+        ],
+    },
     Kind {
         name: "checker",
         kind: TextureKind::Checker,
@@ -919,6 +930,16 @@ fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
             scale: t.require("scale", what, float)?,
             even: t.require("even", what, color_or_texture)?,
             odd: t.require("odd", what, color_or_texture)?,
+        },
+        TextureKind::Checkerboard => TextureDesc::Checkerboard {
+            even: t.require("even", what, color_or_texture)?,
+            odd: t.require("odd", what, color_or_texture)?,
+            uv_scale: t.optional("uv_scale", |n, p| {
+                numbers(n, p, "an array of 2 numbers [u, v]")
+            })?,
+            uv_offset: t.optional("uv_offset", |n, p| {
+                numbers(n, p, "an array of 2 numbers [u, v]")
+            })?,
         },
         TextureKind::Image => TextureDesc::Image {
             file: t.require("file", what, string)?.to_string(),

@@ -275,6 +275,12 @@ fn color(c: &ColorDesc) -> bool {
 fn texture(t: &TextureDesc) -> bool {
     match t {
         TextureDesc::Checker { scale, even, odd } => finite(&[*scale]) && color(even) && color(odd),
+        TextureDesc::Checkerboard {
+            even,
+            odd,
+            uv_scale,
+            uv_offset,
+        } => color(even) && color(odd) && uv_scale.iter().chain(uv_offset).all(|v| finite(v)),
         TextureDesc::Image { .. } => true,
         TextureDesc::Noise { scale, seed, .. } => finite(&[*scale]) && *seed <= MAX_SEED,
     }

@@ -52,7 +52,7 @@ const BSDFS: &[&str] = &[
 ];
 const EMITTERS: &[&str] = &["area", "constant", "envmap", "point", "spot", "directional"];
 const INTEGRATORS: &[&str] = &["path", "direct", "volpath", "volpathmis", "moment"];
-const TEXTURES: &[&str] = &["bitmap"];
+const TEXTURES: &[&str] = &["bitmap", "checkerboard"];
 
 /// The parameters of a rough BSDF's microfacets.
 const MICROFACET_PARAMS: [&str; 5] = [
@@ -1486,6 +1486,9 @@ impl<'d> Convert<'d> {
             return Ok(name.clone());
         }
         let t = self.type_of(e)?;
+        if t == "checkerboard" {
+            return self.checkerboard(e, scalar, key);
+        }
         if t != "bitmap" {
             return Err(self.unknown_type(e, "texture", TEXTURES));
         }
@@ -1556,6 +1559,52 @@ impl<'d> Convert<'d> {
             Some(id) if !scalar && !self.desc.textures.contains_key(id) => id.to_string(),
             _ => self.name("texture"),
         };
+        self.desc.textures.insert(name.clone(), desc);
+        self.textures.insert(key, name.clone());
+        Ok(name)
+    }
+}
+
+impl<'d> Convert<'d> {
+    /// A `checkerboard`: `color0` where ⌊2U⌋ + ⌊2V⌋ is even, (U, V) =
+    /// `to_uv` · (u, v) in Mitsuba's coordinates, whose v runs down the
+    /// image where lumen's runs up.
+    fn checkerboard(
+        &mut self,
+        e: &'d Element,
+        scalar: bool,
+        key: (*const Element, bool),
+    ) -> Result<String, Failure> {
+        let p = Props::of(e, self)?;
+        if scalar {
+            return Err(self.fail(
+                e,
+                "a checkerboard is read as a colour only (not as a roughness or a weight)".into(),
+            ));
+        }
+        let color0 = self
+            .colour(&p, "color0", Use::Reflectance)?
+            .unwrap_or(ColorDesc::Rgb([0.4; 3]));
+        let color1 = self
+            .colour(&p, "color1", Use::Reflectance)?
+            .unwrap_or(ColorDesc::Rgb([0.2; 3]));
+        let [a, b, c, d] = match p.transform("to_uv", self)? {
+            None => [1.0, 1.0, 0.0, 0.0],
+            Some(m) => {
+                if m[0][1] != 0.0 || m[1][0] != 0.0 {
+                    self.lacks(e, "a to_uv that turns or shears", "its scale and offset")?;
+                }
+                [m[0][0], m[1][1], m[0][3], m[1][3]]
+            }
+        };
+        p.finish(&["color0", "color1", "to_uv"], self)?;
+        let desc = TextureDesc::Checkerboard {
+            even: color0,
+            odd: color1,
+            uv_scale: Some([2.0 * a, -2.0 * b]),
+            uv_offset: Some([2.0 * c, 2.0 * (b + d)]),
+        };
+        let name = self.name("checkerboard");
         self.desc.textures.insert(name.clone(), desc);
         self.textures.insert(key, name.clone());
         Ok(name)

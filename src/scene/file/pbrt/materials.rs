@@ -686,6 +686,39 @@ impl Builder {
                     }
                 }
             }
+            "checkerboard" if !float && p.int("dimension")?.unwrap_or(2) == 2 => {
+                let colour = |t: Tex| match t {
+                    Tex::Constant(c) => ColorDesc::Rgb(c),
+                    Tex::Named(n) => ColorDesc::Texture(n),
+                };
+                let even = colour(value(self, "tex1", 1.0)?);
+                let odd = colour(value(self, "tex2", 0.0)?);
+                let [su, sv, du, dv] = mapping(p)?;
+                p.finish(
+                    "a checkerboard texture",
+                    &[
+                        "tex1",
+                        "tex2",
+                        "dimension",
+                        "mapping",
+                        "uscale",
+                        "vscale",
+                        "udelta",
+                        "vdelta",
+                    ],
+                )?;
+                let lumen = self.name("checkerboard");
+                self.desc.textures.insert(
+                    lumen.clone(),
+                    TextureDesc::Checkerboard {
+                        even,
+                        odd,
+                        uv_scale: Some([su, sv]),
+                        uv_offset: Some([du, dv]),
+                    },
+                );
+                Tex::Named(lumen)
+            }
             "checkerboard" | "mix" => {
                 let first = value(self, "tex1", if ty == "mix" { 0.0 } else { 1.0 })?;
                 let names: Vec<String> = p.list.iter().map(|x| x.name.clone()).collect();
