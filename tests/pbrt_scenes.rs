@@ -296,7 +296,7 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("ConcatTransform [ 1 0 0 1  0 1 0 0  0 0 1 0  0 0 0 1 ]\n", "a projective matrix"),
         ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "is not among lumen's conductors"),
         ("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-BK8\"\n", "did you mean `glass-BK7`?"),
-        ("WorldBegin\nShape \"disk\"\n", "--approximate renders no shape instead"),
+        ("WorldBegin\nShape \"disk\"\n", "--approximate renders a polygon of 128 sides of its area instead"),
         ("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "file `sky.exr` not found"),
         ("WorldBegin\nCoordSysTransform \"camra\"\n", "no coordinate system `camra`"),
         ("WorldBegin\n\"float x\" 1\n", "expected a directive"),

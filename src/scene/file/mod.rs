@@ -26,6 +26,7 @@ pub mod import;
 pub(crate) mod matrix;
 pub mod mitsuba;
 pub mod pbrt;
+mod tessellate;
 pub use crate::hint;
 mod node_de;
 mod plain_toml;

@@ -903,7 +903,34 @@ impl<'d> Convert<'d> {
                 material,
                 transform: matrix(&m),
             },
-            "disk" | "cylinder" | "serialized" => {
+            "disk" => {
+                self.lacks(
+                    e,
+                    "a disk shape",
+                    "a polygon of 128 sides of the disk's area",
+                )?;
+                crate::scene::file::tessellate::disk(1.0, 0.0, 0.0, material, matrix(&m))
+            }
+            "cylinder" => {
+                known.extend(["p0", "p1", "radius"]);
+                let p0 = p.point("p0", self)?.unwrap_or([0.0; 3]);
+                let p1 = p.point("p1", self)?.unwrap_or([0.0, 0.0, 1.0]);
+                let radius = p.float("radius", self)?.unwrap_or(1.0);
+                if p0[0] != p1[0] || p0[1] != p1[1] || !(p1[2] > p0[2]) || !(radius > 0.0) {
+                    self.lacks(e, "a cylinder off the z axis", "nothing")?;
+                    p.finish(&known, self).ok();
+                    return Ok(());
+                }
+                self.lacks(
+                    e,
+                    "a cylinder shape",
+                    "a prism of 128 sides of the cylinder's area",
+                )?;
+                let mut t = matrix(&m);
+                t.insert(0, TransformDesc::Translate([p0[0], p0[1], 0.0]));
+                crate::scene::file::tessellate::cylinder(radius, p0[2], p1[2], material, t)
+            }
+            "serialized" => {
                 p.finish(&[], self).ok();
                 self.lacks(e, &format!("a {t} shape"), "nothing")?;
                 return Ok(());

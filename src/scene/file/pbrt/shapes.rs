@@ -265,7 +265,69 @@ impl Builder {
                     "a loopsubdiv",
                 )?;
             }
-            "disk" | "cylinder" | "curve" | "cone" | "paraboloid" | "hyperboloid" => {
+            "disk" | "cylinder" => {
+                let radius = p.float("radius")?.unwrap_or(1.0);
+                let phimax = p.float("phimax")?.unwrap_or(360.0);
+                if !(radius > 0.0) {
+                    return Err((
+                        at,
+                        format!("the `radius` must be above 0, got {radius}"),
+                        None,
+                    ));
+                }
+                if phimax < 360.0 {
+                    self.lacks(at, &format!("part of a {ty} (phimax)"), "the whole")?;
+                }
+                self.lacks(
+                    at,
+                    &format!("`{ty}` shape"),
+                    "a polygon of 128 sides of its area",
+                )?;
+                let object = if ty == "disk" {
+                    let inner = p.float("innerradius")?.unwrap_or(0.0);
+                    let height = p.float("height")?.unwrap_or(0.0);
+                    crate::scene::file::tessellate::disk(
+                        radius,
+                        inner.clamp(0.0, radius),
+                        height,
+                        String::new(),
+                        Vec::new(),
+                    )
+                } else {
+                    let z0 = p.float("zmin")?.unwrap_or(-1.0);
+                    let z1 = p.float("zmax")?.unwrap_or(1.0);
+                    let (z0, z1) = (z0.min(z1), z0.max(z1));
+                    crate::scene::file::tessellate::cylinder(
+                        radius,
+                        z0,
+                        z1,
+                        String::new(),
+                        Vec::new(),
+                    )
+                };
+                let ObjectDesc::Triangles {
+                    positions,
+                    indices,
+                    normals,
+                    ..
+                } = object
+                else {
+                    unreachable!("tessellated")
+                };
+                let indices: Vec<u32> = indices.iter().flatten().copied().collect();
+                self.triangles(
+                    positions,
+                    at,
+                    &indices,
+                    3,
+                    normals,
+                    None,
+                    p,
+                    at,
+                    &format!("a {ty}"),
+                )?;
+            }
+            "curve" | "cone" | "paraboloid" | "hyperboloid" => {
                 p.ignore_all();
                 self.lacks(at, &format!("`{ty}` shape"), "no shape")?;
             }

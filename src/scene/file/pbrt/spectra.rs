@@ -39,7 +39,11 @@ pub fn metal(name: &str) -> Result<(&'static str, bool), String> {
     let (metal, part) = name
         .strip_prefix("metal-")
         .and_then(|rest| rest.rsplit_once('-'))
-        .ok_or_else(|| format!("`{name}` names no metal"))?;
+        .ok_or_else(|| {
+            format!(
+                "`{name}` names no metal: lumen reads pbrt's named metal spectra (metal-Au-eta, metal-Au-k, …), not spectrum files"
+            )
+        })?;
     let k = match part {
         "eta" => false,
         "k" => true,

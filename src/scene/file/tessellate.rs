@@ -1,0 +1,153 @@
+//! Disks and cylinders as triangles, for the readers of other renderers'
+//! formats, which have them where lumen has none (`--approximate`). The
+//! polygons are widened so that their area is the true shape's, which keeps
+//! the light a disk or a cylinder sheds.
+
+use crate::scene::desc::{ObjectDesc, TransformDesc};
+
+/// Sides of the polygons.
+pub const SEGMENTS: u32 = 128;
+
+/// The ring of radius `r` (before widening) at height `z`, `SEGMENTS`
+/// points counter-clockwise seen from +z.
+fn ring(r: f64, z: f64) -> impl Iterator<Item = [f64; 3]> {
+    (0..SEGMENTS).map(move |i| {
+        let phi = 2.0 * std::f64::consts::PI * f64::from(i) / f64::from(SEGMENTS);
+        [r * phi.cos(), r * phi.sin(), z]
+    })
+}
+
+/// A disk of `radius` (with a hole of `inner`) at height `z`, facing +z.
+pub fn disk(
+    radius: f64,
+    inner: f64,
+    z: f64,
+    material: String,
+    transform: Vec<TransformDesc>,
+) -> ObjectDesc {
+    let n = f64::from(SEGMENTS);
+    let angle = 2.0 * std::f64::consts::PI / n;
+    // A regular polygon of circumradius R has area ½ n R² sin(2π/n).
+    let widen = (2.0 * std::f64::consts::PI / (n * angle.sin())).sqrt();
+    let mut positions: Vec<[f64; 3]> = ring(radius * widen, z).collect();
+    let mut indices = Vec::new();
+    let s = SEGMENTS;
+    if inner > 0.0 {
+        positions.extend(ring(inner * widen, z));
+        for i in 0..s {
+            let j = (i + 1) % s;
+            indices.push([i, j, s + j]);
+            indices.push([i, s + j, s + i]);
+        }
+    } else {
+        positions.push([0.0, 0.0, z]);
+        for i in 0..s {
+            indices.push([s, i, (i + 1) % s]);
+        }
+    }
+    let normals = Some(vec![[0.0, 0.0, 1.0]; positions.len()]);
+    ObjectDesc::Triangles {
+        positions,
+        indices,
+        normals,
+        uvs: None,
+        material,
+        transform,
+    }
+}
+
+/// The side of a cylinder about z of `radius` from `z0` to `z1`, facing
+/// outwards, with normals for smooth shading.
+pub fn cylinder(
+    radius: f64,
+    z0: f64,
+    z1: f64,
+    material: String,
+    transform: Vec<TransformDesc>,
+) -> ObjectDesc {
+    let n = f64::from(SEGMENTS);
+    // A regular polygon of circumradius R has perimeter 2 n R sin(π/n).
+    let widen = std::f64::consts::PI / (n * (std::f64::consts::PI / n).sin());
+    let r = radius * widen;
+    let mut positions: Vec<[f64; 3]> = ring(r, z0).collect();
+    positions.extend(ring(r, z1));
+    let normals = positions
+        .iter()
+        .map(|p| [p[0] / r, p[1] / r, 0.0])
+        .collect();
+    let s = SEGMENTS;
+    let mut indices = Vec::new();
+    for i in 0..s {
+        let j = (i + 1) % s;
+        indices.push([i, j, s + j]);
+        indices.push([i, s + j, s + i]);
+    }
+    ObjectDesc::Triangles {
+        positions,
+        indices,
+        normals: Some(normals),
+        uvs: None,
+        material,
+        transform,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(o: &ObjectDesc) -> f64 {
+        let ObjectDesc::Triangles {
+            positions, indices, ..
+        } = o
+        else {
+            panic!()
+        };
+        indices
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                let w = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn tessellated_shapes_keep_their_area_and_face_out() {
+        let pi = std::f64::consts::PI;
+        let d = disk(2.0, 0.0, 1.0, "m".into(), Vec::new());
+        assert!((area(&d) / (pi * 4.0) - 1.0).abs() < 1e-12);
+        let ring = disk(2.0, 1.0, 0.0, "m".into(), Vec::new());
+        assert!((area(&ring) / (pi * 3.0) - 1.0).abs() < 1e-12);
+        let c = cylinder(0.5, -1.0, 2.0, "m".into(), Vec::new());
+        assert!((area(&c) / (2.0 * pi * 0.5 * 3.0) - 1.0).abs() < 1e-12);
+        // Winding: the disk's triangles face +z, the cylinder's outwards.
+        for (o, outward) in [(&d, [0.0, 0.0, 1.0]), (&c, [1.0, 0.0, 0.0])] {
+            let ObjectDesc::Triangles {
+                positions, indices, ..
+            } = o
+            else {
+                panic!()
+            };
+            let [a, b, c] = indices[0].map(|i| positions[i as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let w = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            assert!(
+                w[0] * outward[0] + w[1] * outward[1] + w[2] * outward[2] > 0.0,
+                "{w:?}"
+            );
+        }
+    }
+}
