@@ -430,7 +430,13 @@ fn missing_file_and_directory() {
     let m = SceneFile::read(&dir.join("scene.txt"))
         .unwrap_err()
         .to_string();
-    assert_mentions(&m, &["scene.txt", "must end in .toml, .json or .xml"]);
+    assert_mentions(
+        &m,
+        &[
+            "scene.txt",
+            "must end in .toml, .json, .xml (Mitsuba 3) or .pbrt",
+        ],
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

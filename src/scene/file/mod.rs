@@ -227,9 +227,10 @@ impl SceneFile {
             })
         })?;
         if meta.is_dir() {
-            return Err(
-                fail("is a directory; expected a scene file (.toml or .json)".into()).into(),
-            );
+            return Err(fail(
+                "is a directory; expected a scene file (.toml, .json, .xml or .pbrt)".into(),
+            )
+            .into());
         }
         let format = Format::from_extension(path).ok_or_else(|| {
             fail(
