@@ -1,4 +1,4 @@
-//! Mitsuba 3 scenes (`.xml`): read into a [`SceneDesc`], the description
+//! Mitsuba 3 scenes (`.xml`): read into a [`SceneDesc`](crate::scene::desc::SceneDesc), the description
 //! every lumen scene has, so that a Mitsuba scene renders as it is and
 //! exports to lumen's TOML unchanged.
 //!

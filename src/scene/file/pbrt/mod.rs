@@ -1,4 +1,4 @@
-//! pbrt-v4 scenes (`.pbrt`): read into a [`SceneDesc`], the description
+//! pbrt-v4 scenes (`.pbrt`): read into a [`SceneDesc`](crate::scene::desc::SceneDesc), the description
 //! every lumen scene has, so that a pbrt scene renders as it is and
 //! exports to lumen's TOML unchanged.
 //!
