@@ -485,3 +485,47 @@ fn an_environment_image_is_an_equal_area_map_in_the_lights_frame() {
         "{message}"
     );
 }
+
+#[test]
+fn a_scaled_texture_scales_what_it_shows() {
+    // One bounce of light from a white sky off a textured floor: its
+    // brightness is the texture's, so halving the texture halves it.
+    let dir = scratch_dir("pbrt_scenes_scale");
+    let image = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/khronos/TextureTransformTest/Correct.png");
+    std::fs::copy(image, dir.join("t.png")).unwrap();
+    let render = |texture: &str| {
+        let text = format!(
+            "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n\
+             Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\nPixelFilter \"box\"\n\
+             Sampler \"independent\" \"integer pixelsamples\" 4\nIntegrator \"path\" \"integer maxdepth\" 1\nWorldBegin\n\
+             LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n\
+             Texture \"image\" \"spectrum\" \"imagemap\" \"string filename\" \"t.png\"\n{texture}\n\
+             Material \"diffuse\" \"texture reflectance\" \"shown\"\n\
+             Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"integer indices\" [ 0 1 2  0 2 3 ] \
+             \"point2 uv\" [ 0 0  1 0  1 1  0 1 ]\n"
+        );
+        let file = read_in(&dir, &text, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = file.compile(&Overrides::default()).unwrap();
+        lumen::render::render(&scene, &|_| {}).0.linear()
+    };
+    let plain = render("Texture \"shown\" \"spectrum\" \"scale\" \"texture tex\" \"image\"");
+    let half = render(
+        "Texture \"shown\" \"spectrum\" \"scale\" \"texture tex\" \"image\" \"float scale\" 0.5",
+    );
+    // Pixels wholly on the floor (it fills the middle 14 × 14).
+    let inside: Vec<usize> = (0..plain.len())
+        .filter(|&i| (2..14).contains(&(i % 16)) && (2..14).contains(&(i / 16)))
+        .collect();
+    assert!(
+        inside.iter().any(|&i| plain[i].max_element() > 0.05),
+        "the floor is seen"
+    );
+    for i in inside {
+        let (a, b) = (plain[i], half[i]);
+        assert!(
+            (b * 2.0 - a).abs().max_element() < 1e-5 * a.max_element().max(1.0),
+            "{a:?} vs {b:?}"
+        );
+    }
+}

@@ -36,6 +36,7 @@ fn references(desc: &TextureDesc) -> impl Iterator<Item = &str> {
         TextureDesc::Checker { even, odd, .. } | TextureDesc::Checkerboard { even, odd, .. } => {
             (Some(even), Some(odd))
         }
+        TextureDesc::Scale { texture, .. } => (Some(texture), None),
         _ => (None, None),
     };
     [even, odd].into_iter().flatten().filter_map(|c| match c {
@@ -219,6 +220,10 @@ impl<'a> TextureTable<'a> {
                 inverse_scale: 1.0 / positive(&format!("{here}.scale"), *scale)?,
                 even: self.texture_of(&format!("{here}.even"), even, sources)?,
                 odd: self.texture_of(&format!("{here}.odd"), odd, sources)?,
+            },
+            TextureDesc::Scale { texture, factor } => Texture::Scaled {
+                factor: super::color(&format!("{here}.factor"), *factor)?,
+                texture: self.texture_of(&format!("{here}.texture"), texture, sources)?,
             },
             TextureDesc::Checkerboard {
                 even,

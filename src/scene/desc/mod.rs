@@ -469,6 +469,14 @@ pub enum TextureDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         uv_offset: Option<[f64; 2]>,
     },
+    /// Another texture (or a colour) times a factor per channel (pbrt's
+    /// `scale`).
+    Scale {
+        /// The texture scaled: a texture's name or a colour.
+        texture: ColorDesc,
+        /// The factor, per channel, each ≥ 0.
+        factor: Triple,
+    },
     /// An image wrapped by the surface's texture coordinates.
     Image {
         /// The image file, relative to the scene file.

@@ -810,11 +810,19 @@ fn and_list(items: &[&str]) -> String {
 enum TextureKind {
     Checker,
     Checkerboard,
+    Scale,
     Image,
     Noise,
 }
 
 const TEXTURES: &[Kind<TextureKind>] = &[
+    Kind {
+        name: "scale",
+        kind: TextureKind::Scale,
+        what: "a scale texture",
+        fields: &["type", "texture", "factor"],
+        elsewhere: &[("scale", "checker textures"), ("file", "image textures")],
+    },
     Kind {
         name: "checkerboard",
         kind: TextureKind::Checkerboard,
@@ -930,6 +938,10 @@ fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
             scale: t.require("scale", what, float)?,
             even: t.require("even", what, color_or_texture)?,
             odd: t.require("odd", what, color_or_texture)?,
+        },
+        TextureKind::Scale => TextureDesc::Scale {
+            texture: t.require("texture", what, color_or_texture)?,
+            factor: t.require("factor", what, triple)?,
         },
         TextureKind::Checkerboard => TextureDesc::Checkerboard {
             even: t.require("even", what, color_or_texture)?,

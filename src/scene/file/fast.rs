@@ -275,6 +275,7 @@ fn color(c: &ColorDesc) -> bool {
 fn texture(t: &TextureDesc) -> bool {
     match t {
         TextureDesc::Checker { scale, even, odd } => finite(&[*scale]) && color(even) && color(odd),
+        TextureDesc::Scale { texture, factor } => color(texture) && finite(factor),
         TextureDesc::Checkerboard {
             even,
             odd,

@@ -606,9 +606,12 @@ impl Builder {
                         EncodingDesc::Srgb
                     }
                 };
-                if p.float("scale")?.is_some_and(|s| s != 1.0) || p.boolean("invert")? == Some(true)
-                {
-                    self.lacks(at, "scaled or inverted image texture", "the image as it is")?;
+                let scale = p.float("scale")?.unwrap_or(1.0);
+                if !(scale >= 0.0) {
+                    return Err((at, format!("`scale` must be ≥ 0, got {scale}"), None));
+                }
+                if p.boolean("invert")? == Some(true) {
+                    self.lacks(at, "inverted image texture", "the image as it is")?;
                 }
                 let wrap = match p.string("wrap")?.unwrap_or("repeat") {
                     "repeat" => WrapDesc::Repeat,
@@ -656,7 +659,11 @@ impl Builder {
                 }
                 let lumen = self.name(if float { "float-texture" } else { "texture" });
                 self.desc.textures.insert(lumen.clone(), desc);
-                Tex::Named(lumen)
+                if scale == 1.0 {
+                    Tex::Named(lumen)
+                } else {
+                    self.scaled(lumen, [scale; 3])
+                }
             }
             "constant" => {
                 let v = value(self, "value", 1.0)?;
@@ -680,6 +687,9 @@ impl Builder {
                         Tex::Constant([0, 1, 2].map(|i| a[i] * b[i]))
                     }
                     (t, Tex::Constant([1.0, 1.0, 1.0])) | (Tex::Constant([1.0, 1.0, 1.0]), t) => t,
+                    (Tex::Named(t), Tex::Constant(c)) | (Tex::Constant(c), Tex::Named(t)) => {
+                        self.scaled(t, c)
+                    }
                     (t, _) => {
                         self.lacks(at, "product of a texture and another", "the first texture")?;
                         t
@@ -758,6 +768,19 @@ impl Builder {
         };
         self.textures.insert((name.to_string(), float), tex);
         Ok(())
+    }
+
+    /// Texture `t` times `factor`, as a texture of its own.
+    fn scaled(&mut self, t: String, factor: [f64; 3]) -> Tex {
+        let name = self.name("scaled");
+        self.desc.textures.insert(
+            name.clone(),
+            TextureDesc::Scale {
+                texture: ColorDesc::Texture(t),
+                factor,
+            },
+        );
+        Tex::Named(name)
     }
 
     /// A shape's material (the current one, shining with the current area
