@@ -742,6 +742,18 @@ fn is_false(b: &bool) -> bool {
 }
 
 impl ObjectDesc {
+    /// The object's transform steps, to be changed.
+    pub fn transform_mut(&mut self) -> &mut Vec<TransformDesc> {
+        match self {
+            ObjectDesc::Sphere { transform, .. }
+            | ObjectDesc::Quad { transform, .. }
+            | ObjectDesc::Box { transform, .. }
+            | ObjectDesc::Mesh { transform, .. }
+            | ObjectDesc::Triangles { transform, .. }
+            | ObjectDesc::Medium { transform, .. } => transform,
+        }
+    }
+
     /// The object's transform steps.
     pub fn transform(&self) -> &[TransformDesc] {
         match self {

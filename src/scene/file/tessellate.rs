@@ -17,54 +17,61 @@ fn ring(r: f64, z: f64) -> impl Iterator<Item = [f64; 3]> {
     })
 }
 
-/// A disk of `radius` (with a hole of `inner`) at height `z`, facing +z.
-pub fn disk(
-    radius: f64,
-    inner: f64,
-    z: f64,
+/// A tessellated shape: positions, counter-clockwise triangles and unit
+/// normals (as [`crate::mesh::loop_subdivision::Limit`]).
+pub type Mesh = crate::mesh::loop_subdivision::Limit;
+
+/// `mesh` as an object of the scene.
+pub fn object(
+    (positions, indices, normals): Mesh,
     material: String,
     transform: Vec<TransformDesc>,
 ) -> ObjectDesc {
-    let n = f64::from(SEGMENTS);
-    let angle = 2.0 * std::f64::consts::PI / n;
-    // A regular polygon of circumradius R has area ½ n R² sin(2π/n).
-    let widen = (2.0 * std::f64::consts::PI / (n * angle.sin())).sqrt();
-    let mut positions: Vec<[f64; 3]> = ring(radius * widen, z).collect();
-    let mut indices = Vec::new();
-    let s = SEGMENTS;
-    if inner > 0.0 {
-        positions.extend(ring(inner * widen, z));
-        for i in 0..s {
-            let j = (i + 1) % s;
-            indices.push([i, j, s + j]);
-            indices.push([i, s + j, s + i]);
-        }
-    } else {
-        positions.push([0.0, 0.0, z]);
-        for i in 0..s {
-            indices.push([s, i, (i + 1) % s]);
-        }
-    }
-    let normals = Some(vec![[0.0, 0.0, 1.0]; positions.len()]);
     ObjectDesc::Triangles {
         positions,
         indices,
-        normals,
+        normals: Some(normals),
         uvs: None,
         material,
         transform,
     }
 }
 
+/// The triangles of the band between ring 0 (vertices 0 … SEGMENTS − 1)
+/// and ring 1 (the next SEGMENTS), counter-clockwise seen from the side
+/// the first ring's edge turns to.
+fn band() -> Vec<[u32; 3]> {
+    let s = SEGMENTS;
+    (0..s)
+        .flat_map(|i| {
+            let j = (i + 1) % s;
+            [[i, j, s + j], [i, s + j, s + i]]
+        })
+        .collect()
+}
+
+/// A disk of `radius` (with a hole of `inner`) at height `z`, facing +z.
+pub fn disk(radius: f64, inner: f64, z: f64) -> Mesh {
+    let n = f64::from(SEGMENTS);
+    let angle = 2.0 * std::f64::consts::PI / n;
+    // A regular polygon of circumradius R has area ½ n R² sin(2π/n).
+    let widen = (2.0 * std::f64::consts::PI / (n * angle.sin())).sqrt();
+    let mut positions: Vec<[f64; 3]> = ring(radius * widen, z).collect();
+    let indices = if inner > 0.0 {
+        positions.extend(ring(inner * widen, z));
+        band()
+    } else {
+        let s = SEGMENTS;
+        positions.push([0.0, 0.0, z]);
+        (0..s).map(|i| [s, i, (i + 1) % s]).collect()
+    };
+    let normals = vec![[0.0, 0.0, 1.0]; positions.len()];
+    (positions, indices, normals)
+}
+
 /// The side of a cylinder about z of `radius` from `z0` to `z1`, facing
 /// outwards, with normals for smooth shading.
-pub fn cylinder(
-    radius: f64,
-    z0: f64,
-    z1: f64,
-    material: String,
-    transform: Vec<TransformDesc>,
-) -> ObjectDesc {
+pub fn cylinder(radius: f64, z0: f64, z1: f64) -> Mesh {
     let n = f64::from(SEGMENTS);
     // A regular polygon of circumradius R has perimeter 2 n R sin(π/n).
     let widen = std::f64::consts::PI / (n * (std::f64::consts::PI / n).sin());
@@ -75,21 +82,7 @@ pub fn cylinder(
         .iter()
         .map(|p| [p[0] / r, p[1] / r, 0.0])
         .collect();
-    let s = SEGMENTS;
-    let mut indices = Vec::new();
-    for i in 0..s {
-        let j = (i + 1) % s;
-        indices.push([i, j, s + j]);
-        indices.push([i, s + j, s + i]);
-    }
-    ObjectDesc::Triangles {
-        positions,
-        indices,
-        normals: Some(normals),
-        uvs: None,
-        material,
-        transform,
-    }
+    (positions, band(), normals)
 }
 
 #[cfg(test)]
@@ -122,11 +115,11 @@ mod tests {
     #[test]
     fn tessellated_shapes_keep_their_area_and_face_out() {
         let pi = std::f64::consts::PI;
-        let d = disk(2.0, 0.0, 1.0, "m".into(), Vec::new());
+        let d = object(disk(2.0, 0.0, 1.0), "m".into(), Vec::new());
         assert!((area(&d) / (pi * 4.0) - 1.0).abs() < 1e-12);
-        let ring = disk(2.0, 1.0, 0.0, "m".into(), Vec::new());
+        let ring = object(disk(2.0, 1.0, 0.0), "m".into(), Vec::new());
         assert!((area(&ring) / (pi * 3.0) - 1.0).abs() < 1e-12);
-        let c = cylinder(0.5, -1.0, 2.0, "m".into(), Vec::new());
+        let c = object(cylinder(0.5, -1.0, 2.0), "m".into(), Vec::new());
         assert!((area(&c) / (2.0 * pi * 0.5 * 3.0) - 1.0).abs() < 1e-12);
         // Winding: the disk's triangles face +z, the cylinder's outwards.
         for (o, outward) in [(&d, [0.0, 0.0, 1.0]), (&c, [1.0, 0.0, 0.0])] {

@@ -22,6 +22,7 @@ use crate::scene::desc::{
     PixelFilterDesc, RoughnessDesc, SamplingDesc, ScalarDesc, SceneDesc, TextureDesc,
     TransformDesc, WrapDesc,
 };
+use crate::scene::file::tessellate;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -909,7 +910,7 @@ impl<'d> Convert<'d> {
                     "a disk shape",
                     "a polygon of 128 sides of the disk's area",
                 )?;
-                crate::scene::file::tessellate::disk(1.0, 0.0, 0.0, material, matrix(&m))
+                tessellate::object(tessellate::disk(1.0, 0.0, 0.0), material, matrix(&m))
             }
             "cylinder" => {
                 known.extend(["p0", "p1", "radius"]);
@@ -928,7 +929,7 @@ impl<'d> Convert<'d> {
                 )?;
                 let mut t = matrix(&m);
                 t.insert(0, TransformDesc::Translate([p0[0], p0[1], 0.0]));
-                crate::scene::file::tessellate::cylinder(radius, p0[2], p1[2], material, t)
+                tessellate::object(tessellate::cylinder(radius, p0[2], p1[2]), material, t)
             }
             "serialized" => {
                 p.finish(&[], self).ok();

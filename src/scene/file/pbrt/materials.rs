@@ -177,8 +177,7 @@ impl Builder {
                 return Ok((name, interface));
             }
             "measured" | "hair" | "subsurface" | "diffusetransmission" => {
-                let names: Vec<String> = p.list.iter().map(|x| x.name.clone()).collect();
-                p.ignore(&names.iter().map(String::as_str).collect::<Vec<_>>());
+                p.ignore_all();
                 self.lacks(at, &format!("`{ty}` material"), "a grey diffuse")?;
                 MaterialDesc::Diffuse(DiffuseDesc::new([0.5; 3]))
             }
@@ -731,14 +730,12 @@ impl Builder {
             }
             "checkerboard" | "mix" => {
                 let first = value(self, "tex1", if ty == "mix" { 0.0 } else { 1.0 })?;
-                let names: Vec<String> = p.list.iter().map(|x| x.name.clone()).collect();
-                p.ignore(&names.iter().map(String::as_str).collect::<Vec<_>>());
+                p.ignore_all();
                 self.lacks(at, &format!("`{ty}` texture"), "its `tex1`")?;
                 first
             }
             other => {
-                let names: Vec<String> = p.list.iter().map(|x| x.name.clone()).collect();
-                p.ignore(&names.iter().map(String::as_str).collect::<Vec<_>>());
+                p.ignore_all();
                 if [
                     "bilerp",
                     "directionmix",

@@ -392,35 +392,18 @@ impl Builder {
                 input.string(at)?;
                 input.params(at)?.ignore_all();
             }
-            "Camera" => {
+            // The scene-wide settings: a type, then parameters.
+            "Camera" | "Film" | "Sampler" | "Integrator" | "PixelFilter" => {
                 self.options_only(name, at)?;
                 let (ty, tat) = input.string(at)?;
                 let p = input.params(at)?;
-                self.camera(&ty, tat, &p)?;
-            }
-            "Film" => {
-                self.options_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.film(&ty, tat, &p)?;
-            }
-            "Sampler" => {
-                self.options_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.sampler(&ty, tat, &p)?;
-            }
-            "Integrator" => {
-                self.options_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.integrator(&ty, tat, &p)?;
-            }
-            "PixelFilter" => {
-                self.options_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.filter(&ty, tat, &p)?;
+                match name {
+                    "Camera" => self.camera(&ty, tat, &p)?,
+                    "Film" => self.film(&ty, tat, &p)?,
+                    "Sampler" => self.sampler(&ty, tat, &p)?,
+                    "Integrator" => self.integrator(&ty, tat, &p)?,
+                    _ => self.filter(&ty, tat, &p)?,
+                }
             }
             "MakeNamedMedium" => {
                 let (_, nat) = input.string(at)?;
@@ -489,23 +472,16 @@ impl Builder {
                 self.state.material = Some(material);
                 self.state.interface = interface;
             }
-            "LightSource" => {
+            // The world's entities: a type, then parameters.
+            "LightSource" | "AreaLightSource" | "Shape" => {
                 self.world_only(name, at)?;
                 let (ty, tat) = input.string(at)?;
                 let p = input.params(at)?;
-                self.light(&ty, tat, &p, input)?;
-            }
-            "AreaLightSource" => {
-                self.world_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.area_light(&ty, tat, &p)?;
-            }
-            "Shape" => {
-                self.world_only(name, at)?;
-                let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
-                self.shape(&ty, tat, &p, input)?;
+                match name {
+                    "LightSource" => self.light(&ty, tat, &p, input)?,
+                    "AreaLightSource" => self.area_light(&ty, tat, &p)?,
+                    _ => self.shape(&ty, tat, &p, input)?,
+                }
             }
             "ObjectBegin" => {
                 self.world_only(name, at)?;
@@ -557,7 +533,8 @@ impl Builder {
                     .map(|o| {
                         let mut o = o.clone();
                         if self.state.ctm != IDENTITY {
-                            transform_of(&mut o).push(TransformDesc::Matrix(self.state.ctm));
+                            o.transform_mut()
+                                .push(TransformDesc::Matrix(self.state.ctm));
                         }
                         o
                     })
@@ -797,10 +774,9 @@ impl Builder {
             self.lacks(at, "path regularization", "unregularized paths")?;
         }
         p.ignore(&["maxdepth", "lightsampler", "regularize"]);
-        let params: Vec<String> = p.list.iter().map(|x| x.name.clone()).collect();
         // Other integrators' parameters (bdpt's, sppm's) go with them.
         if ty != "path" && ty != "volpath" {
-            p.ignore(&params.iter().map(String::as_str).collect::<Vec<_>>());
+            p.ignore_all();
         }
         p.finish(
             "the path integrator",
@@ -1153,17 +1129,5 @@ impl Builder {
             desc: self.desc,
             warnings,
         })
-    }
-}
-
-/// An object's transform steps, to be added to.
-fn transform_of(o: &mut ObjectDesc) -> &mut Vec<TransformDesc> {
-    match o {
-        ObjectDesc::Sphere { transform, .. }
-        | ObjectDesc::Quad { transform, .. }
-        | ObjectDesc::Box { transform, .. }
-        | ObjectDesc::Mesh { transform, .. }
-        | ObjectDesc::Triangles { transform, .. }
-        | ObjectDesc::Medium { transform, .. } => transform,
     }
 }

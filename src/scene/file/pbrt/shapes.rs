@@ -8,7 +8,7 @@ use super::params::{Params, Problem};
 use super::scene::Builder;
 use super::Input;
 use crate::scene::desc::ObjectDesc;
-use crate::scene::file::matrix;
+use crate::scene::file::{matrix, tessellate};
 
 /// The shapes lumen reads.
 const SHAPES: &[&str] = &[
@@ -83,13 +83,13 @@ impl Builder {
                         ))
                     }
                 };
+                let triangles = triples(&indices, positions.len(), at)?;
                 let normals = p.tuples::<3>("N", &["normal", "normal3"])?.map(|(n, _)| n);
                 let uvs = self.uvs(p)?;
                 self.triangles(
                     positions,
                     pat,
-                    &indices,
-                    3,
+                    triangles,
                     normals,
                     uvs,
                     p,
@@ -137,7 +137,7 @@ impl Builder {
                 // Each patch p00 p10 p01 p11 is two triangles; exact when it
                 // is a flat parallelogram.
                 let mut curved = false;
-                let mut triangles = Vec::with_capacity(quads.len() / 4 * 6);
+                let mut triangles = Vec::with_capacity(quads.len() / 2);
                 for q in quads.chunks_exact(4) {
                     let [p00, p10, p01, p11] =
                         [q[0], q[1], q[2], q[3]].map(|i| positions[i as usize]);
@@ -151,7 +151,7 @@ impl Builder {
                     {
                         curved = true;
                     }
-                    triangles.extend([q[0], q[1], q[3], q[0], q[3], q[2]]);
+                    triangles.extend([[q[0], q[1], q[3]], [q[0], q[3], q[2]]]);
                 }
                 if curved {
                     self.lacks(at, "curved bilinear patch", "two flat triangles a patch")?;
@@ -161,8 +161,7 @@ impl Builder {
                 self.triangles(
                     positions,
                     pat,
-                    &triangles,
-                    4,
+                    triangles,
                     normals,
                     uvs,
                     p,
@@ -228,36 +227,14 @@ impl Builder {
                         None,
                     )
                 })?;
-                if !indices.len().is_multiple_of(3) {
-                    return Err((
-                        iat,
-                        format!("`indices` hold {} numbers, not 3 a triangle", indices.len()),
-                        None,
-                    ));
-                }
-                if let Some(&i) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                    return Err((
-                        iat,
-                        format!(
-                            "`indices` names point {i}, but there are {} points `P`",
-                            positions.len()
-                        ),
-                        None,
-                    ));
-                }
-                let triangles: Vec<[u32; 3]> = indices
-                    .chunks_exact(3)
-                    .map(|t| [t[0], t[1], t[2]])
-                    .collect();
+                let triangles = triples(&indices, positions.len(), iat)?;
                 let (positions, triangles, normals) =
                     crate::mesh::loop_subdivision::subdivide(&positions, &triangles, levels)
                         .map_err(|m| (at, format!("loopsubdiv: {m}"), None))?;
-                let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
                 self.triangles(
                     positions,
                     pat,
-                    &indices,
-                    3,
+                    triangles,
                     Some(normals),
                     None,
                     p,
@@ -283,44 +260,20 @@ impl Builder {
                     &format!("`{ty}` shape"),
                     "a polygon of 128 sides of its area",
                 )?;
-                let object = if ty == "disk" {
+                let (positions, triangles, normals) = if ty == "disk" {
                     let inner = p.float("innerradius")?.unwrap_or(0.0);
                     let height = p.float("height")?.unwrap_or(0.0);
-                    crate::scene::file::tessellate::disk(
-                        radius,
-                        inner.clamp(0.0, radius),
-                        height,
-                        String::new(),
-                        Vec::new(),
-                    )
+                    tessellate::disk(radius, inner.clamp(0.0, radius), height)
                 } else {
                     let z0 = p.float("zmin")?.unwrap_or(-1.0);
                     let z1 = p.float("zmax")?.unwrap_or(1.0);
-                    let (z0, z1) = (z0.min(z1), z0.max(z1));
-                    crate::scene::file::tessellate::cylinder(
-                        radius,
-                        z0,
-                        z1,
-                        String::new(),
-                        Vec::new(),
-                    )
+                    tessellate::cylinder(radius, z0.min(z1), z0.max(z1))
                 };
-                let ObjectDesc::Triangles {
-                    positions,
-                    indices,
-                    normals,
-                    ..
-                } = object
-                else {
-                    unreachable!("tessellated")
-                };
-                let indices: Vec<u32> = indices.iter().flatten().copied().collect();
                 self.triangles(
                     positions,
                     at,
-                    &indices,
-                    3,
-                    normals,
+                    triangles,
+                    Some(normals),
                     None,
                     p,
                     at,
@@ -351,36 +304,21 @@ impl Builder {
         Ok(p.tuples::<2>("uv", &["point2", "float"])?.map(|(t, _)| t))
     }
 
-    /// Adds a triangle mesh of `indices` (`per` of them a face, for
-    /// messages) over `positions`.
+    /// Adds a triangle mesh of `triangles` (indices in range) over
+    /// `positions`.
     #[allow(clippy::too_many_arguments)]
     fn triangles(
         &mut self,
         positions: Vec<[f64; 3]>,
         pat: At,
-        indices: &[u32],
-        per: usize,
+        mut triangles: Vec<[u32; 3]>,
         normals: Option<Vec<[f64; 3]>>,
         uvs: Option<Vec<[f64; 2]>>,
         p: &Params,
         at: At,
         what: &str,
     ) -> Result<(), Problem> {
-        if !indices.len().is_multiple_of(3) {
-            return Err((
-                at,
-                format!("`indices` hold {} numbers, not 3 a triangle", indices.len()),
-                None,
-            ));
-        }
         let n = positions.len();
-        if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
-            return Err((
-                at,
-                format!("`indices` names point {i}, but there are {n} points `P`"),
-                None,
-            ));
-        }
         for (name, len) in [
             ("N", normals.as_ref().map(Vec::len)),
             ("uv", uvs.as_ref().map(Vec::len)),
@@ -393,17 +331,12 @@ impl Builder {
                 ));
             }
         }
-        let _ = per;
         p.ignore(&["S", "faceIndices"]);
         let material = self.surface(p, at)?;
         p.finish(
             what,
             &["P", "indices", "N", "uv", "S", "faceIndices", "alpha"],
         )?;
-        let mut triangles: Vec<[u32; 3]> = indices
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect();
         // The side that shines: with normals, theirs (turned by
         // ReverseOrientation); otherwise the winding's, so turned.
         let reverse = self.state.reverse;
@@ -448,4 +381,26 @@ impl Builder {
         });
         Ok(())
     }
+}
+
+/// `indices` in threes, each naming one of `n` points.
+fn triples(indices: &[u32], n: usize, at: At) -> Result<Vec<[u32; 3]>, Problem> {
+    if !indices.len().is_multiple_of(3) {
+        return Err((
+            at,
+            format!("`indices` hold {} numbers, not 3 a triangle", indices.len()),
+            None,
+        ));
+    }
+    if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err((
+            at,
+            format!("`indices` names point {i}, but there are {n} points `P`"),
+            None,
+        ));
+    }
+    Ok(indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect())
 }
