@@ -186,16 +186,10 @@ fn close(dir: &str, scene: &str, tolerance: f64) {
     }
 }
 
-/// Mitsuba tabulates a rough coat's transmittance per material with its
-/// separable shadowing; lumen's tables hold the height-correlated one's.
 #[test]
-fn bsdf_spheres_rough_plastic_close() {
-    close("bsdf_spheres", "test_roughplastic_linear_path.xml", 0.025);
-    close(
-        "bsdf_spheres",
-        "test_roughplastic_nonlinear_path.xml",
-        0.015,
-    );
+fn bsdf_spheres_rough_plastic() {
+    check("bsdf_spheres", "test_roughplastic_linear_path.xml");
+    check("bsdf_spheres", "test_roughplastic_nonlinear_path.xml");
 }
 
 #[test]

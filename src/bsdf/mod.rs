@@ -24,6 +24,7 @@
 //! the Lambertian have no density written down and are sampled only.
 
 pub mod albedo;
+pub mod coat;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;

@@ -16,13 +16,15 @@
 //! angle. For a smooth coat T = 1 − F and Ri is the fit of d'Eon & Irving
 //! to the hemispherical Fresnel reflectance, as Mitsuba's; for a rough one
 //! both are tabulated from the rough interface (see [`super::albedo`]),
-//! where Mitsuba tabulates them per material. The coat's specular term uses
-//! the height-correlated Smith shadowing of every lobe here (Mitsuba's is
-//! separable).
+//! or, for a coat of one isotropic roughness, per material as Mitsuba
+//! does (see [`super::coat`]). The coat's specular term uses Mitsuba's
+//! separable Smith shadowing G₁(wo) G₁(wi), which its tables assume, where
+//! the other lobes here use the height-correlated one.
 //!
 //! Nothing is absorbed by the coat, so the lobe reflects at most what
 //! arrives: R(μo) + T(μo) ρ (1 − Ri)/(1 − ρ Ri) ≤ R + T ≤ 1.
 
+use super::coat::CoatTable;
 use super::microfacet::Microfacet;
 use super::{albedo, fresnel};
 use super::{BsdfSample, LobeFlags};
@@ -39,6 +41,9 @@ pub struct Plastic {
     pub eta: f32,
     /// The coat's microfacets; `None` for a smooth coat.
     pub roughness: Option<Microfacet>,
+    /// The rough coat's own table, if made (else the shared tables of
+    /// [`super::albedo`] are looked up).
+    pub coat: Option<&'static CoatTable>,
     /// Return the energy the coat's single scattering loses.
     pub multiscatter: bool,
     /// Whether the light bouncing between base and coat is coloured at
@@ -64,7 +69,10 @@ impl Plastic {
             // Rounding can put the reflectance a hair above 1 at large
             // indices.
             None => (1.0 - fresnel::dielectric(mu, self.eta)).max(0.0),
-            Some(d) => albedo::coat_transmittance(d, self.eta, mu),
+            Some(d) => match self.coat {
+                Some(table) => table.transmittance(mu),
+                None => albedo::coat_transmittance(d, self.eta, mu),
+            },
         }
     }
 
@@ -73,7 +81,10 @@ impl Plastic {
     fn internal_reflectance(&self) -> f32 {
         match &self.roughness {
             None => fresnel::diffuse_reflectance(1.0 / self.eta).clamp(0.0, 1.0),
-            Some(d) => albedo::coat_internal_reflectance(d, self.eta),
+            Some(d) => match self.coat {
+                Some(table) => table.internal_reflectance(),
+                None => albedo::coat_internal_reflectance(d, self.eta),
+            },
         }
     }
 
@@ -146,7 +157,7 @@ impl Plastic {
             let wm = (wo + wi).normalize_or_zero();
             if wm != Vec3::ZERO && wo.dot(wm) > 0.0 {
                 let f = fresnel::dielectric(wo.dot(wm), self.eta);
-                let mut coat = f * d.d(wm) * d.g(wo, wi) / (4.0 * wo.z);
+                let mut coat = f * d.d(wm) * d.g1(wo) * d.g1(wi) / (4.0 * wo.z);
                 if self.multiscatter {
                     coat *= albedo::dielectric_compensation(d, self.eta, wo);
                 }

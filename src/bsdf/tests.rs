@@ -4,6 +4,7 @@
 //!
 //! A lobe is added to the tests by one entry of [`lobes`].
 
+use super::coat::CoatTable;
 use super::conductor::Conductor;
 use super::dielectric::ExactDielectric;
 use super::microfacet::{Microfacet, Model};
@@ -90,18 +91,29 @@ fn lobes_with(multiscatter: bool) -> Vec<Case> {
                 }),
             });
         }
-        for nonlinear in [true, false] {
-            let linear = if nonlinear { "" } else { " linear" };
-            cases.push(Case {
-                name: format!("plastic {what}{ms}{linear}"),
-                lobe: Lobe::Plastic(Plastic {
-                    albedo: Color::new(0.8, 0.4, 0.2),
-                    eta: 1.5,
-                    roughness: Some(d),
-                    multiscatter,
-                    nonlinear,
-                }),
-            });
+        // The coat's own table where the material would make one (one
+        // isotropic roughness), else the shared tables.
+        let tables = if d.alpha_x == d.alpha_y {
+            vec![None, Some(CoatTable::of(&d, 1.5))]
+        } else {
+            vec![None]
+        };
+        for coat in tables {
+            for nonlinear in [true, false] {
+                let linear = if nonlinear { "" } else { " linear" };
+                let own = if coat.is_some() { " own table" } else { "" };
+                cases.push(Case {
+                    name: format!("plastic {what}{ms}{linear}{own}"),
+                    lobe: Lobe::Plastic(Plastic {
+                        albedo: Color::new(0.8, 0.4, 0.2),
+                        eta: 1.5,
+                        roughness: Some(d),
+                        coat,
+                        multiscatter,
+                        nonlinear,
+                    }),
+                });
+            }
         }
     }
     if !multiscatter {
@@ -111,6 +123,7 @@ fn lobes_with(multiscatter: bool) -> Vec<Case> {
                 albedo: Color::new(0.8, 0.4, 0.2),
                 eta: 1.5,
                 roughness: None,
+                coat: None,
                 multiscatter,
                 nonlinear: true,
             }),
@@ -1050,6 +1063,7 @@ fn no_nan_at_the_edges() {
                 albedo: Color::ONE,
                 eta: eta.min(super::albedo::ETA_MAX),
                 roughness: d,
+                coat: None,
                 multiscatter: d.is_some(),
                 nonlinear: true,
             }));

@@ -4,6 +4,7 @@
 use super::param::{self, ColorDesc, ColorParam, ColorRange, Invalid, Textures};
 use super::roughness::Roughness;
 use super::{Kind, Material};
+use crate::bsdf::coat::CoatTable;
 use crate::bsdf::plastic::Plastic as PlasticLobe;
 use crate::geometry::HitRecord;
 use crate::texture::Texture;
@@ -59,10 +60,15 @@ impl PlasticDesc {
             param::Range::Index(MAX_IOR),
         )?;
         let roughness = self.microfacets(field, 0.0, textures)?;
+        let coat = roughness
+            .constant()
+            .filter(|d| d.alpha_x == d.alpha_y)
+            .map(|d| CoatTable::of(&d, ior));
         Ok(Material::new(Kind::Plastic(Box::new(Plastic {
             albedo,
             ior,
             roughness,
+            coat,
             multiscatter: self.multiscatter,
             nonlinear: self.nonlinear.unwrap_or(true),
         }))))
@@ -78,6 +84,9 @@ pub struct Plastic {
     pub ior: f32,
     /// The coat's microfacets.
     pub roughness: Roughness,
+    /// A rough coat's own table, when its roughness is one isotropic
+    /// number.
+    pub coat: Option<&'static CoatTable>,
     /// Return the energy the coat's single scattering loses.
     pub multiscatter: bool,
     /// Colour the light between base and coat at every bounce.
@@ -92,6 +101,7 @@ impl Plastic {
             albedo: self.albedo.albedo_at(hit, textures),
             eta: self.ior,
             roughness: self.roughness.at(hit, textures),
+            coat: self.coat,
             multiscatter: self.multiscatter,
             nonlinear: self.nonlinear,
         }

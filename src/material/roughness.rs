@@ -103,6 +103,17 @@ impl Roughness {
         }
     }
 
+    /// The microfacets, when the roughness is constant and not smooth.
+    pub fn constant(&self) -> Option<Microfacet> {
+        match (self.u, self.v) {
+            (ScalarParam::Const(u), ScalarParam::Const(v)) => {
+                let (au, av) = self.alphas(u.max(0.0), v.max(0.0));
+                (!Microfacet::is_smooth(au, av)).then(|| Microfacet::new(au, av, self.model))
+            }
+            _ => None,
+        }
+    }
+
     fn alphas(&self, u: f32, v: f32) -> (f32, f32) {
         if self.squared {
             (u * u, v * v)
