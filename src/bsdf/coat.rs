@@ -46,8 +46,7 @@ impl CoatTable {
         // Made outside the lock: two threads may both make one, and the
         // first kept is as good as the second.
         let table: &'static CoatTable = Box::leak(Box::new(CoatTable::new(d, eta)));
-        *made
-            .lock()
+        made.lock()
             .unwrap_or_else(|e| e.into_inner())
             .entry(key)
             .or_insert(table)
