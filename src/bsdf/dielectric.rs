@@ -70,7 +70,7 @@ impl SmoothDielectric {
             // The normal (P − C)/R is unit only to within ~1e-4 on small
             // spheres far from the origin; the sphere tests need unit rays.
             _ => (
-                bsdf.reflected_above(reflect(direction, n).normalize()),
+                bsdf.reflected_above(reflect(direction, n).normalize())?,
                 LobeFlags::REFLECTION,
             ),
         };

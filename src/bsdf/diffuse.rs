@@ -78,7 +78,7 @@ impl BookDiffuse {
                 self.albedo / p
             }
         };
-        let wi = bsdf.reflected_above(bounce_direction(self.bounce, bsdf.frame.n, sampler));
+        let wi = bsdf.reflected_above(bounce_direction(self.bounce, bsdf.frame.n, sampler))?;
         let pdf = if self.is_lambertian() {
             self.pdf(bsdf, wi)
         } else {
@@ -118,13 +118,13 @@ impl BookDiffuse {
 /// The density per unit solid angle with which a Lambertian bounce at the
 /// point of `bsdf` leaves along unit `w`: cosine-distributed about the
 /// shading normal, and on a smoothly shaded surface also the directions
-/// that fell below the true surface and were mirrored above it (see
-/// [`Bsdf::reflected_above`]).
+/// that fell below the true surface and were mirrored above it, where
+/// they are (see [`Bsdf::reflected_above`]).
 #[inline]
 pub fn lambertian_pdf(bsdf: &Bsdf, w: Vec3) -> f32 {
     let n = bsdf.frame.n;
     let mut cos = n.dot(w).max(0.0);
-    if bsdf.is_smooth() {
+    if bsdf.mirrors_below() {
         cos += n.dot(reflect(w, bsdf.ng)).max(0.0);
     }
     cos * std::f32::consts::FRAC_1_PI
@@ -257,6 +257,41 @@ mod tests {
                 "{what}: χ² {chi2} with {dof} degrees of freedom"
             );
         }
+    }
+
+    /// On a surface whose bumps shadow (Mitsuba's normal and bump maps),
+    /// what a Lambertian about a tilted normal would send below the true
+    /// surface is lost, not mirrored: for a tilt θ the cosine lobe loses
+    /// (1 − cos θ)/2 of its samples, never returns a direction below, and
+    /// its pdf integrates to the rest.
+    #[test]
+    fn a_surface_whose_bumps_shadow_loses_what_falls_below() {
+        use crate::bsdf::Terminator;
+        let lobe = Lobe::Diffuse(BookDiffuse::lambertian(Color::splat(0.8)));
+        let theta = 0.8f32;
+        let tilted = Vec3::new(theta.sin(), 0.0, theta.cos());
+        let bsdf = on(lobe, Vec3::Z, tilted).with_terminator(Terminator::new(Vec3::Z, tilted));
+        assert!(!bsdf.mirrors_below());
+        let n = 200_000u32;
+        let mut rng = Rng::new(29);
+        let mut lost = 0u32;
+        for _ in 0..n {
+            match bsdf.sample(Vec3::Z, &mut rng) {
+                Some(s) => assert!(s.wi.z > 0.0, "below the surface: {}", s.wi),
+                None => lost += 1,
+            }
+        }
+        let p = f64::from(1.0 - theta.cos()) / 2.0;
+        let sigma = (p * (1.0 - p) / f64::from(n)).sqrt();
+        let measured = f64::from(lost) / f64::from(n);
+        assert!(
+            (measured - p).abs() < 4.0 * sigma,
+            "lost {measured}, expected {p}"
+        );
+        let total: f64 = integrate_cells(|d| f64::from(bsdf.pdf(Vec3::Z, d)))
+            .iter()
+            .sum();
+        assert!((total - (1.0 - p)).abs() < 2e-3, "∫pdf = {total}");
     }
 
     /// The notes' lobes other than the Lambertian report no density: the

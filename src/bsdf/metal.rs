@@ -46,7 +46,7 @@ impl FuzzyMetal {
         };
         Some(BsdfSample {
             value: self.albedo,
-            wi: bsdf.reflected_above(reflected.normalize()),
+            wi: bsdf.reflected_above(reflected.normalize())?,
             pdf: 0.0,
             flags: LobeFlags::REFLECTION | spread,
         })

@@ -313,6 +313,13 @@ impl Terminator {
         self.alpha2 > 0.0
     }
 
+    /// Whether the surface is one whose bumps shadow (tilted or not here):
+    /// light it would reflect below the true surface is lost.
+    #[inline(always)]
+    pub fn is_present(&self) -> bool {
+        self.normal != [0.0; 3]
+    }
+
     /// The terminator of a surface whose shading normal `untilted` a map
     /// tilted to `tilted` (both unit, on the side the ray came from).
     pub fn new(untilted: Vec3, tilted: Vec3) -> Terminator {
@@ -484,15 +491,25 @@ impl Bsdf {
     /// `direction` kept on the side of the surface it was meant for: a
     /// reflection scattered around a smooth shading normal can point below
     /// the true (geometric) surface, where the path would enter the object
-    /// and darken it; it is mirrored back above. Transmitted directions and
-    /// flat surfaces are left alone.
+    /// and darken it; it is mirrored back above. A surface whose bumps
+    /// shadow ([`Terminator`]) loses it instead (`None`), as Mitsuba 3 and
+    /// Cycles do. Transmitted directions and flat surfaces are left alone.
     #[inline(always)]
-    pub fn reflected_above(&self, direction: Vec3) -> Vec3 {
+    pub fn reflected_above(&self, direction: Vec3) -> Option<Vec3> {
         let cos = direction.dot(self.ng);
-        if self.is_smooth() && cos <= 0.0 {
-            (direction - 2.0 * cos * self.ng).normalize()
+        if !(self.is_smooth() && cos <= 0.0) {
+            Some(direction)
+        } else if self.mirrors_below() {
+            Some((direction - 2.0 * cos * self.ng).normalize())
         } else {
-            direction
+            None
         }
+    }
+
+    /// Whether reflections that fall below the true surface are mirrored
+    /// above it (see [`reflected_above`](Self::reflected_above)).
+    #[inline(always)]
+    pub fn mirrors_below(&self) -> bool {
+        self.is_smooth() && !self.terminator.is_present()
     }
 }

@@ -123,8 +123,9 @@ macro_rules! material_desc {
             #[serde(default, skip_serializing_if = "std::ops::Not::not")]
             pub one_sided: bool,
             /// With a normal or bump map: darken the surface by its bumps'
-            /// shadowing and mirror a tilted normal the view is below
-            /// (Mitsuba 3's way), rather than bend it back towards the view
+            /// shadowing, mirror a tilted normal the view is below and lose
+            /// the light it would reflect below the true surface (Mitsuba
+            /// 3's way), rather than bend it back towards the view
             /// (Cycles').
             #[serde(default, skip_serializing_if = "std::ops::Not::not")]
             pub bump_shadowing: bool,
