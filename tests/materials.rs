@@ -110,6 +110,56 @@ material = "gold"
     assert!(paint.shape.is_some(), "the normal map");
 }
 
+/// A roughness may differ along the tangent and the bitangent with either
+/// or both given by a scalar texture, such as a checkerboard of numbers;
+/// a checkerboard of colours is no roughness.
+#[test]
+fn anisotropic_roughness_takes_a_texture_on_either_axis() {
+    use lumen::material::param::ScalarParam;
+    let dir = scratch_dir("materials-anisotropic-textures");
+    let scene = |alpha: &str, odd: &str| {
+        format!(
+            r#"
+[textures.bumps]
+type = "checkerboard"
+even = [0.05, 0.05, 0.05]
+odd = {odd}
+uv_scale = [8, 8]
+
+[materials.m]
+type = "conductor"
+metal = "Al"
+alpha = {alpha}
+
+[[objects]]
+type = "sphere"
+center = [0, 0, -3]
+radius = 1
+material = "m"
+"#
+        )
+    };
+    let s = compile_file(
+        &dir,
+        "mixed.toml",
+        &scene("[0.3, \"bumps\"]", "[0.3, 0.3, 0.3]"),
+    );
+    match &s.materials[0].kind {
+        Kind::Conductor(c) => {
+            assert_eq!(c.roughness.u, ScalarParam::Const(0.3));
+            assert!(matches!(c.roughness.v, ScalarParam::Texture(_)));
+        }
+        other => panic!("{other:?}"),
+    }
+    let message = scene_file_error(&dir, &scene("[\"bumps\", 0.1]", "[0.9, 0.1, 0.1]"));
+    assert!(
+        message.contains("materials.m.alpha[0]") && message.contains("is a colour"),
+        "{message}"
+    );
+    let message = scene_file_error(&dir, &scene("[0.1, 0.2, 0.3]", "[0.3, 0.3, 0.3]"));
+    assert!(message.contains("materials.m.alpha"), "{message}");
+}
+
 /// Each mistake is refused before rendering, naming the field and what
 /// was expected.
 #[test]

@@ -195,3 +195,9 @@ fn bsdf_spheres_identity_normal_map_anisotropic_conductor() {
         "test_normalmap_identity_roughconductor_path.xml",
     );
 }
+
+/// Anisotropic roughness from two scalar checkerboards.
+#[test]
+fn bsdf_spheres_textured_rough_conductor() {
+    check("bsdf_spheres", "test_textured_roughconductor_path.xml");
+}

@@ -62,6 +62,9 @@ pub enum RoughnessDesc {
     Pair([f64; 2]),
     /// The name of a scalar texture.
     Texture(String),
+    /// Along the tangent and the bitangent, either or both a scalar
+    /// texture (`[0.1, "bumps"]`).
+    Each([ScalarDesc; 2]),
 }
 
 impl From<f64> for RoughnessDesc {
@@ -170,16 +173,53 @@ impl<'de> Deserialize<'de> for ScalarDesc {
 
 impl<'de> Deserialize<'de> for RoughnessDesc {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let read = d.deserialize_any(ParamVisitor {
-            expecting: "a number, an array of 2 numbers [u, v] or the name of a texture",
-            number: true,
-            length: 2,
-        })?;
-        Ok(match read {
-            Read::Number(v) => RoughnessDesc::Value(v),
-            Read::Numbers(n) => RoughnessDesc::Pair([n[0], n[1]]),
-            Read::Name(s) => RoughnessDesc::Texture(s),
-        })
+        struct Roughness;
+        impl<'de> Visitor<'de> for Roughness {
+            type Value = RoughnessDesc;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(
+                    "a number, an array of 2 numbers or textures [u, v], or the name of a texture",
+                )
+            }
+
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<RoughnessDesc, E> {
+                Ok(RoughnessDesc::Texture(v.to_string()))
+            }
+
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<RoughnessDesc, E> {
+                Ok(RoughnessDesc::Value(v))
+            }
+
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<RoughnessDesc, E> {
+                Ok(RoughnessDesc::Value(v as f64))
+            }
+
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<RoughnessDesc, E> {
+                Ok(RoughnessDesc::Value(v as f64))
+            }
+
+            fn visit_seq<A: de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<RoughnessDesc, A::Error> {
+                let mut each = Vec::with_capacity(2);
+                while let Some(x) = seq.next_element::<ScalarDesc>()? {
+                    each.push(x);
+                    if each.len() > 2 {
+                        return Err(de::Error::invalid_length(each.len(), &self));
+                    }
+                }
+                match <[ScalarDesc; 2]>::try_from(each) {
+                    Ok([ScalarDesc::Value(u), ScalarDesc::Value(v)]) => {
+                        Ok(RoughnessDesc::Pair([u, v]))
+                    }
+                    Ok(pair) => Ok(RoughnessDesc::Each(pair)),
+                    Err(each) => Err(de::Error::invalid_length(each.len(), &self)),
+                }
+            }
+        }
+        d.deserialize_any(Roughness)
     }
 }
 

@@ -83,6 +83,10 @@ impl Roughness {
                 let p = textures.scalar(&at, &ScalarDesc::Texture(t.clone()), range)?;
                 (p, p)
             }
+            RoughnessDesc::Each([x, y]) => (
+                textures.scalar(&format!("{at}[0]"), x, range)?,
+                textures.scalar(&format!("{at}[1]"), y, range)?,
+            ),
         };
         Ok(Roughness {
             u,

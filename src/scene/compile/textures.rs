@@ -352,7 +352,16 @@ impl TextureTable<'_> {
                     t = *texture;
                     continue;
                 }
-                Texture::Checker { .. } | Texture::UvChecker { .. } => TextureKind::Color,
+                // A checker of greys is grey: its squares decide (the
+                // chain is at most MAX_TEXTURE_DEPTH long).
+                Texture::Checker { even, odd, .. } | Texture::UvChecker { even, odd, .. } => {
+                    match (self.kind(*even), self.kind(*odd)) {
+                        (TextureKind::Color, _) | (_, TextureKind::Color) => TextureKind::Color,
+                        (TextureKind::Scalar, _) | (_, TextureKind::Scalar) => TextureKind::Scalar,
+                        _ => TextureKind::Either,
+                    }
+                }
+                Texture::Solid(c) if !(c.x == c.y && c.y == c.z) => TextureKind::Color,
                 Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
             };
         }

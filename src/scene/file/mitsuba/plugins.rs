@@ -1469,10 +1469,7 @@ impl<'d> Convert<'d> {
             (None, Some(ScalarDesc::Value(u)), Some(ScalarDesc::Value(v))) => {
                 RoughnessDesc::Pair([u, v])
             }
-            (None, Some(_), Some(_)) => {
-                self.lacks(e, "textured anisotropic roughness", "α 0.1")?;
-                RoughnessDesc::Value(0.1)
-            }
+            (None, Some(u), Some(v)) => RoughnessDesc::Each([u, v]),
             (None, None, None) => RoughnessDesc::Value(0.1),
             _ => return Err(self.fail(e, "give both `alpha_u` and `alpha_v`".into())),
         };
@@ -1480,6 +1477,10 @@ impl<'d> Convert<'d> {
         let roughness = match roughness {
             RoughnessDesc::Value(a) => RoughnessDesc::Value(a.max(1e-4)),
             RoughnessDesc::Pair([u, v]) => RoughnessDesc::Pair([u.max(1e-4), v.max(1e-4)]),
+            RoughnessDesc::Each(each) => RoughnessDesc::Each(each.map(|a| match a {
+                ScalarDesc::Value(a) => ScalarDesc::Value(a.max(1e-4)),
+                t => t,
+            })),
             t => t,
         };
         Ok((roughness, distribution))
@@ -1604,18 +1605,28 @@ impl<'d> Convert<'d> {
         key: (*const Element, bool),
     ) -> Result<String, Failure> {
         let p = Props::of(e, self)?;
+        // For a number (a roughness, a weight) its squares are numbers
+        // too: a grey checkerboard, read from any of its channels.
+        let mut square = |cx: &mut Self, n: &str, default: f64| -> Result<ColorDesc, Failure> {
+            Ok(if scalar {
+                match cx.scalar(&p, n)? {
+                    None => ColorDesc::Rgb([default; 3]),
+                    Some(ScalarDesc::Value(v)) => ColorDesc::Rgb([v; 3]),
+                    Some(ScalarDesc::Texture(t)) => ColorDesc::Texture(t),
+                }
+            } else {
+                cx.colour(&p, n, Use::Reflectance)?
+                    .unwrap_or(ColorDesc::Rgb([default; 3]))
+            })
+        };
+        let mut color0 = square(self, "color0", 0.4)?;
+        let mut color1 = square(self, "color1", 0.2)?;
         if scalar {
-            return Err(self.fail(
-                e,
-                "a checkerboard is read as a colour only (not as a roughness or a weight)".into(),
-            ));
+            // Mitsuba 3 (3.9) looks a checkerboard up as a number with its
+            // squares the other way round from the colour lookup: its
+            // `eval_1` gives color0 where `eval` gives color1.
+            std::mem::swap(&mut color0, &mut color1);
         }
-        let color0 = self
-            .colour(&p, "color0", Use::Reflectance)?
-            .unwrap_or(ColorDesc::Rgb([0.4; 3]));
-        let color1 = self
-            .colour(&p, "color1", Use::Reflectance)?
-            .unwrap_or(ColorDesc::Rgb([0.2; 3]));
         let [a, b, c, d] = match p.transform("to_uv", self)? {
             None => [1.0, 1.0, 0.0, 0.0],
             Some(m) => {
