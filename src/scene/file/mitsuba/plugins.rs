@@ -1607,7 +1607,7 @@ impl<'d> Convert<'d> {
         let p = Props::of(e, self)?;
         // For a number (a roughness, a weight) its squares are numbers
         // too: a grey checkerboard, read from any of its channels.
-        let mut square = |cx: &mut Self, n: &str, default: f64| -> Result<ColorDesc, Failure> {
+        let square = |cx: &mut Self, n: &str, default: f64| -> Result<ColorDesc, Failure> {
             Ok(if scalar {
                 match cx.scalar(&p, n)? {
                     None => ColorDesc::Rgb([default; 3]),
