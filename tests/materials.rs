@@ -608,3 +608,77 @@ fn glass_of_index_one_lets_light_straight_through() {
         assert!((mean - 1.0).abs() < 0.02, "{material}: {mean}");
     }
 }
+
+/// A thin dielectric sheet absorbs nothing: under a white sky a ball of
+/// it is invisible, every sample carrying exactly the sky. In front of a
+/// light seen straight on it lets through 1 − 2R/(1 + R) (R = 0.04 for
+/// one face of index 1.5), its inner bounces counted: not the 0.96 of one
+/// face.
+#[test]
+fn a_thin_sheet_mirrors_or_lets_through_and_keeps_all_the_light() {
+    let dir = scratch_dir("materials-thin-sheet");
+    let sheet = "type = \"dielectric\"\nior = 1.5\nthin = true";
+    let furnace = compile_file(
+        &dir,
+        "furnace.toml",
+        &ball_under_white_sky(sheet, 16, 32, 12.0),
+    );
+    for p in common::pixel_stats(&furnace).mean {
+        assert!(p.iter().all(|c| (c - 1.0).abs() < 1e-5), "{p:?}");
+    }
+
+    let spp = 64u32;
+    let window = compile_file(
+        &dir,
+        "window.toml",
+        &format!(
+            r#"[render]
+width = 16
+height = 16
+samples_per_pixel = {spp}
+max_depth = 8
+
+[camera]
+vfov = 1
+lookfrom = [0, 0, 0]
+lookat = [0, 0, -1]
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.pane]
+{sheet}
+
+[materials.panel]
+type = "emissive"
+radiance = [1, 1, 1]
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, -2]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "pane"
+
+[[objects]]
+type = "quad"
+corner = [-1, -1, -3]
+u = [2, 0, 0]
+v = [0, 2, 0]
+material = "panel"
+"#
+        ),
+    );
+    let stats = common::pixel_stats(&window);
+    let n = stats.mean.len() as f64;
+    let mean = stats.mean.iter().map(|p| p[1]).sum::<f64>() / n;
+    let r = 0.04f64;
+    let expected = 1.0 - 2.0 * r / (1.0 + r);
+    // Each sample is 1 (through) or 0 (mirrored into the black behind).
+    let sigma = (expected * (1.0 - expected) / (n * f64::from(spp))).sqrt();
+    assert!(
+        (mean - expected).abs() < 4.0 * sigma,
+        "through the pane {mean}, expected {expected} ± {sigma}"
+    );
+}

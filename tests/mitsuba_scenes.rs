@@ -229,9 +229,7 @@ fn includes_that_loop_or_leave_the_folder_and_unused_parameters_are_refused() {
 #[test]
 fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     let dir = scratch_dir("mitsuba_scenes_approximate");
-    let text = scene(
-        "  <shape type=\"disk\"/>\n  <shape type=\"sphere\"><bsdf type=\"thindielectric\"/></shape>",
-    );
+    let text = scene("  <shape type=\"disk\"/>\n  <shape type=\"serialized\"/>");
     let path = dir.join("s.xml");
     std::fs::write(&path, &text).unwrap();
     let options = mitsuba::Options {
@@ -247,7 +245,7 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("a thin dielectric")));
+        .any(|w| w.contains("s.xml:3:3: a serialized shape")));
     file.compile(&Overrides::default()).unwrap();
 }
 
@@ -331,4 +329,30 @@ fn a_sensor_whose_transform_mirrors_mirrors_the_image() {
     assert!(!plain.mirror && mirrored.mirror);
     assert_eq!(plain.lookfrom, [0.0, 0.0, 5.0]);
     assert_eq!(mirrored.lookfrom, [0.0, 0.0, 5.0]);
+}
+
+/// `thindielectric` is lumen's thin sheet of index int_ior / ext_ior.
+#[test]
+fn a_thin_dielectric_is_a_thin_sheet() {
+    use lumen::scene::desc::{MaterialDesc, ObjectDesc};
+    let dir = scratch_dir("mitsuba_scenes_thin");
+    let path = dir.join("s.xml");
+    std::fs::write(
+        &path,
+        scene(
+            "  <shape type=\"sphere\"><bsdf type=\"thindielectric\">\
+             <string name=\"int_ior\" value=\"water\"/></bsdf></shape>",
+        ),
+    )
+    .unwrap();
+    let file =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let ObjectDesc::Sphere { material, .. } = &file.desc.objects[0] else {
+        panic!("{:?}", file.desc.objects[0]);
+    };
+    let MaterialDesc::Dielectric(d) = &file.desc.materials[material] else {
+        panic!("{:?}", file.desc.materials[material]);
+    };
+    assert!(d.thin && (d.ior - 1.333 / 1.000277).abs() < 1e-3, "{d:?}");
+    file.compile(&Overrides::default()).unwrap();
 }

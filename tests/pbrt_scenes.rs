@@ -349,13 +349,13 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     };
     let file = read_in(
         &dir,
-        "WorldBegin\nShape \"disk\"\nMaterial \"thindielectric\"\nShape \"sphere\"\n",
+        "WorldBegin\nShape \"disk\"\nMaterial \"hair\"\nShape \"sphere\"\n",
         &options,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(file.import_warnings.len(), 2, "{:?}", file.import_warnings);
     assert!(file.import_warnings[0].contains("s.pbrt:2:7: `disk` shape"));
-    assert!(file.import_warnings[1].contains("thin dielectric"));
+    assert!(file.import_warnings[1].contains("`hair` material"));
     file.compile(&Overrides::default()).unwrap();
 }
 
@@ -528,4 +528,46 @@ fn a_scaled_texture_scales_what_it_shows() {
             "{a:?} vs {b:?}"
         );
     }
+}
+
+/// A thin dielectric is lumen's thin sheet of its index (pbrt's takes no
+/// roughness); anisotropic roughness may come from a texture on either
+/// axis.
+#[test]
+fn thin_dielectrics_and_textured_anisotropic_roughness() {
+    use lumen::scene::desc::RoughnessDesc;
+    let d = read(
+        "thin",
+        "WorldBegin\n\
+         Material \"thindielectric\" \"float eta\" 1.33\nShape \"sphere\"\n\
+         Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"t.png\"\n\
+         Material \"conductor\" \"float uroughness\" 0.04 \"texture vroughness\" \"t\" \
+         \"bool remaproughness\" false\nShape \"sphere\"\n",
+    );
+    let material = |i: usize| match &d.objects[i] {
+        ObjectDesc::Sphere { material, .. } => &d.materials[material],
+        other => panic!("{other:?}"),
+    };
+    let MaterialDesc::Dielectric(sheet) = material(0) else {
+        panic!("{:?}", material(0));
+    };
+    assert!(sheet.thin && sheet.ior == 1.33 && sheet.alpha.is_none());
+    let MaterialDesc::Conductor(metal) = material(1) else {
+        panic!("{:?}", material(1));
+    };
+    assert!(
+        matches!(&metal.alpha, Some(RoughnessDesc::Each([u, v]))
+            if *u == lumen::material::param::ScalarDesc::Value(0.04)
+                && matches!(v, lumen::material::param::ScalarDesc::Texture(_))),
+        "{:?}",
+        metal.alpha
+    );
+    let dir = scratch_dir("pbrt_scenes_thin_refused");
+    let e = read_in(
+        &dir,
+        "WorldBegin\nMaterial \"thindielectric\" \"float roughness\" 0.1\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("s.pbrt:2:") && e.contains("roughness"), "{e}");
 }

@@ -36,6 +36,7 @@ pub mod principled;
 pub mod sheen;
 #[cfg(test)]
 mod tests;
+pub mod thin_dielectric;
 
 use crate::math::{Color, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -209,6 +210,8 @@ pub enum Lobe {
     Conductor(conductor::Conductor),
     /// Glass by the exact Fresnel equations, smooth or rough.
     ExactDielectric(dielectric::ExactDielectric),
+    /// A thin sheet of glass: mirror or straight through.
+    ThinDielectric(thin_dielectric::ThinDielectric),
     /// A diffuse base under a clear coat.
     Plastic(plastic::Plastic),
     /// The glTF metallic-roughness material and its layers.
@@ -237,6 +240,7 @@ impl Lobe {
             }
             Lobe::Conductor(c) => c.flags(),
             Lobe::ExactDielectric(d) => d.flags(),
+            Lobe::ThinDielectric(d) => d.flags(),
             Lobe::Plastic(p) => p.flags(),
             Lobe::Principled(p) => p.flags(),
         }
@@ -249,6 +253,7 @@ impl Lobe {
         match self {
             Lobe::Conductor(c) => c.sample(wo, u),
             Lobe::ExactDielectric(d) => d.sample(wo, uc, u),
+            Lobe::ThinDielectric(d) => d.sample(wo, uc),
             Lobe::Plastic(p) => p.sample(wo, uc, u),
             Lobe::Principled(p) => p.sample(wo, uc, u),
             Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => None,
@@ -264,7 +269,9 @@ impl Lobe {
             Lobe::ExactDielectric(d) => d.eval_and_pdf(wo, wi),
             Lobe::Plastic(p) => p.eval_and_pdf(wo, wi),
             Lobe::Principled(p) => p.eval_and_pdf(wo, wi),
-            Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) => (Color::ZERO, 0.0),
+            Lobe::Diffuse(_) | Lobe::Metal(_) | Lobe::Dielectric(_) | Lobe::ThinDielectric(_) => {
+                (Color::ZERO, 0.0)
+            }
         }
     }
 }

@@ -1059,6 +1059,11 @@ fn no_nan_at_the_edges() {
                 roughness: d,
                 multiscatter: d.is_some(),
             }));
+            if d.is_none() {
+                lobes.push(Lobe::ThinDielectric(
+                    super::thin_dielectric::ThinDielectric { eta },
+                ));
+            }
             lobes.push(Lobe::Plastic(Plastic {
                 albedo: Color::ONE,
                 eta: eta.min(super::albedo::ETA_MAX),

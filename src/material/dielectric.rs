@@ -4,6 +4,7 @@ use super::param::{Invalid, RoughnessDesc, Textures};
 use super::roughness::Roughness;
 use super::{Kind, Material};
 use crate::bsdf::dielectric::{ExactDielectric, SmoothDielectric};
+use crate::bsdf::thin_dielectric::ThinDielectric;
 use crate::bsdf::Lobe;
 use crate::geometry::HitRecord;
 use crate::texture::Texture;
@@ -22,6 +23,11 @@ material_desc! {
         /// "exact" (the Fresnel equations, as a rough surface always does).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub fresnel: Option<FresnelDesc>,
+        /// A thin sheet (a window pane, a bubble) rather than the surface
+        /// of a solid: light is mirrored or goes straight through, its
+        /// bounces inside the sheet counted; smooth only.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        pub thin: bool,
     }
 }
 
@@ -77,6 +83,26 @@ impl DielectricDesc {
                 "is the notes' smooth glass: a rough dielectric reflects by the Fresnel equations",
             ));
         }
+        if self.thin {
+            let refused = if rough {
+                Some(("roughness", "a thin sheet is smooth"))
+            } else if self.refract_only {
+                Some((
+                    "refract_only",
+                    "a thin sheet reflects by the Fresnel equations",
+                ))
+            } else if self.fresnel == Some(FresnelDesc::Schlick) {
+                Some((
+                    "fresnel",
+                    "a thin sheet reflects by the Fresnel equations (\"exact\")",
+                ))
+            } else {
+                None
+            };
+            if let Some((name, why)) = refused {
+                return Err(Invalid::new(format!("{field}.{name}"), why));
+            }
+        }
         let exact = match self.fresnel {
             Some(FresnelDesc::Schlick) if rough => return Err(Invalid::new(
                 format!("{field}.fresnel"),
@@ -93,8 +119,9 @@ impl DielectricDesc {
             ior: ior as f32,
             refract_only: self.refract_only,
             roughness: rough.then_some(roughness),
-            exact,
+            exact: exact || self.thin,
             multiscatter: self.multiscatter,
+            thin: self.thin,
         })))
     }
 }
@@ -116,6 +143,8 @@ pub struct Dielectric {
     pub exact: bool,
     /// Return the energy single scattering loses.
     pub multiscatter: bool,
+    /// A thin sheet: mirrored or straight through.
+    pub thin: bool,
 }
 
 impl Dielectric {
@@ -123,6 +152,7 @@ impl Dielectric {
     #[inline(always)]
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> Lobe {
         match &self.roughness {
+            None if self.thin => Lobe::ThinDielectric(ThinDielectric { eta: self.ior }),
             None if self.exact => Lobe::ExactDielectric(ExactDielectric {
                 eta: crate::bsdf::fresnel::rough_eta(self.ior, hit.front_face),
                 roughness: None,

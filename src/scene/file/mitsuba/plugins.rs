@@ -1089,9 +1089,7 @@ impl<'d> Convert<'d> {
                     "specular_transmittance",
                 ];
                 let mut d = DielectricDesc::new(ior);
-                if t == "thindielectric" {
-                    self.lacks(e, "a thin dielectric", "a solid dielectric")?;
-                }
+                d.thin = t == "thindielectric";
                 if t == "roughdielectric" {
                     known.extend(MICROFACET_PARAMS);
                     let (alpha, distribution) = self.microfacets(e, &p)?;

@@ -83,7 +83,14 @@ impl Builder {
                 d.distribution = distribution;
                 MaterialDesc::Conductor(d)
             }
-            "dielectric" | "thindielectric" => {
+            "thindielectric" => {
+                known.push("eta");
+                let mut d = DielectricDesc::new(self.eta(p, "eta", at)?);
+                d.thin = true;
+                d.fresnel = Some(FresnelDesc::Exact);
+                MaterialDesc::Dielectric(d)
+            }
+            "dielectric" => {
                 known.extend([
                     "eta",
                     "roughness",
@@ -91,9 +98,6 @@ impl Builder {
                     "vroughness",
                     "remaproughness",
                 ]);
-                if ty == "thindielectric" {
-                    self.lacks(at, "thin dielectric", "a solid dielectric")?;
-                }
                 let eta = self.eta(p, "eta", at)?;
                 let mut d = DielectricDesc::new(eta);
                 let (rough, distribution) = self.roughness(p, "", at)?;
@@ -455,7 +459,7 @@ impl Builder {
                     RoughnessDesc::Pair([au, av])
                 }
             }
-            (Err(t), Err(t2)) if t == t2 => {
+            (u, v) => {
                 if remap {
                     self.lacks(
                         at,
@@ -463,11 +467,18 @@ impl Builder {
                         "the texture read as α",
                     )?;
                 }
-                RoughnessDesc::Texture(self.scalar_texture(&t, at)?)
-            }
-            _ => {
-                self.lacks(at, "anisotropic textured roughness", "α 0.1")?;
-                RoughnessDesc::Value(0.1)
+                let mut each = |x: Result<f64, String>| -> Result<ScalarDesc, Problem> {
+                    Ok(match x {
+                        Ok(x) => ScalarDesc::Value(alpha(x, remap)),
+                        Err(t) => ScalarDesc::Texture(self.scalar_texture(&t, at)?),
+                    })
+                };
+                match (each(u)?, each(v)?) {
+                    (ScalarDesc::Texture(t), ScalarDesc::Texture(t2)) if t == t2 => {
+                        RoughnessDesc::Texture(t)
+                    }
+                    (u, v) => RoughnessDesc::Each([u, v]),
+                }
             }
         };
         Ok((Some(rough), Some(DistributionDesc::Ggx)))
