@@ -35,6 +35,12 @@ pub struct CameraSettings {
     pub shutter: [f32; 2],
     /// Mirror the image left to right (a left-handed camera).
     pub mirror: bool,
+    /// Rays start this far in front of the lens along the view direction
+    /// (nothing nearer is seen); 0: at the lens.
+    pub near_clip: f32,
+    /// The image is the window `[x, y, …]` of a full image of
+    /// `[…, width, height]` pixels; `None`: the whole image.
+    pub crop: Option<[u32; 4]>,
 }
 
 impl Default for CameraSettings {
@@ -48,6 +54,8 @@ impl Default for CameraSettings {
             focus_dist: 1.0,
             shutter: [0.0, 0.0],
             mirror: false,
+            near_clip: 0.0,
+            crop: None,
         }
     }
 }
@@ -102,6 +110,13 @@ pub enum CameraError {
     /// The shutter interval is not within [0, 1] or closes before it opens.
     #[error("shutter must be [open, close] with 0 <= open <= close <= 1, got [{0}, {1}]")]
     Shutter(f32, f32),
+    #[error("a {1}x{2} window at ({x}, {y}) does not fit a {w}x{h} image", x = .0[0], y = .0[1], w = .0[2], h = .0[3])]
+    /// A crop window `[x, y, full width, full height]` that the image of
+    /// the given width and height does not fit.
+    Crop([u32; 4], u32, u32),
+    #[error("near_clip must be finite and not negative, got {0}")]
+    /// A negative or non-finite near clipping distance.
+    NearClip(f32),
 }
 
 /// A camera ready to generate rays for an image of a given size.
@@ -120,6 +135,8 @@ pub struct Camera {
     pub basis: [Vec3; 3],
     /// Where about its pixel a camera ray goes.
     filter: crate::filter::PixelFilter,
+    /// How far in front of the lens rays start.
+    near_clip: f32,
 }
 
 impl Camera {
@@ -168,6 +185,9 @@ impl Camera {
         if width == 0 || height == 0 {
             return Err(CameraError::EmptyImage(width, height));
         }
+        if !(s.near_clip >= 0.0 && s.near_clip.is_finite()) {
+            return Err(CameraError::NearClip(s.near_clip));
+        }
         if !view.length_squared().is_finite() {
             return Err(CameraError::Overflow);
         }
@@ -182,15 +202,27 @@ impl Camera {
         // Mirrored, the image's x runs the other way; up stays up.
         let u = if s.mirror { -u } else { u };
 
+        // A cropped image is a window of the full one, framed as it.
+        let [x0, y0, full_width, full_height] = match s.crop {
+            None => [0, 0, width, height],
+            Some([x, y, fw, fh])
+                if x.checked_add(width).is_some_and(|e| e <= fw)
+                    && y.checked_add(height).is_some_and(|e| e <= fh) =>
+            {
+                [x, y, fw, fh]
+            }
+            Some(crop) => return Err(CameraError::Crop(crop, width, height)),
+        };
         let h = (s.vfov.to_radians() / 2.0).tan();
         let viewport_height = 2.0 * h * s.focus_dist;
-        let viewport_width = viewport_height * (width as f32 / height as f32);
+        let viewport_width = viewport_height * (full_width as f32 / full_height as f32);
         let viewport_u = viewport_width * u;
         let viewport_v = -viewport_height * v; // image rows go down
-        let pixel_du = viewport_u / width as f32;
-        let pixel_dv = viewport_v / height as f32;
+        let pixel_du = viewport_u / full_width as f32;
+        let pixel_dv = viewport_v / full_height as f32;
         let upper_left = s.lookfrom - s.focus_dist * w - viewport_u / 2.0 - viewport_v / 2.0;
-        let pixel00 = upper_left + 0.5 * (pixel_du + pixel_dv);
+        let pixel00 =
+            upper_left + 0.5 * (pixel_du + pixel_dv) + x0 as f32 * pixel_du + y0 as f32 * pixel_dv;
         let defocus_radius = s.focus_dist * (s.defocus_angle.to_radians() / 2.0).tan();
         let derived = [u, v, w, pixel_du, pixel_dv, pixel00];
         if !(derived.iter().all(|d| d.is_finite()) && defocus_radius.is_finite()) {
@@ -249,6 +281,7 @@ impl Camera {
             shutter_span: close - open,
             basis: [u, v, w],
             filter: crate::filter::PixelFilter::Box,
+            near_clip: s.near_clip,
         })
     }
 
@@ -283,7 +316,14 @@ impl Camera {
         } else {
             self.shutter_open
         };
-        Ray::timed(origin, (target - origin).normalize(), time)
+        let direction = (target - origin).normalize();
+        let origin = if self.near_clip > 0.0 {
+            // On the near plane: its distance over the cosine to the view.
+            origin + direction * (self.near_clip / -direction.dot(self.basis[2]))
+        } else {
+            origin
+        };
+        Ray::timed(origin, direction, time)
     }
 }
 
@@ -302,6 +342,8 @@ mod tests {
             focus_dist: 1.0,
             shutter: [0.0, 0.0],
             mirror: false,
+            near_clip: 0.0,
+            crop: None,
         }
     }
 
@@ -464,6 +506,59 @@ mod tests {
             assert!(r.origin().length() <= radius * 1.0001);
             let p = r.at(3.0 / -r.direction.z);
             assert!((p - focus_point).length() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn a_crop_window_sees_what_the_full_image_sees_there() {
+        let full = Camera::new(&settings(), 64, 48).unwrap();
+        let crop = Camera::new(
+            &CameraSettings {
+                crop: Some([40, 10, 64, 48]),
+                ..settings()
+            },
+            16,
+            20,
+        )
+        .unwrap();
+        for (x, y) in [(0, 0), (15, 0), (0, 19), (7, 11)] {
+            let (a, b) = (crop.central_ray(x, y), full.central_ray(40 + x, 10 + y));
+            assert!((a.direction - b.direction).length() < 1e-6, "({x}, {y})");
+        }
+        for bad in [[50, 10, 64, 48], [40, 30, 64, 48], [u32::MAX, 0, 64, 48]] {
+            let s = CameraSettings {
+                crop: Some(bad),
+                ..settings()
+            };
+            assert_eq!(
+                Camera::new(&s, 16, 20).unwrap_err(),
+                CameraError::Crop(bad, 16, 20)
+            );
+        }
+    }
+
+    #[test]
+    fn rays_start_on_the_near_plane() {
+        let s = CameraSettings {
+            near_clip: 0.5,
+            ..settings()
+        };
+        let camera = Camera::new(&s, 32, 32).unwrap();
+        let mut rng = Rng::new(5);
+        for (x, y) in [(0, 0), (31, 31), (16, 3)] {
+            let ray = camera.ray(x, y, 0.5, 0.5, &mut rng);
+            let depth = (ray.origin() - s.lookfrom).dot((s.lookat - s.lookfrom).normalize());
+            assert!((depth - 0.5).abs() < 1e-6, "({x}, {y}): {depth}");
+        }
+        for bad in [-1.0, f32::NAN] {
+            let s = CameraSettings {
+                near_clip: bad,
+                ..settings()
+            };
+            assert!(matches!(
+                Camera::new(&s, 4, 4),
+                Err(CameraError::NearClip(_))
+            ));
         }
     }
 }

@@ -356,3 +356,59 @@ fn a_thin_dielectric_is_a_thin_sheet() {
     assert!(d.thin && (d.ior - 1.333 / 1.000277).abs() < 1e-3, "{d:?}");
     file.compile(&Overrides::default()).unwrap();
 }
+
+/// A film's crop window renders that window of the image; the sensor's
+/// near clipping plane (10⁻² by default) is where camera rays start.
+#[test]
+fn crop_windows_and_near_clipping_planes_are_read() {
+    let dir = scratch_dir("mitsuba_scenes_crop");
+    let path = dir.join("s.xml");
+    let sensor = |film: &str, clip: &str| {
+        scene(&format!(
+            "  <sensor type=\"perspective\">{clip}<film type=\"hdrfilm\">\
+             <integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"48\"/>\
+             {film}</film></sensor>\n  <shape type=\"sphere\"/>"
+        ))
+    };
+    std::fs::write(
+        &path,
+        sensor(
+            "<integer name=\"crop_offset_x\" value=\"8\"/><integer name=\"crop_width\" value=\"16\"/>",
+            "<float name=\"near_clip\" value=\"0.5\"/>",
+        ),
+    )
+    .unwrap();
+    let file =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(file.desc.render.crop, Some([8, 0, 16, 48]));
+    assert_eq!(file.desc.camera.near_clip, 0.5);
+    let compiled = file.compile(&Overrides::default()).unwrap();
+    assert_eq!(
+        (compiled.settings.width, compiled.settings.height),
+        (16, 48)
+    );
+
+    std::fs::write(&path, sensor("", "")).unwrap();
+    let file = SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap();
+    assert_eq!(
+        (file.desc.render.crop, file.desc.camera.near_clip),
+        (None, 1e-2)
+    );
+
+    // A window that leaves the image: Mitsuba's default width is the
+    // image's, so an offset alone does not fit.
+    std::fs::write(
+        &path,
+        sensor("<integer name=\"crop_offset_y\" value=\"4\"/>", ""),
+    )
+    .unwrap();
+    let e = SceneFile::read_with(&path, &mitsuba::Options::default())
+        .unwrap()
+        .compile(&Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("render.crop") && e.contains("[0, 4, 64, 48]"),
+        "{e}"
+    );
+}

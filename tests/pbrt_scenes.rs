@@ -571,3 +571,27 @@ fn thin_dielectrics_and_textured_anisotropic_roughness() {
     .unwrap_err();
     assert!(e.contains("s.pbrt:2:") && e.contains("roughness"), "{e}");
 }
+
+/// `cropwindow` (fractions, rounded up to pixels as pbrt does) and
+/// `pixelbounds` render a window of the image.
+#[test]
+fn crop_windows_render_a_part_of_the_image() {
+    let film = |window: &str| {
+        format!(
+            "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 50 {window}\n\
+             WorldBegin\nShape \"sphere\"\n"
+        )
+    };
+    let d = read("crop", &film("\"float cropwindow\" [0.255 0.5 0 1]"));
+    assert_eq!(d.render.crop, Some([26, 0, 24, 50]));
+    let d = read("bounds", &film("\"integer pixelbounds\" [10 20 5 45]"));
+    assert_eq!(d.render.crop, Some([10, 5, 10, 40]));
+    let dir = scratch_dir("pbrt_scenes_crop_bad");
+    let e = read_in(
+        &dir,
+        &film("\"integer pixelbounds\" [10 120 5 45]"),
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("s.pbrt:1:") && e.contains("100x50"), "{e}");
+}

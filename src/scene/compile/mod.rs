@@ -315,6 +315,13 @@ fn compile_camera(
     finite("camera.vup", &cam.vup)?;
     finite("camera.defocus_angle", &[cam.defocus_angle])?;
     finite("camera.shutter", &cam.shutter)?;
+    finite("camera.near_clip", &[cam.near_clip])?;
+    if !(cam.near_clip >= 0.0) {
+        return Err(invalid(
+            "camera.near_clip",
+            format!("must not be negative, got {}", cam.near_clip),
+        ));
+    }
     let focus_dist = match cam.focus_dist {
         Some(d) => {
             finite("camera.focus_dist", &[d])?;
@@ -343,6 +350,10 @@ fn compile_camera(
                 [cam.shutter[0] as f32; 2]
             },
             mirror: cam.mirror,
+            near_clip: cam.near_clip as f32,
+            crop: settings
+                .crop
+                .map(|c| [c.x, c.y, c.full_width, c.full_height]),
         },
         settings.width,
         settings.height,
@@ -1338,9 +1349,35 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
             ))
         }
     };
+    let (width, height, crop) = match r.crop {
+        None => (r.width, height, None),
+        Some([x, y, w, h]) => {
+            let inside = w > 0
+                && h > 0
+                && x.checked_add(w).is_some_and(|e| e <= r.width)
+                && y.checked_add(h).is_some_and(|e| e <= height);
+            if !inside {
+                return Err(invalid(
+                    "render.crop",
+                    format!(
+                        "[x, y, width, height] must be a window of at least one pixel within                          the {}x{height} image, got [{x}, {y}, {w}, {h}]",
+                        r.width
+                    ),
+                ));
+            }
+            let full = crate::scene::Crop {
+                x,
+                y,
+                full_width: r.width,
+                full_height: height,
+            };
+            (w, h, Some(full))
+        }
+    };
     Ok(Settings {
-        width: r.width,
+        width,
         height,
+        crop,
         noise_target,
         samples_per_pixel: r.samples_per_pixel,
         max_depth: r.max_depth,

@@ -129,6 +129,11 @@ pub struct RenderDesc {
     pub height: Option<u32>,
     /// Width over height, used when `height` is absent.
     pub aspect_ratio: f64,
+    /// Render only the window `[x, y, width, height]` of the image (in
+    /// pixels from its top left corner): the output is that window, as the
+    /// full image would show it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crop: Option<[u32; 4]>,
     /// Camera samples per pixel.
     pub samples_per_pixel: u32,
     /// Maximum number of ray segments per path; 1 shows no bounce light.
@@ -212,6 +217,7 @@ impl Default for RenderDesc {
             width: 400,
             height: None,
             aspect_ratio: 16.0 / 9.0,
+            crop: None,
             samples_per_pixel: 100,
             max_depth: 50,
             seed: 0,
@@ -314,6 +320,10 @@ pub struct CameraDesc {
     /// `LookAt`, a Mitsuba sensor whose transform mirrors) sees it.
     #[serde(default, skip_serializing_if = "is_false")]
     pub mirror: bool,
+    /// Nothing nearer than this along the view direction is seen: camera
+    /// rays start on the plane this far in front of the lens.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub near_clip: f64,
 }
 
 /// Which camera of the scene's glTF models.
@@ -349,6 +359,7 @@ impl Default for CameraDesc {
             shutter: FULL_SHUTTER,
             gltf: None,
             mirror: false,
+            near_clip: 0.0,
         }
     }
 }

@@ -244,9 +244,15 @@ fn list<T>(node: &Node, path: &str, item: impl Fn(&Node, &str) -> Result<T>) -> 
 
 /// A triangle's three vertex indices.
 fn index_triple(node: &Node, path: &str) -> Result<[u32; 3]> {
+    counts(node, path, "an array of 3 vertex indices [a, b, c]")
+}
+
+/// An array of exactly `N` whole numbers from 0; `expected` says which in
+/// messages.
+fn counts<const N: usize>(node: &Node, path: &str, expected: &str) -> Result<[u32; N]> {
     match &node.value {
-        Value::Array(items) if items.len() == 3 => {
-            let mut t = [0; 3];
+        Value::Array(items) if items.len() == N => {
+            let mut t = [0; N];
             for (i, item) in items.iter().enumerate() {
                 t[i] = u32_field(item, &format!("{path}[{i}]"), 0)?;
             }
@@ -255,10 +261,7 @@ fn index_triple(node: &Node, path: &str) -> Result<[u32; 3]> {
         other => Err(error(
             path,
             &node.span,
-            format!(
-                "expected an array of 3 vertex indices [a, b, c], got {}",
-                other.describe()
-            ),
+            format!("expected {expected}, got {}", other.describe()),
         )),
     }
 }
@@ -522,6 +525,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "shading",
             "pixel_filter",
             "filter_stddev",
+            "crop",
         ],
         &[],
     )?;
@@ -531,6 +535,9 @@ fn render(node: &Node) -> Result<RenderDesc> {
         width: t.optional("width", positive)?.unwrap_or(d.width),
         height: t.optional("height", positive)?,
         aspect_ratio: t.optional("aspect_ratio", float)?.unwrap_or(d.aspect_ratio),
+        crop: t.optional("crop", |n, p| {
+            counts(n, p, "an array of 4 pixel counts [x, y, width, height]")
+        })?,
         samples_per_pixel: t
             .optional("samples_per_pixel", positive)?
             .unwrap_or(d.samples_per_pixel),
@@ -592,6 +599,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "shutter",
             "gltf",
             "mirror",
+            "near_clip",
         ],
         &[],
     )?;
@@ -608,6 +616,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         shutter: t.optional("shutter", pair)?.unwrap_or(d.shutter),
         gltf: t.optional("gltf", gltf_camera)?,
         mirror: t.optional("mirror", boolean)?.unwrap_or(false),
+        near_clip: t.optional("near_clip", float)?.unwrap_or(d.near_clip),
     })
 }
 

@@ -472,8 +472,15 @@ impl<'d> Convert<'d> {
             ));
         }
         let vfov = 2.0 * ((x_fov / 2.0).tan() / aspect).atan();
-        let _ = p.float("near_clip", self)?; // rays start at the camera
-        let _ = p.float("far_clip", self)?;
+        // Mitsuba's camera rays start on the near plane (10⁻² by default).
+        let near_clip = p.float("near_clip", self)?.unwrap_or(1e-2);
+        let _ = p.float("far_clip", self)?; // not applied
+        if !(near_clip >= 0.0) {
+            return Err(self.fail(
+                e,
+                format!("near_clip must not be negative, got {near_clip}"),
+            ));
+        }
         for n in ["principal_point_offset_x", "principal_point_offset_y"] {
             if p.float(n, self)?.is_some_and(|v| v != 0.0) {
                 self.lacks(e, &format!("{n} (a shifted lens)"), "a centred lens")?;
@@ -529,6 +536,7 @@ impl<'d> Convert<'d> {
             camera.focus_dist = Some(focus);
         }
         p.finish(&known, self)?;
+        camera.near_clip = near_clip;
         self.desc.camera = camera;
         self.desc.render.width = width;
         self.desc.render.height = Some(height);
@@ -549,15 +557,26 @@ impl<'d> Convert<'d> {
         };
         let width = size(&p, "width", 768, self)?;
         let height = size(&p, "height", 576, self)?;
-        for n in [
+        let mut crop = [0, 0, width, height];
+        let mut cropped = false;
+        for (i, n) in [
             "crop_offset_x",
             "crop_offset_y",
             "crop_width",
             "crop_height",
-        ] {
-            if p.integer(n, self)?.is_some() {
-                self.lacks(e, "a crop window (crop_*)", "the whole image")?;
+        ]
+        .iter()
+        .enumerate()
+        {
+            if let Some(v) = p.integer(n, self)? {
+                crop[i] = u32::try_from(v)
+                    .map_err(|_| self.fail(e, format!("{n} must not be negative, got {v}")))?;
+                cropped = true;
             }
+        }
+        if cropped {
+            // The window's size defaults to the image's, as Mitsuba's.
+            self.desc.render.crop = Some(crop);
         }
         for n in ["pixel_format", "component_format", "file_format"] {
             let _ = p.string(n, self)?; // lumen's output follows -o.

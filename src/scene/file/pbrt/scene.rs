@@ -648,15 +648,52 @@ impl Builder {
             ))
         };
         self.film = (size("xresolution", 1280)?, size("yresolution", 720)?);
-        for n in ["cropwindow", "pixelbounds"] {
-            if p.has(n) {
-                let _ = p.get(n);
-                self.lacks(
-                    at,
-                    &format!("`{n}` (a part of the image)"),
-                    "the whole image",
-                )?;
+        // pbrt's window [x0 x1 y0 y1]: in pixels, or as fractions of the
+        // image whose pixel bounds are their products rounded up.
+        let (w, h) = (f64::from(self.film.0), f64::from(self.film.1));
+        let window = match (
+            p.nums("pixelbounds", &["integer"])?,
+            p.nums("cropwindow", &["float"])?,
+        ) {
+            (Some((b, at)), _) => Some((b.to_vec(), at)),
+            (None, Some((c, at))) if c.len() == 4 => Some((
+                vec![
+                    (c[0] * w).ceil(),
+                    (c[1] * w).ceil(),
+                    (c[2] * h).ceil(),
+                    (c[3] * h).ceil(),
+                ],
+                at,
+            )),
+            (None, Some((_, at))) => return Err((at, "`cropwindow` takes 4 numbers".into(), None)),
+            (None, None) => None,
+        };
+        if let Some((b, wat)) = window {
+            let fits = b.len() == 4
+                && b.iter().all(|v| v.is_finite())
+                && 0.0 <= b[0]
+                && b[0] < b[1]
+                && b[1] <= w
+                && 0.0 <= b[2]
+                && b[2] < b[3]
+                && b[3] <= h;
+            if !fits {
+                return Err((
+                    wat,
+                    format!(
+                        "the window [{}] must hold x0 < x1 and y0 < y1 within the {}x{} image",
+                        b.iter()
+                            .map(|v| v.to_string())
+                            .collect::<Vec<_>>()
+                            .join(" "),
+                        self.film.0,
+                        self.film.1
+                    ),
+                    None,
+                ));
             }
+            let [x0, x1, y0, y1] = [b[0], b[1], b[2], b[3]].map(|v| v as u32);
+            self.desc.render.crop = Some([x0, y0, x1 - x0, y1 - y0]);
         }
         if p.float("iso")?.is_some_and(|v| v != 100.0) {
             self.lacks(at, "film sensitivity other than ISO 100", "ISO 100")?;
