@@ -340,31 +340,42 @@ impl TextureTable<'_> {
     /// Whether texture `t` gives a colour, a scalar (one channel of an
     /// image), or either (grey noise, one colour).
     pub(crate) fn kind(&self, t: u32) -> TextureKind {
-        let mut t = t;
+        self.kind_among(t, &mut HashMap::new())
+    }
+
+    /// [`kind`](Self::kind), each texture decided once: checkers nested
+    /// many times over one texture are as many lookups, not 2ⁿ.
+    fn kind_among(&self, t: u32, known: &mut HashMap<u32, TextureKind>) -> TextureKind {
         // Scaled textures are what they scale (a chain: no recursion).
-        loop {
-            return match &self.textures[t as usize] {
-                Texture::Map(map) => match map.channels {
-                    Channels::Rgb => TextureKind::Color,
-                    Channels::One(_) => TextureKind::Scalar,
-                },
-                Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
-                    t = *texture;
-                    continue;
-                }
-                // A checker of greys is grey: its squares decide (the
-                // chain is at most MAX_TEXTURE_DEPTH long).
-                Texture::Checker { even, odd, .. } | Texture::UvChecker { even, odd, .. } => {
-                    match (self.kind(*even), self.kind(*odd)) {
-                        (TextureKind::Color, _) | (_, TextureKind::Color) => TextureKind::Color,
-                        (TextureKind::Scalar, _) | (_, TextureKind::Scalar) => TextureKind::Scalar,
-                        _ => TextureKind::Either,
-                    }
-                }
-                Texture::Solid(c) if !(c.x == c.y && c.y == c.z) => TextureKind::Color,
-                Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
-            };
+        let mut t = t;
+        while let Texture::Scaled { texture, .. } | Texture::Inverted { texture } =
+            &self.textures[t as usize]
+        {
+            t = *texture;
         }
+        if let Some(k) = known.get(&t) {
+            return *k;
+        }
+        let kind = match &self.textures[t as usize] {
+            Texture::Map(map) => match map.channels {
+                Channels::Rgb => TextureKind::Color,
+                Channels::One(_) => TextureKind::Scalar,
+            },
+            Texture::Scaled { .. } | Texture::Inverted { .. } => unreachable!("followed above"),
+            // A checker of greys is grey: its squares decide (chains of
+            // them are at most MAX_TEXTURE_DEPTH long).
+            Texture::Checker { even, odd, .. } | Texture::UvChecker { even, odd, .. } => {
+                match (self.kind_among(*even, known), self.kind_among(*odd, known)) {
+                    (TextureKind::Color, _) | (_, TextureKind::Color) => TextureKind::Color,
+                    (TextureKind::Scalar, _) | (_, TextureKind::Scalar) => TextureKind::Scalar,
+                    _ => TextureKind::Either,
+                }
+            }
+            Texture::Solid(c) if !(c.x == c.y && c.y == c.z) => TextureKind::Color,
+            Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
+        };
+        known.insert(t, kind);
+        kind
     }
 }
 
