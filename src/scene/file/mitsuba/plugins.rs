@@ -40,6 +40,7 @@ const BSDFS: &[&str] = &[
     "diffuse",
     "dielectric",
     "roughdielectric",
+    "thindielectric",
     "conductor",
     "roughconductor",
     "plastic",
