@@ -102,13 +102,19 @@ enum Scattering {
 /// The single-scattering power an interface of microfacets `d` and
 /// relative index `eta` reflects or refracts from incidence cosine `mu`.
 fn integrate(d: &Microfacet, mu: f32, eta: f32, what: Scattering) -> f32 {
-    let n = if eta > 1.0 { 32 } else { 128 };
-    let (nodes, weights) = gauss_legendre(n);
+    // The two rules are made once for every table, not for each cosine.
+    static OUTSIDE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
+    static INSIDE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
+    let (nodes, weights) = if eta > 1.0 {
+        OUTSIDE.get_or_init(|| gauss_legendre(32))
+    } else {
+        INSIDE.get_or_init(|| gauss_legendre(128))
+    };
     let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let g1_wi = d.g1(wi);
     let mut sum = 0.0f64;
-    for (x, wx) in nodes.iter().zip(&weights) {
-        for (y, wy) in nodes.iter().zip(&weights) {
+    for (x, wx) in nodes.iter().zip(weights) {
+        for (y, wy) in nodes.iter().zip(weights) {
             let u = [(0.5 * x + 0.5) as f32, (0.5 * y + 0.5) as f32];
             let m = d.sample_wm(wi, u);
             let cos_m = wi.dot(m);

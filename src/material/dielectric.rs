@@ -119,7 +119,7 @@ impl DielectricDesc {
             ior: ior as f32,
             refract_only: self.refract_only,
             roughness: rough.then_some(roughness),
-            exact: exact || self.thin,
+            exact,
             multiscatter: self.multiscatter,
             thin: self.thin,
         })))

@@ -128,19 +128,6 @@ pub type Sampling = SamplingDesc;
 /// How paths gather light (see [`desc::IntegratorDesc`]).
 pub type Integrator = IntegratorDesc;
 
-/// A window of the full image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Crop {
-    /// The window's top left pixel in the full image.
-    pub x: u32,
-    /// The window's top row in the full image.
-    pub y: u32,
-    /// The full image's width.
-    pub full_width: u32,
-    /// The full image's height.
-    pub full_height: u32,
-}
-
 /// Render settings after validation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -148,9 +135,10 @@ pub struct Settings {
     pub width: u32,
     /// Image height in pixels (of the crop window, when cropped).
     pub height: u32,
-    /// Where the image lies in the full image, when cropped: its top left
-    /// pixel and the full image's width and height.
-    pub crop: Option<Crop>,
+    /// Where the image lies in the full image, when cropped: `[x, y]` of
+    /// its top left pixel and the full image's width and height (as
+    /// [`crate::camera::CameraSettings::crop`]).
+    pub crop: Option<[u32; 4]>,
     /// Samples per pixel.
     pub samples_per_pixel: u32,
     /// Maximum ray segments per path.

@@ -315,13 +315,6 @@ fn compile_camera(
     finite("camera.vup", &cam.vup)?;
     finite("camera.defocus_angle", &[cam.defocus_angle])?;
     finite("camera.shutter", &cam.shutter)?;
-    finite("camera.near_clip", &[cam.near_clip])?;
-    if !(cam.near_clip >= 0.0) {
-        return Err(invalid(
-            "camera.near_clip",
-            format!("must not be negative, got {}", cam.near_clip),
-        ));
-    }
     let focus_dist = match cam.focus_dist {
         Some(d) => {
             finite("camera.focus_dist", &[d])?;
@@ -351,9 +344,7 @@ fn compile_camera(
             },
             mirror: cam.mirror,
             near_clip: cam.near_clip as f32,
-            crop: settings
-                .crop
-                .map(|c| [c.x, c.y, c.full_width, c.full_height]),
+            crop: settings.crop,
         },
         settings.width,
         settings.height,
@@ -1360,18 +1351,13 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
                 return Err(invalid(
                     "render.crop",
                     format!(
-                        "[x, y, width, height] must be a window of at least one pixel within                          the {}x{height} image, got [{x}, {y}, {w}, {h}]",
+                        "[x, y, width, height] must be a window of at least one pixel within \
+                         the {}x{height} image, got [{x}, {y}, {w}, {h}]",
                         r.width
                     ),
                 ));
             }
-            let full = crate::scene::Crop {
-                x,
-                y,
-                full_width: r.width,
-                full_height: height,
-            };
-            (w, h, Some(full))
+            (w, h, Some([x, y, r.width, height]))
         }
     };
     Ok(Settings {

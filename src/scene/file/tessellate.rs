@@ -88,8 +88,11 @@ pub fn cylinder(radius: f64, z0: f64, z1: f64) -> Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
 
-    fn area(o: &ObjectDesc) -> f64 {
+    /// The triangles of a `triangles` object, each as twice its area
+    /// along its normal (by the winding).
+    fn normals(o: &ObjectDesc) -> Vec<DVec3> {
         let ObjectDesc::Triangles {
             positions, indices, ..
         } = o
@@ -99,17 +102,14 @@ mod tests {
         indices
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|i| positions[i as usize]);
-                let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-                let w = [
-                    u[1] * v[2] - u[2] * v[1],
-                    u[2] * v[0] - u[0] * v[2],
-                    u[0] * v[1] - u[1] * v[0],
-                ];
-                0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
+                let [a, b, c] = t.map(|i| DVec3::from(positions[i as usize]));
+                (b - a).cross(c - a)
             })
-            .sum()
+            .collect()
+    }
+
+    fn area(o: &ObjectDesc) -> f64 {
+        normals(o).iter().map(|n| 0.5 * n.length()).sum()
     }
 
     #[test]
@@ -122,25 +122,9 @@ mod tests {
         let c = object(cylinder(0.5, -1.0, 2.0), "m".into(), Vec::new());
         assert!((area(&c) / (2.0 * pi * 0.5 * 3.0) - 1.0).abs() < 1e-12);
         // Winding: the disk's triangles face +z, the cylinder's outwards.
-        for (o, outward) in [(&d, [0.0, 0.0, 1.0]), (&c, [1.0, 0.0, 0.0])] {
-            let ObjectDesc::Triangles {
-                positions, indices, ..
-            } = o
-            else {
-                panic!()
-            };
-            let [a, b, c] = indices[0].map(|i| positions[i as usize]);
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let w = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            assert!(
-                w[0] * outward[0] + w[1] * outward[1] + w[2] * outward[2] > 0.0,
-                "{w:?}"
-            );
+        for (o, outward) in [(&d, DVec3::Z), (&c, DVec3::X)] {
+            let w = normals(o)[0];
+            assert!(w.dot(outward) > 0.0, "{w:?}");
         }
     }
 }
