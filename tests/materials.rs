@@ -682,3 +682,277 @@ material = "panel"
         "through the pane {mean}, expected {expected} ± {sigma}"
     );
 }
+
+/// A scene of a ball of `ball` (with `extra` materials and textures
+/// beside it) lit by a small light above it and a dim grey sky, seen
+/// whole against the sky.
+fn ball_under_a_light(ball: &str, extra: &str, spp: u32) -> String {
+    format!(
+        r#"
+[render]
+width = 12
+height = 12
+samples_per_pixel = {spp}
+max_depth = 6
+integrator = "path"
+
+[camera]
+vfov = 14
+lookfrom = [0, 0, 10]
+lookat = [0, 0, 0]
+
+[background]
+type = "solid"
+color = [0.2, 0.2, 0.2]
+
+{extra}
+
+[materials.ball]
+{ball}
+
+[materials.lamp]
+type = "emissive"
+radiance = [8, 8, 8]
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "ball"
+
+[[objects]]
+type = "quad"
+corner = [-0.5, 3, -0.5]
+u = [1, 0, 0]
+v = [0, 0, 1]
+material = "lamp"
+"#
+    )
+}
+
+/// The mean of an image and the standard deviation of that mean, from
+/// its pixels' sample variances.
+fn image_mean(scene: &Scene) -> ([f64; 3], [f64; 3]) {
+    let stats = common::pixel_stats(scene);
+    let n = stats.mean.len() as f64;
+    let mean = [0, 1, 2].map(|c| stats.mean.iter().map(|p| p[c]).sum::<f64>() / n);
+    let sigma = [0, 1, 2].map(|c| {
+        let var: f64 = stats
+            .var
+            .iter()
+            .zip(&stats.counts)
+            .map(|(v, &k)| v[c] / f64::from(k))
+            .sum();
+        var.sqrt() / n
+    });
+    (mean, sigma)
+}
+
+/// A mix is its two materials blended by its weight: the image of a ball
+/// of a rough gold and red diffuse mix, lit by a small light (light
+/// samples and BSDF samples weighed by MIS) is (1 − w) times the gold
+/// ball's image plus w times the red ball's, within 4σ of the three
+/// renders' noise.
+#[test]
+fn a_mix_renders_as_its_materials_blended_by_its_weight() {
+    let dir = scratch_dir("materials-mix-blend");
+    let gold = "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\nroughness = 0.4";
+    let red = "[materials.red]\ntype = \"diffuse\"\nalbedo = [0.7, 0.1, 0.1]";
+    let both = format!("{gold}\n\n{red}");
+    let spp = 256;
+    let render = |name: &str, ball: &str| {
+        image_mean(&compile_file(
+            &dir,
+            name,
+            &ball_under_a_light(ball, &both, spp),
+        ))
+    };
+    let w = 0.3;
+    let (a, sa) = render("a.toml", &gold.replace("[materials.gold]\n", ""));
+    let (b, sb) = render("b.toml", &red.replace("[materials.red]\n", ""));
+    let (m, sm) = render(
+        "mix.toml",
+        &format!("type = \"mix\"\nmaterials = [\"gold\", \"red\"]\nweight = {w}"),
+    );
+    for c in 0..3 {
+        let expected = (1.0 - w) * a[c] + w * b[c];
+        let sigma = (sm[c].powi(2) + ((1.0 - w) * sa[c]).powi(2) + (w * sb[c]).powi(2)).sqrt();
+        assert!(
+            (m[c] - expected).abs() < 4.0 * sigma,
+            "channel {c}: mix {} against {expected} ± {sigma}",
+            m[c]
+        );
+    }
+    // Not merely the mean of the two: the weight moves it.
+    assert!(
+        (m[1] - 0.5 * (a[1] + b[1])).abs() > 4.0 * sm[1],
+        "{m:?} {a:?} {b:?}"
+    );
+}
+
+/// A textured weight chooses per point: a quad under a white sky whose
+/// weight is 0 on its left half and 1 on its right shows the first
+/// material's albedo on the left and the second's on the right, exactly
+/// in every sample.
+#[test]
+fn a_textured_weight_chooses_the_material_per_point() {
+    let dir = scratch_dir("materials-mix-texture");
+    png(&dir.join("halves.png"), 2, 1, |x, _| {
+        let v = if x == 0 { 0 } else { 255 };
+        [v, v, v, 255]
+    });
+    let scene = compile_file(
+        &dir,
+        "halves.toml",
+        r#"
+[render]
+width = 8
+height = 8
+samples_per_pixel = 8
+max_depth = 4
+
+[camera]
+vfov = 20
+lookfrom = [0, 0, 5]
+lookat = [0, 0, 0]
+
+[background]
+type = "solid"
+color = [1, 1, 1]
+
+[textures.halves]
+type = "image"
+file = "halves.png"
+channel = "r"
+filter = "nearest"
+
+[materials.dark]
+type = "diffuse"
+albedo = [0.2, 0.2, 0.2]
+
+[materials.light]
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+
+[materials.halves]
+type = "mix"
+materials = ["dark", "light"]
+weight = "halves"
+one_sided = true
+
+[[objects]]
+type = "quad"
+corner = [-2, -2, 0]
+u = [4, 0, 0]
+v = [0, 4, 0]
+material = "halves"
+"#,
+    );
+    let stats = common::pixel_stats(&scene);
+    for y in 0..8 {
+        for x in 0..8 {
+            let i = y * 8 + x;
+            let expected = if x < 4 { 0.2 } else { 0.8 };
+            for c in 0..3 {
+                assert!(
+                    (stats.mean[i][c] - expected).abs() < 1e-5 && stats.var[i][c] < 1e-9,
+                    "pixel ({x}, {y}): {:?} ± {:?}, expected {expected}",
+                    stats.mean[i],
+                    stats.var[i]
+                );
+            }
+        }
+    }
+}
+
+/// A mix's mistakes are refused with the field they are in: a material
+/// that is not there, a mix of itself, materials that give off light or
+/// have their own map where the mix has one, a weight outside [0, 1], and
+/// mixes of mixes past the limit.
+#[test]
+fn a_mix_refuses_what_it_cannot_be() {
+    let dir = scratch_dir("materials-mix-errors");
+    let base = "[materials.a]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+                [materials.b]\ntype = \"diffuse\"\nalbedo = [0.1, 0.1, 0.1]\n\n\
+                [textures.h]\ntype = \"checkerboard\"\neven = [0, 0, 0]\nodd = [1, 1, 1]\n\n\
+                [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
+    let cases: Vec<(String, &[&str])> =
+        vec![
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"bb\"]\n".into(),
+            &["materials.m.materials[1]", "no material is named \"bb\"", "did you mean \"b\""],
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"n\"]\n\n\
+             [materials.n]\ntype = \"mix\"\nmaterials = [\"m\", \"b\"]\n"
+                .into(),
+            &["materials.n.materials[0]", "\"m\" is mixed into itself"],
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"glow\"]\n\n\
+             [materials.glow]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\nemission = [1, 1, 1]\n"
+                .into(),
+            &["materials.m.materials[1]", "gives off light", "give it to the mix"],
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"bumpy\"]\nbump_map = \"h\"\n\n\
+             [materials.bumpy]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\nbump_map = \"h\"\n"
+                .into(),
+            &["materials.m.materials[1]", "normal or bump map of its own"],
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"b\"]\nweight = 1.5\n".into(),
+            &["materials.m.weight"],
+        ),
+        (
+            "[materials.m]\ntype = \"mix\"\nmaterials = [\"a\"]\n".into(),
+            &["materials.m"],
+        ),
+    ];
+    for (text, expected) in cases {
+        let message = common::scene_file_error(&dir, &format!("{base}\n{text}"));
+        for e in expected {
+            assert!(message.contains(e), "{text}\ngave: {message}\nmissing: {e}");
+        }
+    }
+    // Seven levels of mixes of mixes hold 2⁷ = 128 materials: refused
+    // before they are copied.
+    let mut text = String::from(base).replace("material = \"m\"", "material = \"m7\"");
+    text.push_str("\n[materials.m0]\ntype = \"mix\"\nmaterials = [\"a\", \"b\"]\n");
+    for level in 1..=7 {
+        let below = level - 1;
+        text.push_str(&format!(
+            "\n[materials.m{level}]\ntype = \"mix\"\nmaterials = [\"m{below}\", \"m{below}\"]\n"
+        ));
+    }
+    let message = common::scene_file_error(&dir, &text);
+    assert!(message.contains("at most 64"), "{message}");
+}
+
+/// A mix's normal or bump map tilts the normal of both its materials.
+#[test]
+fn a_mixs_bump_map_is_its_materials() {
+    let dir = scratch_dir("materials-mix-bump");
+    let scene = compile_file(
+        &dir,
+        "bump.toml",
+        &ball_under_white_sky(
+            "type = \"mix\"\nmaterials = [\"a\", \"b\"]\nbump_map = \"h\"\n\n\
+             [materials.a]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+             [materials.b]\ntype = \"conductor\"\nmetal = \"Au\"\n\n\
+             [textures.h]\ntype = \"checkerboard\"\neven = [0, 0, 0]\nodd = [1, 1, 1]",
+            1,
+            1,
+            10.0,
+        ),
+    );
+    let mix = scene
+        .materials
+        .iter()
+        .find_map(|m| match &m.kind {
+            Kind::Mix(mix) => Some(mix),
+            _ => None,
+        })
+        .expect("a mix");
+    assert!(mix.materials.iter().all(|m| m.shape.is_some()), "{mix:?}");
+}

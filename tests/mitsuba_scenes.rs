@@ -412,3 +412,80 @@ fn crop_windows_and_near_clipping_planes_are_read() {
         "{e}"
     );
 }
+
+/// `blendbsdf` is a mix of its two BSDFs, the second with share `weight`
+/// (a number or a texture); each BSDF keeps its own sides, and `twosided`
+/// around a blend makes both of them scatter on both sides (copies, as
+/// another shape uses one of them one-sided). Exported to TOML, it renders
+/// to the same bits.
+#[test]
+fn a_blendbsdf_is_a_mix_of_its_bsdfs() {
+    use lumen::scene::desc::{MaterialDesc, ObjectDesc, ScalarDesc};
+    let dir = scratch_dir("mitsuba_scenes_blend");
+    let path = dir.join("s.xml");
+    std::fs::write(
+        &path,
+        scene(
+            "  <sensor type=\"perspective\"><transform name=\"to_world\">\
+             <lookat origin=\"0, 0, 6\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\
+             <film type=\"hdrfilm\"><integer name=\"width\" value=\"24\"/>\
+             <integer name=\"height\" value=\"16\"/></film>\
+             <sampler type=\"independent\"><integer name=\"sample_count\" value=\"4\"/></sampler>\
+             </sensor>\n\
+             <emitter type=\"constant\"/>\n\
+             <bsdf type=\"diffuse\" id=\"matte\"/>\n\
+             <bsdf type=\"roughconductor\" id=\"gold\"><string name=\"material\" value=\"Au\"/></bsdf>\n\
+             <shape type=\"sphere\"><point name=\"center\" x=\"-1.2\" y=\"0\" z=\"0\"/>\
+             <bsdf type=\"twosided\"><bsdf type=\"blendbsdf\">\
+             <texture type=\"checkerboard\" name=\"weight\"/>\
+             <ref id=\"matte\"/><ref id=\"gold\"/></bsdf></bsdf></shape>\n\
+             <shape type=\"sphere\"><point name=\"center\" x=\"1.2\" y=\"0\" z=\"0\"/>\
+             <bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.2\"/>\
+             <ref id=\"matte\"/><ref id=\"gold\"/></bsdf></shape>",
+        ),
+    )
+    .unwrap();
+    let file =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mix = |i: usize| {
+        let ObjectDesc::Sphere { material, .. } = &file.desc.objects[i] else {
+            panic!("{:?}", file.desc.objects[i]);
+        };
+        let MaterialDesc::Mix(m) = &file.desc.materials[material] else {
+            panic!("{:?}", file.desc.materials[material]);
+        };
+        m.clone()
+    };
+    let sides = |m: &lumen::material::MixDesc| {
+        m.materials
+            .clone()
+            .map(|name| match &file.desc.materials[&name] {
+                MaterialDesc::Diffuse(d) => d.one_sided,
+                MaterialDesc::Conductor(c) => c.one_sided,
+                other => panic!("{other:?}"),
+            })
+    };
+    let (two, one) = (mix(0), mix(1));
+    assert!(
+        matches!(two.weight, Some(ScalarDesc::Texture(_))),
+        "{two:?}"
+    );
+    assert_eq!(sides(&two), [false, false]);
+    assert!(!two.one_sided);
+    assert_eq!(one.weight, Some(ScalarDesc::Value(0.2)));
+    assert_eq!(one.materials, ["matte".to_string(), "gold".to_string()]);
+    assert_eq!(sides(&one), [true, true]);
+
+    let text = lumen::scene::file::export(&file.desc, Format::Toml).unwrap();
+    let mut exported =
+        SceneFile::parse("exported.toml", text, Format::Toml).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(exported.desc, file.desc);
+    exported.dir = file.dir.clone();
+    let render = |f: &SceneFile| {
+        let scene = f.compile(&Overrides::default()).unwrap();
+        lumen::render::render(&scene, &|_| {}).0.linear()
+    };
+    let (a, b) = (render(&file), render(&exported));
+    assert!(a.iter().any(|c| c.max_element() > 0.0));
+    assert!(a == b, "the exported scene renders differently");
+}

@@ -595,3 +595,57 @@ fn crop_windows_render_a_part_of_the_image() {
     .unwrap_err();
     assert!(e.contains("s.pbrt:1:") && e.contains("100x50"), "{e}");
 }
+
+/// `mix` is a mix of two named materials, the second with share `amount`
+/// (a number, clamped to [0, 1] as pbrt's choice is, or a float texture);
+/// an `interface` in a mix is refused where it is written.
+#[test]
+fn mix_materials_mix_two_named_materials() {
+    use lumen::material::param::ScalarDesc;
+    let d = read(
+        "mix",
+        "WorldBegin\n\
+         MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.7 0.1 0.1]\n\
+         MakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \
+         \"spectrum k\" \"metal-Au-k\"\n\
+         Texture \"t\" \"float\" \"imagemap\" \"string filename\" \"t.png\"\n\
+         Material \"mix\" \"string materials\" [\"red\" \"gold\"] \"float amount\" 1.7\nShape \"sphere\"\n\
+         Material \"mix\" \"string materials\" [\"gold\" \"red\"] \"texture amount\" \"t\"\nShape \"sphere\"\n",
+    );
+    let mix = |i: usize| match &d.objects[i] {
+        ObjectDesc::Sphere { material, .. } => match &d.materials[material] {
+            MaterialDesc::Mix(m) => m.clone(),
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    let (a, b) = (mix(0), mix(1));
+    assert_eq!(a.weight, Some(ScalarDesc::Value(1.0)));
+    assert!(matches!(
+        d.materials[&a.materials[0]],
+        MaterialDesc::Diffuse(_)
+    ));
+    assert!(matches!(
+        d.materials[&a.materials[1]],
+        MaterialDesc::Conductor(_)
+    ));
+    assert_eq!(
+        b.materials,
+        [a.materials[1].clone(), a.materials[0].clone()]
+    );
+    assert!(matches!(b.weight, Some(ScalarDesc::Texture(_))), "{b:?}");
+
+    let dir = scratch_dir("pbrt_scenes_mix_refused");
+    let e = read_in(
+        &dir,
+        "WorldBegin\nMakeNamedMaterial \"air\" \"string type\" \"interface\"\n\
+         MakeNamedMaterial \"red\" \"string type\" \"diffuse\"\n\
+         Material \"mix\" \"string materials\" [\"air\" \"red\"]\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("s.pbrt:4:") && e.contains("`air` is an interface"),
+        "{e}"
+    );
+}

@@ -246,6 +246,7 @@ pub mod diffuse;
 pub mod emissive;
 pub mod metal;
 pub mod metals;
+pub mod mix;
 pub mod param;
 pub mod plastic;
 pub mod principled;
@@ -259,6 +260,7 @@ pub use dielectric::{Dielectric, DielectricDesc};
 pub use diffuse::{AttenuationDesc, BounceDesc, Diffuse, DiffuseDesc};
 pub use emissive::{Emission, Emissive, EmissiveDesc};
 pub use metal::{Metal, MetalDesc};
+pub use mix::{Mix, MixDesc};
 pub use param::{ColorDesc, ColorParam, Invalid, ScalarDesc, ScalarParam, Textures};
 pub use plastic::{Plastic, PlasticDesc};
 pub use principled::{Principled, PrincipledDesc};
@@ -284,6 +286,8 @@ material_kinds! {
     Plastic(PlasticDesc) = "plastic", "a plastic material";
     /// The glTF metallic-roughness material and its layers.
     Principled(PrincipledDesc) = "principled", "a principled material";
+    /// Two materials, one or the other at each point.
+    Mix(MixDesc) = "mix", "a mix material";
 }
 
 /// A kind of material as the readers know it.
@@ -394,16 +398,22 @@ impl SurfaceDesc<'_> {
         } else if let Some(e) = &mut material.emission {
             e.two_sided = self.two_sided;
         }
-        material.shape = self.shape(field, textures)?;
+        let shape = self.shape(field, textures)?;
         material.opacity = self.opacity(field, textures)?;
         material.one_sided = self.one_sided;
-        if self.bump_shadowing && material.shape.is_none() {
+        if self.bump_shadowing && shape.is_none() {
             return Err(Invalid::new(
                 format!("{field}.bump_shadowing"),
                 "shadows the bumps of a normal_map or bump_map, which the material does not have",
             ));
         }
-        material.bump_shadowing = self.bump_shadowing;
+        match (&mut material.kind, shape) {
+            (Kind::Mix(mix), Some(shape)) => mix.take_shape(field, shape, self.bump_shadowing)?,
+            (_, shape) => {
+                material.shape = shape;
+                material.bump_shadowing = self.bump_shadowing;
+            }
+        }
         Ok(material)
     }
 
@@ -661,6 +671,8 @@ pub enum Kind {
     /// The glTF metallic-roughness material (out of line: it is large,
     /// and the table of materials every hit reads stays small).
     Principled(Box<Principled>),
+    /// One of two materials at each point.
+    Mix(Box<Mix>),
 }
 
 /// A surface material.
@@ -714,6 +726,9 @@ impl Material {
         if self.one_sided && !hit.front_face {
             return None;
         }
+        if let Kind::Mix(mix) = &self.kind {
+            return mix.bsdf(hit, wo, textures);
+        }
         let (n, terminator) = match &self.shape {
             None => (hit.shading_normal, None),
             Some(shape) if self.bump_shadowing => {
@@ -747,7 +762,9 @@ impl Material {
             Some(Bsdf::new(frame, hit.normal, lobe))
         };
         match &self.kind {
-            Kind::Black => None,
+            // A mix has no lobe of its own: `bsdf` asks the material it
+            // chooses.
+            Kind::Black | Kind::Mix(_) => None,
             Kind::Diffuse(d) => notes(Lobe::Diffuse(d.at(hit, textures))),
             Kind::Metal(m) => notes(Lobe::Metal(m.at(hit, textures))),
             Kind::Dielectric(d) => match d.at(hit, textures) {
@@ -786,6 +803,14 @@ impl Material {
         }
     }
 
+    /// How many materials it is: 1, or for a mix those it holds.
+    pub fn parts(&self) -> usize {
+        match &self.kind {
+            Kind::Mix(m) => m.materials.iter().map(Material::parts).sum(),
+            _ => 1,
+        }
+    }
+
     /// Whether it scatters nothing (a path that meets it ends there).
     #[inline(always)]
     pub fn is_black(&self) -> bool {
@@ -818,6 +843,7 @@ impl Material {
             Kind::Conductor(c) => c.roughness.textures().collect(),
             Kind::Plastic(p) => p.textures(),
             Kind::Principled(p) => p.textures(),
+            Kind::Mix(m) => m.textures(),
             Kind::Black => Vec::new(),
         };
         out.extend(self.emission.and_then(|e| e.radiance.texture()));

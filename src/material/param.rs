@@ -407,6 +407,10 @@ pub trait Textures {
     /// The colour texture `name` of field `field` read as a tangent-space
     /// normal map (linear data, not sRGB-decoded colour).
     fn normal_map(&mut self, field: &str, name: &str) -> Result<u32, Invalid>;
+
+    /// The scene's material `name`, compiled, for field `field` (a mix's
+    /// materials).
+    fn material(&mut self, field: &str, name: &str) -> Result<super::Material, Invalid>;
 }
 
 /// `v` checked by `range` for field `field`.

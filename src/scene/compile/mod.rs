@@ -23,7 +23,7 @@ use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
 use crate::mesh::{self, Model, TriangleMesh, NO_MATERIAL};
 use crate::texture::{Channels, ImageMap, Texture};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use textures::{read_image, ColorRef, TextureKind, TextureTable};
@@ -107,14 +107,24 @@ impl Scene {
         let mut sources = Vec::new();
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);
-            let field = format!("materials.{name}");
-            materials.push(compile_material(&field, m, &mut table, &mut sources)?);
+            let mut context = MaterialTextures {
+                textures: &mut table,
+                sources: &mut sources,
+                materials: &desc.materials,
+                resolving: vec![name.as_str()],
+            };
+            materials.push(
+                m.compile(&format!("materials.{name}"), &mut context)
+                    .map_err(|e| invalid(e.field, e.message))?,
+            );
         }
         let mut light_sources = Vec::with_capacity(desc.lights.len());
         for (i, l) in desc.lights.iter().enumerate() {
             let mut textures = MaterialTextures {
                 textures: &mut table,
                 sources: &mut sources,
+                materials: &desc.materials,
+                resolving: Vec::new(),
             };
             light_sources.push(
                 l.compile(&format!("lights[{i}]"), &mut textures)
@@ -1388,21 +1398,15 @@ pub(super) fn check_seed(field: &str, seed: u64) -> Result<u64, SceneError> {
     Ok(seed)
 }
 
-/// The material `m` of field `field`.
-fn compile_material<'a>(
-    field: &str,
-    m: &'a MaterialDesc,
-    textures: &mut TextureTable<'a>,
-    sources: &mut Vec<MeshSource>,
-) -> Result<Material, SceneError> {
-    m.compile(field, &mut MaterialTextures { textures, sources })
-        .map_err(|e| invalid(e.field, e.message))
-}
-
-/// The scene's textures as a material being compiled finds them.
+/// The scene's textures and materials as a material being compiled finds
+/// them.
 struct MaterialTextures<'t, 'a> {
     textures: &'t mut TextureTable<'a>,
     sources: &'t mut Vec<MeshSource>,
+    materials: &'a BTreeMap<String, MaterialDesc>,
+    /// The materials being compiled, outermost first (a mix's materials
+    /// are compiled inside it): one that is among them mixes itself in.
+    resolving: Vec<&'a str>,
 }
 
 impl Textures for MaterialTextures<'_, '_> {
@@ -1463,6 +1467,30 @@ impl Textures for MaterialTextures<'_, '_> {
 
     fn scaled(&mut self, t: u32, factor: Color) -> u32 {
         self.textures.push(Texture::Scaled { texture: t, factor })
+    }
+
+    fn material(&mut self, field: &str, name: &str) -> Result<Material, Invalid> {
+        let Some((name, desc)) = self.materials.get_key_value(name) else {
+            return Err(Invalid::new(
+                field,
+                format!(
+                    "no material is named \"{name}\"{}",
+                    crate::hint::closest(name, self.materials.keys().map(String::as_str))
+                        .map(|k| format!("; did you mean \"{k}\"?"))
+                        .unwrap_or_default()
+                ),
+            ));
+        };
+        if self.resolving.contains(&name.as_str()) {
+            return Err(Invalid::new(
+                field,
+                format!("material \"{name}\" is mixed into itself"),
+            ));
+        }
+        self.resolving.push(name);
+        let material = desc.compile(&format!("materials.{name}"), self);
+        self.resolving.pop();
+        material
     }
 
     fn normal_map(&mut self, field: &str, name: &str) -> Result<u32, Invalid> {

@@ -14,7 +14,7 @@ use crate::light::source::{DirectionalLightDesc, PointLightDesc, SpotLightDesc};
 use crate::material::dielectric::FresnelDesc;
 use crate::material::roughness::DistributionDesc;
 use crate::material::{
-    ConductorDesc, DielectricDesc, DiffuseDesc, EmissiveDesc, MaterialDesc, PlasticDesc,
+    ConductorDesc, DielectricDesc, DiffuseDesc, EmissiveDesc, MaterialDesc, MixDesc, PlasticDesc,
     PrincipledDesc,
 };
 use crate::scene::desc::{
@@ -51,6 +51,7 @@ const BSDFS: &[&str] = &[
     "bumpmap",
     "normalmap",
     "null",
+    "blendbsdf",
 ];
 const EMITTERS: &[&str] = &["area", "constant", "envmap", "point", "spot", "directional"];
 const INTEGRATORS: &[&str] = &["path", "direct", "volpath", "volpathmis", "moment"];
@@ -1196,7 +1197,7 @@ impl<'d> Convert<'d> {
             "twosided" => {
                 let mut d = self.nested(e, &p)?;
                 p.finish(&[], self)?;
-                *d.surface_mut().one_sided = false;
+                self.two_sided(&mut d);
                 d
             }
             "mask" => {
@@ -1284,15 +1285,37 @@ impl<'d> Convert<'d> {
                 MaterialDesc::Diffuse(d)
             }
             "blendbsdf" => {
-                let _ = p.scalar("weight", self)?;
-                self.lacks(e, "a blend of two BSDFs", "the first BSDF")?;
-                let d = self.nested(e, &p)?;
+                let weight = match p.scalar("weight", self)? {
+                    None => ScalarDesc::Value(0.5),
+                    Some(Colour::Rgb(c)) => ScalarDesc::Value(mean(c).clamp(0.0, 1.0)),
+                    Some(Colour::Texture(t)) => ScalarDesc::Texture(self.texture(t, true)?),
+                };
+                let [first, second] = p.objects("bsdf")[..] else {
+                    return Err(self.fail(e, "a blendbsdf blends two <bsdf>s".into()));
+                };
+                let (first, second) = (self.bsdf(first)?, self.bsdf(second)?);
                 p.finish(&["weight"], self)?;
-                d
+                // Each BSDF keeps its own sides: the blend adds none.
+                MaterialDesc::Mix(MixDesc::new(&first, &second, weight))
             }
             _ => return Err(self.unknown_type(e, "bsdf", BSDFS)),
         };
         Ok(desc)
+    }
+
+    /// Makes `d` scatter on both sides, as Mitsuba's `twosided` does: a
+    /// blend's BSDFs too (copies of them, as another shape may use them
+    /// one-sided).
+    fn two_sided(&mut self, d: &mut MaterialDesc) {
+        *d.surface_mut().one_sided = false;
+        if let MaterialDesc::Mix(mix) = d {
+            for name in &mut mix.materials {
+                let mut part = self.desc.materials[name.as_str()].clone();
+                self.two_sided(&mut part);
+                *name = self.name("twosided");
+                self.desc.materials.insert(name.clone(), part);
+            }
+        }
     }
 
     /// Whether a normal map's `normalmap` is a `rawconstant` texture of

@@ -8,7 +8,7 @@ use super::scene::Builder;
 use super::{spectra, Input};
 use crate::material::dielectric::FresnelDesc;
 use crate::material::roughness::DistributionDesc;
-use crate::material::{ConductorDesc, PlasticDesc};
+use crate::material::{ConductorDesc, MixDesc, PlasticDesc};
 use crate::scene::desc::{
     ColorDesc, DielectricDesc, DiffuseDesc, EncodingDesc, FilterDesc, MaterialDesc, RoughnessDesc,
     ScalarDesc, TextureDesc, WrapDesc,
@@ -162,8 +162,8 @@ impl Builder {
             }
             "mix" => {
                 known.extend(["materials", "amount"]);
-                let first = match p.get("materials").map(|m| &m.values) {
-                    Some(super::params::Values::Strs(v)) if v.len() == 2 => v[0].clone(),
+                let names = match p.get("materials").map(|m| &m.values) {
+                    Some(super::params::Values::Strs(v)) if v.len() == 2 => [&v[0], &v[1]],
                     _ => {
                         return Err((
                             at,
@@ -172,13 +172,28 @@ impl Builder {
                         ))
                     }
                 };
-                let _ = p.float_or_texture("amount")?;
-                self.lacks(at, "mix of two materials", "the first material")?;
-                let Some((name, interface)) = self.named_materials.get(&first).cloned() else {
-                    return Err((at, format!("no material is named `{first}`"), None));
+                let mut parts = Vec::with_capacity(2);
+                for name in names {
+                    match self.named_materials.get(name) {
+                        None => return Err((at, format!("no material is named `{name}`"), None)),
+                        Some((_, true)) => {
+                            return Err((
+                                at,
+                                format!("`{name}` is an interface, which lumen cannot mix"),
+                                None,
+                            ))
+                        }
+                        Some((lumen, false)) => parts.push(lumen.clone()),
+                    }
+                }
+                // pbrt takes the first material at amounts up to 0 and the
+                // second from 1.
+                let weight = match p.float_or_texture("amount")? {
+                    None => ScalarDesc::Value(0.5),
+                    Some((Ok(v), _)) => ScalarDesc::Value(v.clamp(0.0, 1.0)),
+                    Some((Err(t), tat)) => ScalarDesc::Texture(self.scalar_texture(&t, tat)?),
                 };
-                p.finish("a mix material", &known)?;
-                return Ok((name, interface));
+                MaterialDesc::Mix(MixDesc::new(&parts[0], &parts[1], weight))
             }
             "measured" | "hair" | "subsurface" | "diffusetransmission" => {
                 p.ignore_all();
