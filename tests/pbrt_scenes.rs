@@ -649,3 +649,42 @@ fn mix_materials_mix_two_named_materials() {
         "{e}"
     );
 }
+
+/// A float `checkerboard` is a checkerboard of greys, which lumen's
+/// scalar parameters (a roughness here) take.
+#[test]
+fn float_checkerboards_are_grey_checkerboards() {
+    use lumen::material::param::RoughnessDesc;
+    let dir = scratch_dir("pbrt_scenes_float_checkerboard");
+    let file = read_in(
+        &dir,
+        "WorldBegin\n\
+         Texture \"r\" \"float\" \"checkerboard\" \"float tex1\" 0.1 \"float tex2\" 0.4 \
+         \"float uscale\" 8 \"float vscale\" 8\n\
+         Material \"conductor\" \"texture roughness\" \"r\" \"bool remaproughness\" false\n\
+         Shape \"sphere\"\n",
+        &Options::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let d = &file.desc;
+    let ObjectDesc::Sphere { material, .. } = &d.objects[0] else {
+        panic!("{:?}", d.objects[0]);
+    };
+    let MaterialDesc::Conductor(metal) = &d.materials[material] else {
+        panic!("{:?}", d.materials[material]);
+    };
+    let Some(RoughnessDesc::Texture(name)) = &metal.alpha else {
+        panic!("{:?}", metal.alpha);
+    };
+    assert_eq!(
+        d.textures[name],
+        TextureDesc::Checkerboard {
+            even: ColorDesc::Rgb([0.1; 3]),
+            odd: ColorDesc::Rgb([0.4; 3]),
+            uv_scale: Some([8.0, 8.0]),
+            uv_offset: Some([0.0, 0.0]),
+        }
+    );
+    file.compile(&Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+}

@@ -721,7 +721,9 @@ impl Builder {
                     }
                 }
             }
-            "checkerboard" if !float && p.int("dimension")?.unwrap_or(2) == 2 => {
+            // A float checkerboard is a checkerboard of greys: lumen's
+            // scalar checkerboard.
+            "checkerboard" if p.int("dimension")?.unwrap_or(2) == 2 => {
                 let colour = |t: Tex| match t {
                     Tex::Constant(c) => ColorDesc::Rgb(c),
                     Tex::Named(n) => ColorDesc::Texture(n),
