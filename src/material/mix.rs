@@ -3,7 +3,7 @@
 //!
 //! Choosing one material per hit, rather than summing both lobes, gives
 //! the blend f = (1 − w)·f₀ + w·f₁ in expectation (every estimator of a
-//! path is linear in the BSDF it meets), keeps a [`Bsdf`] one lobe, and
+//! path is linear in the BSDF it meets), keeps a [`Bsdf`](crate::bsdf::Bsdf) one lobe, and
 //! lets a mix hold any materials, mixes among them. The choice is a hash of
 //! the hit point and the direction it is seen from, as pbrt-v4's: the same
 //! hit seen the same way always makes the same choice, whatever thread or
@@ -11,7 +11,6 @@
 
 use super::param::{self, Invalid, ScalarDesc, ScalarParam, Textures};
 use super::{Kind, Material, Shape};
-use crate::bsdf::Bsdf;
 use crate::geometry::HitRecord;
 use crate::math::Vec3;
 use crate::rng::mix64;
@@ -101,17 +100,32 @@ pub struct Mix {
 }
 
 impl Mix {
-    /// The scattering at `hit` seen from `wo`: the chosen material's.
+    /// The material used at `hit` seen from `wo`, never a mix (a mix
+    /// chosen chooses in turn). Out of the path loop's way (cold), as few
+    /// materials are mixes.
+    #[cold]
     #[inline(never)]
-    pub fn bsdf(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Option<Bsdf> {
-        self.choose(hit, wo, textures).bsdf(hit, wo, textures)
+    pub fn choose(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> &Material {
+        let mut mix = self;
+        loop {
+            let w = mix.weight.at(hit, textures);
+            let second = w >= 1.0 || (w > 0.0 && unit_hash(hit.point, wo) < w);
+            let m = &mix.materials[usize::from(second)];
+            match &m.kind {
+                Kind::Mix(inner) => mix = inner,
+                _ => return m,
+            }
+        }
     }
 
-    /// The material used at `hit` seen from `wo`.
-    pub fn choose(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> &Material {
-        let w = self.weight.at(hit, textures);
-        let second = w >= 1.0 || (w > 0.0 && unit_hash(hit.point, wo) < w);
-        &self.materials[usize::from(second)]
+    /// Makes every material it holds one-sided, as the mix is.
+    pub(super) fn make_one_sided(&mut self) {
+        for m in &mut self.materials {
+            m.one_sided = true;
+            if let Kind::Mix(inner) = &mut m.kind {
+                inner.make_one_sided();
+            }
+        }
     }
 
     /// Gives the mix's normal or bump map to its materials (a map tilts the

@@ -407,6 +407,9 @@ impl SurfaceDesc<'_> {
                 "shadows the bumps of a normal_map or bump_map, which the material does not have",
             ));
         }
+        if let (Kind::Mix(mix), true) = (&mut material.kind, self.one_sided) {
+            mix.make_one_sided();
+        }
         match (&mut material.kind, shape) {
             (Kind::Mix(mix), Some(shape)) => mix.take_shape(field, shape, self.bump_shadowing)?,
             (_, shape) => {
@@ -723,11 +726,20 @@ impl Material {
     /// scatters nothing.
     #[inline(always)]
     pub fn bsdf(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Option<Bsdf> {
+        // A mix is the material it chooses (a pointer picked, no call back
+        // into this function), its sides and map given to it when compiled.
+        let m = match &self.kind {
+            Kind::Mix(mix) => mix.choose(hit, wo, textures),
+            _ => self,
+        };
+        m.leaf_bsdf(hit, wo, textures)
+    }
+
+    /// [`bsdf`](Self::bsdf) of a material that is not a mix.
+    #[inline(always)]
+    fn leaf_bsdf(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Option<Bsdf> {
         if self.one_sided && !hit.front_face {
             return None;
-        }
-        if let Kind::Mix(mix) = &self.kind {
-            return mix.bsdf(hit, wo, textures);
         }
         let (n, terminator) = match &self.shape {
             None => (hit.shading_normal, None),
@@ -762,8 +774,7 @@ impl Material {
             Some(Bsdf::new(frame, hit.normal, lobe))
         };
         match &self.kind {
-            // A mix has no lobe of its own: `bsdf` asks the material it
-            // chooses.
+            // `bsdf` gives a mix's chosen material, never the mix.
             Kind::Black | Kind::Mix(_) => None,
             Kind::Diffuse(d) => notes(Lobe::Diffuse(d.at(hit, textures))),
             Kind::Metal(m) => notes(Lobe::Metal(m.at(hit, textures))),
