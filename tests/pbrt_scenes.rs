@@ -688,3 +688,53 @@ fn float_checkerboards_are_grey_checkerboards() {
     file.compile(&Overrides::default())
         .unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// A `mix` texture is lumen's mix texture; of constants it is their blend;
+/// an amount outside [0, 1] is refused where it is written.
+#[test]
+fn mix_textures_blend_their_two_textures() {
+    use lumen::material::param::ScalarDesc;
+    let d = read(
+        "mix_texture",
+        "WorldBegin\n\
+         Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"t.png\"\n\
+         Texture \"a\" \"float\" \"imagemap\" \"string filename\" \"t.png\"\n\
+         Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"t\" \"rgb tex2\" [0 0 1] \
+         \"texture amount\" \"a\"\n\
+         Texture \"c\" \"spectrum\" \"mix\" \"rgb tex1\" [1 0 0] \"rgb tex2\" [0 0 1] \
+         \"float amount\" 0.25\n\
+         Material \"diffuse\" \"texture reflectance\" \"m\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n",
+    );
+    let albedo = |i: usize| match &d.objects[i] {
+        ObjectDesc::Sphere { material, .. } => match &d.materials[material] {
+            MaterialDesc::Diffuse(m) => m.albedo.clone(),
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    let ColorDesc::Texture(name) = albedo(0) else {
+        panic!("{:?}", albedo(0));
+    };
+    let TextureDesc::Mix {
+        first,
+        second,
+        amount,
+    } = &d.textures[&name]
+    else {
+        panic!("{:?}", d.textures[&name]);
+    };
+    assert!(matches!(first, ColorDesc::Texture(_)), "{first:?}");
+    assert_eq!(*second, ColorDesc::Rgb([0.0, 0.0, 1.0]));
+    assert!(matches!(amount, ScalarDesc::Texture(_)), "{amount:?}");
+    assert_eq!(albedo(1), ColorDesc::Rgb([0.75, 0.0, 0.25]));
+
+    let dir = scratch_dir("pbrt_scenes_mix_texture_refused");
+    let e = read_in(
+        &dir,
+        "WorldBegin\nTexture \"c\" \"float\" \"mix\"\n  \"float amount\" 2\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("s.pbrt:3:") && e.contains("amount"), "{e}");
+}

@@ -513,3 +513,127 @@ fn bad_textures_are_refused_with_the_field_named() {
         );
     }
 }
+
+/// A `mix` texture is (1 − amount)·first + amount·second: a constant
+/// amount blends two colours everywhere; an amount that is a texture (an
+/// image's red channel, 0 on the left and 1 on the right of a quad)
+/// shows the first on the left, the second on the right, half and half
+/// between the texel centres. A mix of greys gives a number (a roughness).
+#[test]
+fn a_mix_texture_blends_by_its_amount() {
+    let dir = scratch_dir("tex-mix");
+    image::RgbImage::from_raw(2, 1, vec![0, 0, 0, 255, 255, 255])
+        .unwrap()
+        .save(dir.join("ramp.png"))
+        .unwrap();
+    let scene = compile_file(
+        &dir,
+        "m.toml",
+        r#"
+[textures.ramp]
+type = "image"
+file = "ramp.png"
+channel = "r"
+
+[textures.even]
+type = "mix"
+first = [0.8, 0.2, 0.0]
+second = [0.0, 0.2, 0.8]
+amount = 0.25
+
+[textures.by-ramp]
+type = "mix"
+first = [1, 0, 0]
+second = "even"
+amount = "ramp"
+
+[textures.grey]
+type = "mix"
+first = [0.1, 0.1, 0.1]
+second = [0.5, 0.5, 0.5]
+amount = "ramp"
+
+[materials.flat]
+type = "diffuse"
+albedo = "even"
+
+[materials.ramped]
+type = "diffuse"
+albedo = "by-ramp"
+
+[materials.rough]
+type = "conductor"
+metal = "Au"
+roughness = "grey"
+
+[[objects]]
+type = "quad"
+corner = [0, 0, 0]
+u = [1, 0, 0]
+v = [0, 1, 0]
+material = "flat"
+
+[[objects]]
+type = "quad"
+corner = [2, 0, 0]
+u = [1, 0, 0]
+v = [0, 1, 0]
+material = "ramped"
+
+[[objects]]
+type = "quad"
+corner = [4, 0, 0]
+u = [1, 0, 0]
+v = [0, 1, 0]
+material = "rough"
+"#,
+    );
+    let look = |x: f32, y: f32| colour_at(&scene, Vec3::new(x, y, 1.0), -Vec3::Z);
+    let even = Color::new(0.6, 0.2, 0.2);
+    assert!(close(look(0.3, 0.6), even), "{:?}", look(0.3, 0.6));
+    // Texel centres at u = ¼ and ¾: the amount 0 and 1 there, ½ midway.
+    assert!(close(look(2.25, 0.5), Color::X), "{:?}", look(2.25, 0.5));
+    assert!(close(look(2.75, 0.5), even), "{:?}", look(2.75, 0.5));
+    let half = (Color::X + even) * 0.5;
+    assert!(close(look(2.5, 0.5), half), "{:?}", look(2.5, 0.5));
+}
+
+#[test]
+fn bad_mix_textures_are_refused_with_the_field_named() {
+    let dir = scratch_dir("tex-mix-bad");
+    let scene = |mix: &str| {
+        format!(
+            "[textures.m]\ntype = \"mix\"\n{mix}\n\n\
+             [textures.colour]\ntype = \"checkerboard\"\neven = [1, 0, 0]\nodd = [0, 0, 1]\n\n\
+             [materials.a]\ntype = \"diffuse\"\nalbedo = \"m\"\n\n\
+             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"a\"\n"
+        )
+    };
+    for (mix, expected) in [
+        (
+            "first = [1, 1, 1]\nsecond = [0, 0, 0]\namount = 1.5",
+            &["textures.m.amount", "[0, 1]"][..],
+        ),
+        (
+            "first = [1, 1, 1]\nsecond = [0, 0, 0]\namount = \"colour\"",
+            &["textures.m.amount", "is a colour"][..],
+        ),
+        (
+            "first = [1, 1, 1]\nsecond = [0, 0, 0]\namount = \"m\"",
+            &["textures.m", "refers to itself"][..],
+        ),
+        (
+            "first = [1, 1, 1]\nsecond = [0, 0, 0]\namount = [0.5, 0.5, 0.5]",
+            &["textures.m.amount", "a number or the name of a texture"][..],
+        ),
+        (
+            "first = [1, 1, 1]\namount = 0.5",
+            &["textures.m", "second"][..],
+        ),
+    ] {
+        let message = scene_file_error(&dir, &scene(mix));
+        for e in expected {
+            assert!(message.contains(e), "{mix}\ngave: {message}\nmissing: {e}");
+        }
+    }
+}

@@ -78,6 +78,16 @@ pub enum Texture {
         /// The factor.
         factor: Color,
     },
+    /// Two textures of the table blended: (1 − a)·first + a·second, a the
+    /// (scalar) texture `amount`.
+    Mix {
+        /// What amount 0 shows.
+        first: u32,
+        /// What amount 1 shows.
+        second: u32,
+        /// How much of `second`.
+        amount: u32,
+    },
     /// One minus another texture of the table (a gloss map read as a
     /// roughness).
     Inverted {
@@ -150,6 +160,15 @@ impl Texture {
                 table[*texture as usize].value(table, at) * *factor
             }
             Texture::Inverted { texture } => Color::ONE - table[*texture as usize].value(table, at),
+            Texture::Mix {
+                first,
+                second,
+                amount,
+            } => {
+                let a = table[*amount as usize].value(table, at).x;
+                let first = table[*first as usize].value(table, at);
+                first + (table[*second as usize].value(table, at) - first) * a
+            }
             Texture::Noise {
                 perlin,
                 scale,
@@ -176,11 +195,16 @@ impl Texture {
         while let Some(t) = todo.pop() {
             let refs = match t {
                 Texture::Map(_) | Texture::UvChecker { .. } => return true,
-                Texture::Checker { even, odd, .. } => [Some(*even), Some(*odd)],
+                Texture::Checker { even, odd, .. } => [Some(*even), Some(*odd), None],
+                Texture::Mix {
+                    first,
+                    second,
+                    amount,
+                } => [Some(*first), Some(*second), Some(*amount)],
                 Texture::Scaled { texture, .. } | Texture::Inverted { texture } => {
-                    [Some(*texture), None]
+                    [Some(*texture), None, None]
                 }
-                Texture::Solid(_) | Texture::Noise { .. } => [None, None],
+                Texture::Solid(_) | Texture::Noise { .. } => [None, None, None],
             };
             for r in refs.into_iter().flatten() {
                 if seen.insert(r) {

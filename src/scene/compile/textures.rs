@@ -6,7 +6,8 @@
 use crate::hint;
 use crate::math::Color;
 use crate::scene::desc::{
-    ChannelDesc, ColorDesc, EncodingDesc, FilterDesc, NoisePatternDesc, TextureDesc, WrapDesc,
+    ChannelDesc, ColorDesc, EncodingDesc, FilterDesc, NoisePatternDesc, ScalarDesc, TextureDesc,
+    WrapDesc,
 };
 use crate::scene::{invalid, MeshSource, SceneError};
 use crate::texture::{
@@ -36,13 +37,25 @@ fn references(desc: &TextureDesc) -> impl Iterator<Item = &str> {
         TextureDesc::Checker { even, odd, .. } | TextureDesc::Checkerboard { even, odd, .. } => {
             (Some(even), Some(odd))
         }
+        TextureDesc::Mix { first, second, .. } => (Some(first), Some(second)),
         TextureDesc::Scale { texture, .. } => (Some(texture), None),
         _ => (None, None),
     };
-    [even, odd].into_iter().flatten().filter_map(|c| match c {
-        ColorDesc::Texture(name) => Some(name.as_str()),
-        ColorDesc::Rgb(_) => None,
-    })
+    let amount = match desc {
+        TextureDesc::Mix {
+            amount: ScalarDesc::Texture(name),
+            ..
+        } => Some(name.as_str()),
+        _ => None,
+    };
+    [even, odd]
+        .into_iter()
+        .flatten()
+        .filter_map(|c| match c {
+            ColorDesc::Texture(name) => Some(name.as_str()),
+            ColorDesc::Rgb(_) => None,
+        })
+        .chain(amount)
 }
 
 /// Checks every texture, whether a material uses it or not: none refers to
@@ -225,6 +238,39 @@ impl<'a> TextureTable<'a> {
                 factor: super::color(&format!("{here}.factor"), *factor)?,
                 texture: self.texture_of(&format!("{here}.texture"), texture, sources)?,
             },
+            TextureDesc::Mix {
+                first,
+                second,
+                amount,
+            } => {
+                let at = format!("{here}.amount");
+                let amount = match amount {
+                    ScalarDesc::Value(v) => {
+                        if !(0.0..=1.0).contains(v) {
+                            return Err(invalid(at, format!("must be within [0, 1], got {v}")));
+                        }
+                        self.push(Texture::Solid(Color::splat(*v as f32)))
+                    }
+                    ScalarDesc::Texture(name) => {
+                        let t = self.named(&at, name, sources)?;
+                        if self.kind(t) == TextureKind::Color {
+                            return Err(invalid(
+                                at,
+                                format!(
+                                    "texture \"{name}\" is a colour; the amount is a number: \
+                                     give the image texture a `channel`"
+                                ),
+                            ));
+                        }
+                        t
+                    }
+                };
+                Texture::Mix {
+                    first: self.texture_of(&format!("{here}.first"), first, sources)?,
+                    second: self.texture_of(&format!("{here}.second"), second, sources)?,
+                    amount,
+                }
+            }
             TextureDesc::Checkerboard {
                 even,
                 odd,
@@ -362,15 +408,19 @@ impl TextureTable<'_> {
                 Channels::One(_) => TextureKind::Scalar,
             },
             Texture::Scaled { .. } | Texture::Inverted { .. } => unreachable!("followed above"),
-            // A checker of greys is grey: its squares decide (chains of
-            // them are at most MAX_TEXTURE_DEPTH long).
-            Texture::Checker { even, odd, .. } | Texture::UvChecker { even, odd, .. } => {
-                match (self.kind_among(*even, known), self.kind_among(*odd, known)) {
-                    (TextureKind::Color, _) | (_, TextureKind::Color) => TextureKind::Color,
-                    (TextureKind::Scalar, _) | (_, TextureKind::Scalar) => TextureKind::Scalar,
-                    _ => TextureKind::Either,
-                }
-            }
+            // A checker (or a mix) of greys is grey: its squares decide
+            // (chains of them are at most MAX_TEXTURE_DEPTH long).
+            Texture::Checker { even, odd, .. }
+            | Texture::UvChecker { even, odd, .. }
+            | Texture::Mix {
+                first: even,
+                second: odd,
+                ..
+            } => match (self.kind_among(*even, known), self.kind_among(*odd, known)) {
+                (TextureKind::Color, _) | (_, TextureKind::Color) => TextureKind::Color,
+                (TextureKind::Scalar, _) | (_, TextureKind::Scalar) => TextureKind::Scalar,
+                _ => TextureKind::Either,
+            },
             Texture::Solid(c) if !(c.x == c.y && c.y == c.z) => TextureKind::Color,
             Texture::Solid(_) | Texture::Noise { .. } => TextureKind::Either,
         };

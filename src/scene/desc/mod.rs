@@ -488,6 +488,16 @@ pub enum TextureDesc {
         /// The factor, per channel, each ≥ 0.
         factor: Triple,
     },
+    /// Two textures (or colours) blended: (1 − amount)·first +
+    /// amount·second (pbrt's `mix`).
+    Mix {
+        /// What amount 0 shows: a texture's name or a colour.
+        first: ColorDesc,
+        /// What amount 1 shows.
+        second: ColorDesc,
+        /// How much of `second`: a number or a scalar texture.
+        amount: ScalarDesc,
+    },
     /// An image wrapped by the surface's texture coordinates.
     Image {
         /// The image file, relative to the scene file.

@@ -16,8 +16,8 @@ use crate::material::KindInfo;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc,
     EnvironmentLayoutDesc, FilterDesc, GltfCamera, IntegratorDesc, LightDesc, MaterialDesc,
-    NoisePatternDesc, ObjectDesc, PixelFilterDesc, RenderDesc, SamplingDesc, ScaleDesc, SceneDesc,
-    ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
+    NoisePatternDesc, ObjectDesc, PixelFilterDesc, RenderDesc, SamplingDesc, ScalarDesc, ScaleDesc,
+    SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -300,6 +300,22 @@ fn color_or_texture(node: &Node, path: &str) -> Result<ColorDesc> {
             &node.span,
             format!(
                 "expected an array of 3 numbers [r, g, b] or the name of a texture, got {}",
+                other.describe()
+            ),
+        )),
+    }
+}
+
+/// A number, or the name of a (scalar) texture.
+fn number_or_texture(node: &Node, path: &str) -> Result<ScalarDesc> {
+    match &node.value {
+        Value::String(name) => Ok(ScalarDesc::Texture(name.clone())),
+        Value::Float(_) | Value::Integer(_) => Ok(ScalarDesc::Value(float(node, path)?)),
+        other => Err(error(
+            path,
+            &node.span,
+            format!(
+                "expected a number or the name of a texture, got {}",
                 other.describe()
             ),
         )),
@@ -820,6 +836,7 @@ enum TextureKind {
     Checker,
     Checkerboard,
     Scale,
+    Mix,
     Image,
     Noise,
 }
@@ -831,6 +848,18 @@ const TEXTURES: &[Kind<TextureKind>] = &[
         what: "a scale texture",
         fields: &["type", "texture", "factor"],
         elsewhere: &[("scale", "checker textures"), ("file", "image textures")],
+    },
+    Kind {
+        name: "mix",
+        kind: TextureKind::Mix,
+        what: "a mix texture",
+        fields: &["type", "first", "second", "amount"],
+        elsewhere: &[
+            ("even", "checker textures"),
+            ("odd", "checker textures"),
+            ("texture", "scale textures"),
+            ("file", "image textures"),
+        ],
     },
     Kind {
         name: "checkerboard",
@@ -951,6 +980,11 @@ fn texture(node: &Node, path: &str) -> Result<TextureDesc> {
         TextureKind::Scale => TextureDesc::Scale {
             texture: t.require("texture", what, color_or_texture)?,
             factor: t.require("factor", what, triple)?,
+        },
+        TextureKind::Mix => TextureDesc::Mix {
+            first: t.require("first", what, color_or_texture)?,
+            second: t.require("second", what, color_or_texture)?,
+            amount: t.require("amount", what, number_or_texture)?,
         },
         TextureKind::Checkerboard => TextureDesc::Checkerboard {
             even: t.require("even", what, color_or_texture)?,

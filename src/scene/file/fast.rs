@@ -18,7 +18,7 @@ use super::toml_cut;
 use super::Format;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ColorDesc, LightDesc, ObjectDesc, RenderDesc,
-    ScaleDesc, SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
+    ScalarDesc, ScaleDesc, SceneDesc, TextureDesc, TransformDesc, MAX_SEED,
 };
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -276,6 +276,18 @@ fn texture(t: &TextureDesc) -> bool {
     match t {
         TextureDesc::Checker { scale, even, odd } => finite(&[*scale]) && color(even) && color(odd),
         TextureDesc::Scale { texture, factor } => color(texture) && finite(factor),
+        TextureDesc::Mix {
+            first,
+            second,
+            amount,
+        } => {
+            color(first)
+                && color(second)
+                && match amount {
+                    ScalarDesc::Value(v) => finite(&[*v]),
+                    ScalarDesc::Texture(_) => true,
+                }
+        }
         TextureDesc::Checkerboard {
             even,
             odd,

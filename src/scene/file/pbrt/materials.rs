@@ -756,10 +756,48 @@ impl Builder {
                 );
                 Tex::Named(lumen)
             }
-            "checkerboard" | "mix" => {
-                let first = value(self, "tex1", if ty == "mix" { 0.0 } else { 1.0 })?;
+            "mix" => {
+                let first = value(self, "tex1", 0.0)?;
+                let second = value(self, "tex2", 1.0)?;
+                let amount = match p.float_or_texture("amount")? {
+                    None => ScalarDesc::Value(0.5),
+                    Some((Ok(v), vat)) if !(0.0..=1.0).contains(&v) => {
+                        return Err((
+                            vat,
+                            format!("`amount` must be within [0, 1], got {v}"),
+                            None,
+                        ))
+                    }
+                    Some((Ok(v), _)) => ScalarDesc::Value(v),
+                    Some((Err(t), tat)) => ScalarDesc::Texture(self.scalar_texture(&t, tat)?),
+                };
+                p.finish("a mix texture", &["tex1", "tex2", "amount"])?;
+                match (first, second, amount) {
+                    (Tex::Constant(a), Tex::Constant(b), ScalarDesc::Value(t)) => {
+                        Tex::Constant([0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t))
+                    }
+                    (first, second, amount) => {
+                        let colour = |t: Tex| match t {
+                            Tex::Constant(c) => ColorDesc::Rgb(c),
+                            Tex::Named(n) => ColorDesc::Texture(n),
+                        };
+                        let lumen = self.name("mix");
+                        self.desc.textures.insert(
+                            lumen.clone(),
+                            TextureDesc::Mix {
+                                first: colour(first),
+                                second: colour(second),
+                                amount,
+                            },
+                        );
+                        Tex::Named(lumen)
+                    }
+                }
+            }
+            "checkerboard" => {
+                let first = value(self, "tex1", 1.0)?;
                 p.ignore_all();
-                self.lacks(at, &format!("`{ty}` texture"), "its `tex1`")?;
+                self.lacks(at, "three-dimensional `checkerboard` texture", "its `tex1`")?;
                 first
             }
             other => {
