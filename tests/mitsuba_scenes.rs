@@ -229,7 +229,7 @@ fn includes_that_loop_or_leave_the_folder_and_unused_parameters_are_refused() {
 #[test]
 fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     let dir = scratch_dir("mitsuba_scenes_approximate");
-    let text = scene("  <shape type=\"disk\"/>\n  <shape type=\"serialized\"/>");
+    let text = scene("  <shape type=\"disk\"/>\n  <shape type=\"cylinder\"/>");
     let path = dir.join("s.xml");
     std::fs::write(&path, &text).unwrap();
     let options = mitsuba::Options {
@@ -245,7 +245,7 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("s.xml:3:3: a serialized shape")));
+        .any(|w| w.contains("s.xml:3:3: a cylinder shape")));
     file.compile(&Overrides::default()).unwrap();
 }
 
@@ -488,4 +488,197 @@ fn a_blendbsdf_is_a_mix_of_its_bsdfs() {
     let (a, b) = (render(&file), render(&exported));
     assert!(a.iter().any(|c| c.max_element() > 0.0));
     assert!(a == b, "the exported scene renders differently");
+}
+
+fn mitsuba_data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/mitsuba-data")
+}
+
+/// Mitsuba's test meshes in `.serialized` form (version 4) read as their
+/// PLY twins do: the same positions, normals and triangles, and texture
+/// coordinates with v turned over (the serialized files were written from
+/// OBJs, read flipped; Mitsuba's `test_mesh_io.py` checks the same), as
+/// Mitsuba reads both: as stored.
+#[test]
+fn serialized_meshes_read_as_their_ply_twins() {
+    for name in ["rectangle_normals", "rectangle_uv", "rectangle_normals_uv"] {
+        let dir = mitsuba_data().join("tests");
+        let a = lumen::mesh::load(&dir.join(format!("serialized/{name}.serialized")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let b = lumen::mesh::load(&dir.join(format!("ply/{name}.ply")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(a.meshes.len(), 1, "{name}");
+        let (a, b) = (&a.meshes[0], &b.meshes[0]);
+        assert_eq!(a.positions, b.positions, "{name}");
+        assert_eq!(a.normals, b.normals, "{name}");
+        let turned = b
+            .uvs
+            .as_ref()
+            .map(|uvs| uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect::<Vec<_>>());
+        let close = match (&a.uvs, &turned) {
+            (Some(a), Some(b)) => a
+                .iter()
+                .zip(b)
+                .all(|(p, q)| (p[0] - q[0]).abs() < 1e-6 && (p[1] - q[1]).abs() < 1e-6),
+            (None, None) => true,
+            _ => false,
+        };
+        assert!(close, "{name}: {:?} against {turned:?}", a.uvs);
+        assert_eq!(a.triangles, b.triangles, "{name}");
+        assert!(a.uvs.is_some() == name.contains("uv"), "{name}");
+    }
+}
+
+/// A `.serialized` file of several meshes (Mitsuba's material preview,
+/// version 3) is read whole, and each shape takes the mesh its
+/// `shape_index` names; an index past the last is refused.
+#[test]
+fn a_serialized_shape_takes_the_mesh_its_index_names() {
+    let file = mitsuba_data().join("scenes/matpreview/matpreview.serialized");
+    let model = lumen::mesh::load(&file).unwrap_or_else(|e| panic!("{e}"));
+    assert!(model.meshes.len() >= 3, "{} meshes", model.meshes.len());
+    assert!(model.meshes.iter().all(|m| !m.triangles.is_empty()));
+
+    let dir = scratch_dir("mitsuba_scenes_serialized");
+    std::fs::copy(&file, dir.join("m.serialized")).unwrap();
+    let shape = |index: usize| {
+        scene(&format!(
+            "  <shape type=\"serialized\"><string name=\"filename\" value=\"m.serialized\"/>\
+             <integer name=\"shape_index\" value=\"{index}\"/></shape>"
+        ))
+    };
+    let path = dir.join("s.xml");
+    std::fs::write(&path, shape(1)).unwrap();
+    let read =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let compiled = read
+        .compile(&Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        compiled.stats.placed_triangles as usize,
+        model.meshes[1].triangles.len()
+    );
+    let past = model.meshes.len();
+    let e = refused(&dir, "s.xml", &shape(past), &mitsuba::Options::default());
+    assert!(
+        e.contains("objects[0].part") && e.contains(&format!("no mesh {past}")),
+        "{e}"
+    );
+}
+
+/// Broken `.serialized` files are refused, naming the file and what is
+/// wrong: another format, a cut file, a table that points nowhere, and
+/// counts its compressed data could not hold (refused before anything is
+/// allocated for them).
+#[test]
+fn broken_serialized_files_are_refused() {
+    use flate2::{write::ZlibEncoder, Compression};
+    use std::io::Write;
+    let dir = scratch_dir("mitsuba_scenes_serialized_bad");
+    let good =
+        std::fs::read(mitsuba_data().join("tests/serialized/rectangle_normals_uv.serialized"))
+            .unwrap();
+    // A version 4 mesh declaring two billion vertices in a few bytes.
+    let mut z = ZlibEncoder::new(Vec::new(), Compression::default());
+    z.write_all(&1u32.to_le_bytes()).unwrap();
+    z.write_all(b"bomb\0").unwrap();
+    z.write_all(&2_000_000_000u64.to_le_bytes()).unwrap();
+    z.write_all(&1u64.to_le_bytes()).unwrap();
+    let mut bomb = vec![0x1C, 0x04, 0x04, 0x00];
+    bomb.extend(z.finish().unwrap());
+    bomb.extend(0u64.to_le_bytes());
+    bomb.extend(1u32.to_le_bytes());
+    let mut bad_table = good.clone();
+    let n = bad_table.len();
+    bad_table[n - 12..n - 4].copy_from_slice(&7u64.to_le_bytes());
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "ply",
+            b"ply\nformat ascii 1.0\n".to_vec(),
+            "does not start with 0x041C",
+        ),
+        ("cut", good[..good.len() / 2].to_vec(), "m.serialized"),
+        ("table", bad_table, "where no mesh of version 4 starts"),
+        ("bomb", bomb, "more than its compressed data can hold"),
+    ];
+    for (what, bytes, expected) in cases {
+        let path = dir.join("m.serialized");
+        std::fs::write(&path, &bytes).unwrap();
+        let e = lumen::mesh::load(&path)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.serialized") && e.contains(expected),
+            "{what}: {e}"
+        );
+    }
+}
+
+/// A version 5 file (Mitsuba's packed records: eight floats a vertex, four
+/// `u32`s a face, maps and attributes after them) reads as the mesh it
+/// packs; one that stores tangent frames is refused.
+#[test]
+fn version_5_serialized_meshes_read_their_packed_records() {
+    use flate2::{write::ZlibEncoder, Compression};
+    use std::io::Write;
+    let twin = lumen::mesh::load(&mitsuba_data().join("tests/ply/rectangle_normals_uv.ply"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mesh = &twin.meshes[0];
+    let pack = |layout: u32| {
+        let mut z = ZlibEncoder::new(Vec::new(), Compression::default());
+        let mut put = |b: &[u8]| z.write_all(b).unwrap();
+        put(&(0x1000 | layout).to_le_bytes());
+        put(&4u32.to_le_bytes());
+        put(b"rect");
+        let (v, f) = (mesh.positions.len() as u64, mesh.triangles.len() as u64);
+        for n in [v, f, v, 0] {
+            put(&n.to_le_bytes());
+        }
+        let normals = mesh.normals.as_ref().unwrap();
+        let uvs = mesh.uvs.as_ref().unwrap();
+        for i in 0..mesh.positions.len() {
+            for x in mesh.positions[i].iter().chain(&normals[i]).chain(&uvs[i]) {
+                put(&x.to_le_bytes());
+            }
+        }
+        for t in &mesh.triangles {
+            for i in t.iter().chain(&[0]) {
+                put(&i.to_le_bytes());
+            }
+        }
+        // The vertex-to-surface-point map (P = V), then one attribute.
+        for i in 0..v as u32 {
+            put(&i.to_le_bytes());
+        }
+        put(&1u32.to_le_bytes());
+        put(&11u32.to_le_bytes());
+        put(b"vertex_mark");
+        put(&[0u8]);
+        put(&1u32.to_le_bytes());
+        for _ in 0..v {
+            put(&0.5f32.to_le_bytes());
+        }
+        let mut bytes = vec![0x1C, 0x04, 0x05, 0x00];
+        bytes.extend(z.finish().unwrap());
+        bytes.extend(0u64.to_le_bytes());
+        bytes.extend(1u32.to_le_bytes());
+        bytes
+    };
+    let dir = scratch_dir("mitsuba_scenes_serialized_v5");
+    let path = dir.join("r.serialized");
+    std::fs::write(&path, pack(0x1 | 0x4)).unwrap();
+    let read = lumen::mesh::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let got = &read.meshes[0];
+    assert_eq!(got.positions, mesh.positions);
+    assert_eq!(got.normals, mesh.normals);
+    assert_eq!(got.uvs, mesh.uvs);
+    assert_eq!(got.triangles, mesh.triangles);
+
+    std::fs::write(&path, pack(0x1 | 0x2 | 0x4)).unwrap();
+    let e = lumen::mesh::load(&path)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("tangent frames"), "{e}");
 }

@@ -209,6 +209,7 @@ fn expected() -> SceneDesc {
             material: None,
             smooth: true,
             allow_outside: false,
+            part: None,
             transform: vec![TransformDesc::Matrix([
                 [1.0, 0.0, 0.0, 0.5],
                 [0.0, 1.0, 0.0, 0.0],
@@ -221,6 +222,7 @@ fn expected() -> SceneDesc {
             material: Some("gold".into()),
             smooth: false,
             allow_outside: false,
+            part: None,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [1.0, 1.0, 0.0],
@@ -354,6 +356,7 @@ fn every_step_form_reads_alone() {
                     material: None,
                     smooth: true,
                     allow_outside: false,
+                    part: None,
                     transform: vec![step.clone()],
                 },
             ),

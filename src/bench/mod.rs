@@ -96,6 +96,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
         material: Some("bunny".into()),
         smooth: false,
         allow_outside: false,
+        part: None,
         transform: Vec::new(),
     });
     desc
@@ -129,6 +130,7 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
             material: Some("bunny".into()),
             smooth: false,
             allow_outside: false,
+            part: None,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [0.0, 1.0, 0.0],

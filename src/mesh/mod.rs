@@ -1,6 +1,6 @@
 //! Triangle meshes from files: Wavefront OBJ (with its MTL materials),
-//! glTF 2.0 (`.gltf` with external or embedded buffers, and binary `.glb`)
-//! and Stanford PLY (ASCII or binary).
+//! glTF 2.0 (`.gltf` with external or embedded buffers, and binary `.glb`),
+//! Stanford PLY (ASCII or binary) and Mitsuba's `.serialized` meshes.
 //!
 //! [`load`] picks the loader by extension and returns a [`Model`]: indexed
 //! [`TriangleMesh`]es, their [`MeshMaterial`]s and the [`Model::instances`]
@@ -25,6 +25,7 @@ pub mod loop_subdivision;
 pub mod material;
 mod obj;
 mod ply;
+mod serialized;
 mod tangents;
 
 pub use material::{AlphaMode, Mapped, MeshMaterial};
@@ -371,7 +372,7 @@ impl fmt::Display for MeshError {
 }
 
 /// The file extensions [`load`] accepts.
-pub const SUPPORTED_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ply"];
+pub const SUPPORTED_EXTENSIONS: [&str; 5] = ["obj", "gltf", "glb", "ply", "serialized"];
 
 /// How a mesh file is read.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -405,6 +406,7 @@ pub fn load_with(path: &Path, options: LoadOptions) -> Result<Model, MeshError> 
         Some("gltf") | Some("glb") => gltf::load,
         // PLY names no other file.
         Some("ply") => |path, bytes, _| ply::load(path, bytes),
+        Some("serialized") => |path, bytes, _| serialized::load(path, bytes),
         _ => {
             return Err(MeshError::new(
                 path,

@@ -685,6 +685,7 @@ impl<'a> Objects<'a> {
                 material,
                 smooth,
                 allow_outside,
+                part,
                 ..
             } => {
                 let override_material = material
@@ -698,7 +699,7 @@ impl<'a> Objects<'a> {
                 self.place(
                     i,
                     file,
-                    path,
+                    (path, *part),
                     override_material,
                     *smooth,
                     &transform,
@@ -736,30 +737,49 @@ impl<'a> Objects<'a> {
                 );
                 let label = format!("the triangles of objects[{i}]");
                 let smooth = normals.is_some();
-                self.place(i, &label, path, Some(material), smooth, &transform, motion)?;
+                self.place(
+                    i,
+                    &label,
+                    (path, None),
+                    Some(material),
+                    smooth,
+                    &transform,
+                    motion,
+                )?;
             }
         }
         Ok(())
     }
 
     /// Places every mesh of the loaded model at `path` (`file` names it in
-    /// messages) by `transform`, moving by `motion`, in `material` or the
-    /// model's own.
+    /// messages), or only its mesh `part`, by `transform`, moving by
+    /// `motion`, in `material` or the model's own.
     #[allow(clippy::too_many_arguments)]
     fn place(
         &mut self,
         i: usize,
         file: &str,
-        path: PathBuf,
+        (path, part): (PathBuf, Option<u32>),
         override_material: Option<u32>,
         smooth: bool,
         transform: &Transform,
         motion: Vec3,
     ) -> Result<(), SceneError> {
         let model = &self.models[&path].model;
+        if let Some(part) = part.filter(|&p| p as usize >= model.meshes.len()) {
+            let n = model.meshes.len();
+            return Err(invalid(
+                format!("objects[{i}].part"),
+                format!(
+                    "{file} holds {n} mesh{}, numbered from 0; there is no mesh {part}",
+                    if n == 1 { "" } else { "es" }
+                ),
+            ));
+        }
+        let chosen = |mesh: usize| part.is_none_or(|p| p as usize == mesh);
         // Counted before they are taken: a file of many nodes placed
         // by many objects multiplies.
-        let more = model.instances.len() as u64;
+        let more = model.instances.iter().filter(|(m, _)| chosen(*m)).count() as u64;
         let total = self.placements.len() as u64 + more;
         if total > MAX_INSTANCES {
             return Err(invalid(
@@ -785,7 +805,7 @@ impl<'a> Objects<'a> {
                 format!("{file}: {e}"),
             ));
         }
-        for (mesh, node) in &model.instances {
+        for (mesh, node) in model.instances.iter().filter(|(m, _)| chosen(*m)) {
             let node = mat4_transform(node).ok_or_else(|| {
                 invalid(
                     format!("objects[{i}].file"),

@@ -671,7 +671,8 @@ pub enum ObjectDesc {
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
     },
-    /// A triangle mesh read from a file (.obj, .gltf or .glb).
+    /// A triangle mesh read from a file (.obj, .gltf, .glb, .ply or
+    /// Mitsuba's .serialized).
     Mesh {
         /// The file, relative to the scene file.
         file: String,
@@ -689,6 +690,11 @@ pub enum ObjectDesc {
         /// [`LoadOptions`](crate::mesh::LoadOptions).
         #[serde(default, skip_serializing_if = "is_false")]
         allow_outside: bool,
+        /// Only the file's mesh of this index (from 0), placed where the
+        /// file places it: one of the meshes of a Mitsuba `.serialized`
+        /// file (its `shape_index`); all when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        part: Option<u32>,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,

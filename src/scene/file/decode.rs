@@ -1082,6 +1082,7 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             "material",
             "smooth",
             "allow_outside",
+            "part",
             "transform",
         ],
         elsewhere: &[
@@ -1191,6 +1192,9 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             material: t.optional("material", string)?.map(str::to_string),
             smooth: t.optional("smooth", boolean)?.unwrap_or(true),
             allow_outside: t.optional("allow_outside", boolean)?.unwrap_or(false),
+            part: t
+                .optional("part", |n, p| integer(n, p, 0, u64::from(u32::MAX)))?
+                .map(|n| n as u32),
             transform,
         },
         ObjectKind::Triangles => ObjectDesc::Triangles {

@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 const SHAPES: &[&str] = &[
     "obj",
     "ply",
+    "serialized",
     "sphere",
     "rectangle",
     "cube",
@@ -876,28 +877,40 @@ impl<'d> Convert<'d> {
             }
         };
         let object = match t {
-            "obj" | "ply" => {
-                known.extend(["filename", "face_normals", "flip_tex_coords"]);
+            "obj" | "ply" | "serialized" => {
+                known.extend(["filename", "face_normals"]);
                 let (name, at) = p
                     .string_at("filename", self)?
                     .ok_or_else(|| self.fail(e, format!("a {t} shape needs a `filename`")))?;
                 let file = self.file(name, at)?;
                 let flat = p.boolean("face_normals", self)?.unwrap_or(false);
-                // lumen reads OBJ texture coordinates as Mitsuba does by
-                // default (flipped to v down the image), PLY's as written.
-                let flip = p.boolean("flip_tex_coords", self)?;
-                if flip.is_some_and(|f| f != (t == "obj")) {
-                    self.lacks(
-                        e,
-                        "flip_tex_coords other than the format's default",
-                        "the default",
-                    )?;
-                }
+                let part = if t == "serialized" {
+                    // Serialized texture coordinates are read as written.
+                    known.push("shape_index");
+                    match p.integer("shape_index", self)?.unwrap_or(0) {
+                        i @ 0..=0xFFFF_FFFF => Some(i as u32),
+                        i => return Err(self.fail(e, format!("shape_index must be ≥ 0, got {i}"))),
+                    }
+                } else {
+                    // lumen reads OBJ texture coordinates as Mitsuba does by
+                    // default (flipped to v down the image), PLY's as written.
+                    known.push("flip_tex_coords");
+                    let flip = p.boolean("flip_tex_coords", self)?;
+                    if flip.is_some_and(|f| f != (t == "obj")) {
+                        self.lacks(
+                            e,
+                            "flip_tex_coords other than the format's default",
+                            "the default",
+                        )?;
+                    }
+                    None
+                };
                 ObjectDesc::Mesh {
                     file,
                     material: Some(material),
                     smooth: !flat,
                     allow_outside: false,
+                    part,
                     transform: matrix(&m),
                 }
             }
@@ -951,11 +964,6 @@ impl<'d> Convert<'d> {
                 let mut t = matrix(&m);
                 t.insert(0, TransformDesc::Translate([p0[0], p0[1], 0.0]));
                 tessellate::object(tessellate::cylinder(radius, p0[2], p1[2]), material, t)
-            }
-            "serialized" => {
-                p.finish(&[], self).ok();
-                self.lacks(e, &format!("a {t} shape"), "nothing")?;
-                return Ok(());
             }
             "shapegroup" => {
                 return Err(self.fail(

@@ -205,6 +205,7 @@ impl Builder {
                     material: Some(material),
                     smooth: true,
                     allow_outside: false,
+                    part: None,
                     transform,
                 });
             }
