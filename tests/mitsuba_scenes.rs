@@ -495,10 +495,11 @@ fn mitsuba_data() -> PathBuf {
 }
 
 /// Mitsuba's test meshes in `.serialized` form (version 4) read as their
-/// PLY twins do: the same positions, normals and triangles, and texture
-/// coordinates with v turned over (the serialized files were written from
-/// OBJs, read flipped; Mitsuba's `test_mesh_io.py` checks the same), as
-/// Mitsuba reads both: as stored.
+/// PLY twins do: the same positions, normals and triangles, and the same
+/// texture coordinates. The serialized files were written from OBJs, so
+/// they store v down the image, as Mitsuba reads OBJs (its
+/// `test_mesh_io.py` checks 1 − v); turned into lumen's v up the image,
+/// they are the PLY's as written.
 #[test]
 fn serialized_meshes_read_as_their_ply_twins() {
     for name in ["rectangle_normals", "rectangle_uv", "rectangle_normals_uv"] {
@@ -511,11 +512,7 @@ fn serialized_meshes_read_as_their_ply_twins() {
         let (a, b) = (&a.meshes[0], &b.meshes[0]);
         assert_eq!(a.positions, b.positions, "{name}");
         assert_eq!(a.normals, b.normals, "{name}");
-        let turned = b
-            .uvs
-            .as_ref()
-            .map(|uvs| uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect::<Vec<_>>());
-        let close = match (&a.uvs, &turned) {
+        let close = match (&a.uvs, &b.uvs) {
             (Some(a), Some(b)) => a
                 .iter()
                 .zip(b)
@@ -523,7 +520,7 @@ fn serialized_meshes_read_as_their_ply_twins() {
             (None, None) => true,
             _ => false,
         };
-        assert!(close, "{name}: {:?} against {turned:?}", a.uvs);
+        assert!(close, "{name}: {:?} against {:?}", a.uvs, b.uvs);
         assert_eq!(a.triangles, b.triangles, "{name}");
         assert!(a.uvs.is_some() == name.contains("uv"), "{name}");
     }
@@ -638,7 +635,9 @@ fn version_5_serialized_meshes_read_their_packed_records() {
         let normals = mesh.normals.as_ref().unwrap();
         let uvs = mesh.uvs.as_ref().unwrap();
         for i in 0..mesh.positions.len() {
-            for x in mesh.positions[i].iter().chain(&normals[i]).chain(&uvs[i]) {
+            // Mitsuba's v runs down the image, lumen's up.
+            let uv = [uvs[i][0], 1.0 - uvs[i][1]];
+            for x in mesh.positions[i].iter().chain(&normals[i]).chain(&uv) {
                 put(&x.to_le_bytes());
             }
         }
@@ -672,7 +671,17 @@ fn version_5_serialized_meshes_read_their_packed_records() {
     let got = &read.meshes[0];
     assert_eq!(got.positions, mesh.positions);
     assert_eq!(got.normals, mesh.normals);
-    assert_eq!(got.uvs, mesh.uvs);
+    let uvs = |m: &lumen::mesh::TriangleMesh| m.uvs.clone().unwrap_or_default();
+    assert!(
+        uvs(got)
+            .iter()
+            .zip(&uvs(mesh))
+            .all(|(p, q)| (p[0] - q[0]).abs() < 1e-6 && (p[1] - q[1]).abs() < 1e-6),
+        "{:?} against {:?}",
+        got.uvs,
+        mesh.uvs
+    );
+    assert_eq!(uvs(got).len(), 4);
     assert_eq!(got.triangles, mesh.triangles);
 
     std::fs::write(&path, pack(0x1 | 0x2 | 0x4)).unwrap();
@@ -681,4 +690,123 @@ fn version_5_serialized_meshes_read_their_packed_records() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("tangent frames"), "{e}");
+}
+
+/// An envmap's `to_world` of any rotation is lumen's map in that frame:
+/// turned about +y it is a `rotation` (as before); turned otherwise (a
+/// z-up scene's sky) a `frame`, which shows the same sky along the same
+/// directions as the rotation would; a scale or a mirror is refused.
+#[test]
+fn an_envmap_turned_any_way_keeps_its_orientation() {
+    use lumen::scene::desc::BackgroundDesc;
+    let dir = scratch_dir("mitsuba_scenes_envmap_frame");
+    let museum = data().join("../../common/textures/museum.exr");
+    std::fs::copy(museum, dir.join("sky.exr")).unwrap();
+    let read = |turn: &str| {
+        let path = dir.join("s.xml");
+        std::fs::write(
+            &path,
+            scene(&format!(
+                "  <emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>\
+                 <transform name=\"to_world\">{turn}</transform></emitter>"
+            )),
+        )
+        .unwrap();
+        SceneFile::read_with(&path, &mitsuba::Options::default())
+    };
+    let background = |f: &SceneFile| match &f.desc.background {
+        BackgroundDesc::Image {
+            rotation, frame, ..
+        } => (*rotation, *frame),
+        other => panic!("{other:?}"),
+    };
+    let about_y = read("<rotate y=\"1\" angle=\"30\"/>").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(background(&about_y), (210.0, None));
+
+    let up_z = read("<rotate x=\"1\" angle=\"90\"/>").unwrap_or_else(|e| panic!("{e}"));
+    let (rotation, frame) = background(&up_z);
+    let frame = frame.expect("a frame");
+    assert_eq!(rotation, 180.0);
+    let want = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]];
+    for (a, b) in frame.iter().flatten().zip(want.iter().flatten()) {
+        assert!((a - b).abs() < 1e-9, "{frame:?}");
+    }
+
+    // The turn about +y written as a frame shows the same sky.
+    let mut framed = about_y.clone();
+    let t = 30f64.to_radians();
+    framed.desc.background = match &about_y.desc.background {
+        BackgroundDesc::Image {
+            file,
+            intensity,
+            rows_at_poles,
+            layout,
+            ..
+        } => BackgroundDesc::Image {
+            file: file.clone(),
+            rotation: 180.0,
+            intensity: *intensity,
+            rows_at_poles: *rows_at_poles,
+            layout: *layout,
+            frame: Some([
+                [t.cos(), 0.0, -t.sin()],
+                [0.0, 1.0, 0.0],
+                [t.sin(), 0.0, t.cos()],
+            ]),
+        },
+        other => panic!("{other:?}"),
+    };
+    let (a, b) = (
+        about_y.compile(&Overrides::default()).unwrap(),
+        framed.compile(&Overrides::default()).unwrap(),
+    );
+    for i in 0..200 {
+        let (y, phi) = (-0.99 + 1.98 * (i as f32 / 200.0), i as f32 * 2.39996);
+        let r = (1.0 - y * y).sqrt();
+        let d = lumen::math::Vec3::new(r * phi.cos(), y, r * phi.sin());
+        let (p, q) = (a.background.color(d), b.background.color(d));
+        assert!(
+            (p - q).abs().max_element() < 1e-3 * (1.0 + p.max_element()),
+            "{d:?}: {p:?} against {q:?}"
+        );
+    }
+
+    for bad in ["<scale value=\"2\"/>", "<scale x=\"-1\"/>"] {
+        let e = read(bad).map(|_| ()).unwrap_err().to_string();
+        assert!(e.contains("must turn it"), "{bad}: {e}");
+    }
+}
+
+/// Mitsuba's material preview scene (three meshes of one `.serialized`
+/// file, a sky turned to z up, a checkerboard floor) reads, renders, and
+/// renders to the same bits from its TOML export.
+#[test]
+fn the_material_preview_scene_renders_and_exports() {
+    let path = mitsuba_data().join("scenes/matpreview/matpreview.xml");
+    let options = mitsuba::Options {
+        defines: vec![
+            ("spp".into(), "2".into()),
+            ("width".into(), "68".into()),
+            ("height".into(), "51".into()),
+        ],
+        ..Default::default()
+    };
+    let direct = SceneFile::read_with(&path, &options).unwrap_or_else(|e| panic!("{e}"));
+    let text = lumen::scene::file::export(&direct.desc, Format::Toml).unwrap();
+    let mut exported =
+        SceneFile::parse("exported.toml", text, Format::Toml).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(exported.desc, direct.desc);
+    exported.dir = direct.dir.clone();
+    let model = lumen::mesh::load(&mitsuba_data().join("scenes/matpreview/matpreview.serialized"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    // Shapes 0, 1 and 2 of the file, each placed once.
+    let parts: usize = model.meshes[..3].iter().map(|m| m.triangles.len()).sum();
+    let render = |f: &SceneFile| {
+        let scene = f.compile(&Overrides::default()).unwrap();
+        assert_eq!(scene.stats.placed_triangles as usize, parts);
+        lumen::render::render(&scene, &|_| {}).0.linear()
+    };
+    let (a, b) = (render(&direct), render(&exported));
+    assert!(a.iter().any(|c| c.max_element() > 0.1), "black");
+    assert!(a == b, "the exported scene renders differently");
 }

@@ -149,6 +149,10 @@ pub struct EnvironmentMap {
     /// [`EnvironmentMap::equal_area`]): the map's x, y and z axes in the
     /// world.
     equal_area: Option<[Vec3; 3]>,
+    /// For an equirectangular map turned by more than a turn about +y
+    /// (see [`EnvironmentMap::with_frame`]): its x, y and z axes in the
+    /// world.
+    frame: Option<[Vec3; 3]>,
 }
 
 /// The point of the unit square of the equal-area octahedral layout
@@ -248,6 +252,7 @@ impl EnvironmentMap {
             integral,
             rows_at_poles: false,
             equal_area: None,
+            frame: None,
         })
     }
 
@@ -287,7 +292,25 @@ impl EnvironmentMap {
             integral,
             rows_at_poles: false,
             equal_area: Some(frame),
+            frame: None,
         }))
+    }
+
+    /// The equirectangular map with its x, y and z axes `frame` in the
+    /// world (orthonormal), turned by its rotation within that frame: a map
+    /// whose top is not up (a scene whose up is +z).
+    pub fn with_frame(mut self, frame: [Vec3; 3]) -> Self {
+        self.frame = Some(frame);
+        self
+    }
+
+    /// World direction `d` in the equirectangular map's frame.
+    #[inline]
+    fn local(&self, d: Vec3) -> Vec3 {
+        match self.frame {
+            Some([x, y, z]) => Vec3::new(x.dot(d), y.dot(d), z.dot(d)),
+            None => d,
+        }
     }
 
     /// The image's (u, v) seen along unit world `direction`.
@@ -297,6 +320,7 @@ impl EnvironmentMap {
             let d = Vec3::new(x.dot(direction), y.dot(direction), z.dot(direction));
             return equal_area_square(d);
         }
+        let direction = self.local(direction);
         // Into the image's frame: turned back by the rotation.
         let (s, c) = self.rotation;
         let x = c * direction.x - s * direction.z;
@@ -317,7 +341,11 @@ impl EnvironmentMap {
         let (sin_phi, cos_phi) = (-s_u, -c_u);
         let (x, z) = (sin_theta * sin_phi, -sin_theta * cos_phi);
         let (s, c) = self.rotation;
-        let world = Vec3::new(c * x + s * z, cos_theta, -s * x + c * z);
+        let turned = Vec3::new(c * x + s * z, cos_theta, -s * x + c * z);
+        let world = match self.frame {
+            Some([fx, fy, fz]) => fx * turned.x + fy * turned.y + fz * turned.z,
+            None => turned,
+        };
         (world, sin_theta)
     }
 
@@ -358,7 +386,8 @@ impl EnvironmentMap {
         if self.equal_area.is_some() {
             return self.distribution.density(self.uv(direction)) / (4.0 * PI);
         }
-        let sin_theta = (direction.x * direction.x + direction.z * direction.z).sqrt();
+        let d = self.local(direction);
+        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
         if !(sin_theta > 0.0) {
             return 0.0;
         }

@@ -12,6 +12,9 @@
 //! need, and custom attributes, which are skipped. Every mesh of the file
 //! becomes a mesh of the model, placed once where it is (a scene picks one
 //! by its index, Mitsuba's `shape_index`).
+//!
+//! Texture coordinates are Mitsuba's, v down the image (v = 0 its top
+//! row); lumen's v runs up the image, so v is turned over as it is read.
 
 use super::{MeshError, Model, TriangleMesh, NO_MATERIAL};
 use flate2::read::ZlibDecoder;
@@ -194,7 +197,7 @@ fn read_mesh(bytes: &[u8]) -> Result<(TriangleMesh, usize), String> {
                 (0..count)
                     .map(|i| {
                         let v = vertex(i, 6..8);
-                        [v[0], v[1]]
+                        [v[0], 1.0 - v[1]]
                     })
                     .collect()
             }),
@@ -224,7 +227,7 @@ fn read_mesh(bytes: &[u8]) -> Result<(TriangleMesh, usize), String> {
         TriangleMesh {
             positions: triples(positions),
             normals: normal_values.filter(|_| !flat).map(triples),
-            uvs: uv_values.map(|v| v.chunks_exact(2).map(|c| [c[0], c[1]]).collect()),
+            uvs: uv_values.map(|v| v.chunks_exact(2).map(|c| [c[0], 1.0 - c[1]]).collect()),
             ..TriangleMesh::default()
         }
         .with_faces(indices.chunks_exact(3).map(|f| [f[0], f[1], f[2]]))

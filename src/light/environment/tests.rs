@@ -303,3 +303,38 @@ fn an_equal_area_sky_is_sampled_by_its_brightness_and_integrates_to_its_integral
     let world = Vec3::X * sun.x + Vec3::NEG_Z * sun.y + Vec3::Y * sun.z;
     assert_eq!(env.color(world), Color::new(600.0, 400.0, 200.0));
 }
+
+/// A map turned by a frame (its axes in the world: here its top along +z,
+/// as a z-up scene has it) shows along F·d what the unturned map shows
+/// along d, with the density it has there; its samples are the unturned
+/// map's turned, and follow its pdf.
+#[test]
+fn a_framed_map_is_the_map_turned_into_its_frame() {
+    let frame = [
+        Vec3::new(0.6, 0.8, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.8, -0.6, 0.0),
+    ];
+    let plain = test_map(30.0);
+    let framed = test_map(30.0).with_frame(frame);
+    let turn = |d: Vec3| frame[0] * d.x + frame[1] * d.y + frame[2] * d.z;
+    let mut rng = Rng::new(5);
+    for _ in 0..1000 {
+        // Uniform on the sphere: y uniform in [-1, 1], azimuth uniform.
+        let (y, phi) = (2.0 * rng.next_f32() - 1.0, 2.0 * PI * rng.next_f32());
+        let r = (1.0 - y * y).max(0.0).sqrt();
+        let d = Vec3::new(r * phi.cos(), y, r * phi.sin());
+        let (a, b) = (plain.color(d), framed.color(turn(d)));
+        assert!(
+            (a - b).abs().max_element() < 1e-3 * (1.0 + a.max_element()),
+            "{a:?} {b:?}"
+        );
+        let (p, q) = (plain.pdf(d), framed.pdf(turn(d)));
+        assert!((p - q).abs() < 1e-3 * p.max(1e-3), "{p} {q}");
+        let u = [rng.next_f32(), rng.next_f32()];
+        if let (Some((x, _)), Some((y, _))) = (plain.sample(u), framed.sample(u)) {
+            assert!((turn(x) - y).length() < 1e-5, "{x:?} {y:?}");
+        }
+    }
+    assert_samples_follow_pdf("framed map", &Environment::Map(Arc::new(framed)));
+}

@@ -258,26 +258,7 @@ fn compile_background(
                     "an equal-area map turns by its `frame`; `rotation` and `rows_at_poles` are for equirectangular maps",
                 ));
             }
-            let axes = match frame {
-                None => [Vec3::X, Vec3::Y, Vec3::Z],
-                Some(f) => {
-                    finite("background.frame", &f.concat())?;
-                    let axes = f.map(vec3);
-                    let orthonormal = (0..3).all(|i| {
-                        (0..3).all(|j| {
-                            let want = if i == j { 1.0 } else { 0.0 };
-                            (axes[i].dot(axes[j]) - want).abs() < 1e-4
-                        })
-                    });
-                    if !orthonormal {
-                        return Err(invalid(
-                            "background.frame",
-                            "must be three unit axes at right angles (a rotation)",
-                        ));
-                    }
-                    axes
-                }
-            };
+            let axes = frame_axes(frame)?.unwrap_or([Vec3::X, Vec3::Y, Vec3::Z]);
             let image = read_image("background.file", base, file, sources)?;
             match EnvironmentMap::equal_area(image, axes, *intensity as f32)
                 .map_err(|e| invalid("background.file", format!("{file}: {e}")))?
@@ -291,6 +272,7 @@ fn compile_background(
             rotation,
             intensity,
             rows_at_poles,
+            frame,
             ..
         } => {
             finite("background.rotation", &[*rotation])?;
@@ -301,10 +283,18 @@ fn compile_background(
                     format!("must not be negative, got {intensity}"),
                 ));
             }
+            let axes = frame_axes(frame)?;
             let image = read_image("background.file", base, file, sources)?;
             match EnvironmentMap::new(image, *rotation as f32, *intensity as f32) {
-                Some(map) if *rows_at_poles => Environment::Map(Arc::new(map.with_rows_at_poles())),
-                Some(map) => Environment::Map(Arc::new(map)),
+                Some(mut map) => {
+                    if *rows_at_poles {
+                        map = map.with_rows_at_poles();
+                    }
+                    if let Some(axes) = axes {
+                        map = map.with_frame(axes);
+                    }
+                    Environment::Map(Arc::new(map))
+                }
                 // Black everywhere: it sheds no light.
                 None => Environment::Solid(Color::ZERO),
             }
@@ -1407,6 +1397,29 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         shading: r.shading,
         pixel_filter: (r.pixel_filter, r.filter_stddev),
     })
+}
+
+/// An environment image's `frame`, checked: three unit axes at right
+/// angles.
+fn frame_axes(frame: &Option<[super::desc::Triple; 3]>) -> Result<Option<[Vec3; 3]>, SceneError> {
+    let Some(f) = frame else {
+        return Ok(None);
+    };
+    finite("background.frame", &f.concat())?;
+    let axes = f.map(vec3);
+    let orthonormal = (0..3).all(|i| {
+        (0..3).all(|j| {
+            let want = if i == j { 1.0 } else { 0.0 };
+            (axes[i].dot(axes[j]) - want).abs() < 1e-4
+        })
+    });
+    if !orthonormal {
+        return Err(invalid(
+            "background.frame",
+            "must be three unit axes at right angles (a rotation)",
+        ));
+    }
+    Ok(Some(axes))
 }
 
 /// The seed, or refuses one above [`MAX_SEED`] (given by a program or the library's

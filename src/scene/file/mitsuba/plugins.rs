@@ -406,6 +406,12 @@ impl<'d> Convert<'d> {
             "principal_point_offset_y",
             "srf",
         ];
+        if t == "perspective" {
+            // Every Mitsuba camera has one; a pinhole is in focus
+            // everywhere.
+            let _ = p.float("focus_distance", self)?;
+            known.push("focus_distance");
+        }
         // The film first: the field of view depends on its shape.
         let films = p.objects("film");
         let samplers = p.objects("sampler");
@@ -711,18 +717,16 @@ impl<'d> Convert<'d> {
                     let file = self.file(name, at)?;
                     let scale = p.float("scale", self)?.unwrap_or(1.0);
                     let m = p.transform("to_world", self)?.unwrap_or(IDENTITY);
-                    let rotation = self.about_y(e, &m)?;
+                    let (rotation, frame) = self.envmap_orientation(e, &m)?;
                     let _ = p.boolean("mis_compensation", self)?;
                     p.finish(&["filename", "scale", "to_world", "mis_compensation"], self)?;
-                    // Mitsuba's image centre looks along +z, lumen's along
-                    // -z: half a turn apart.
                     self.desc.background = BackgroundDesc::Image {
                         file,
-                        rotation: (180.0 + rotation).rem_euclid(360.0),
+                        rotation,
                         intensity: scale,
                         rows_at_poles: true,
                         layout: Default::default(),
-                        frame: None,
+                        frame,
                     };
                 }
                 // Mitsuba samples its environment as a light.
@@ -816,24 +820,38 @@ impl<'d> Convert<'d> {
 
     /// The turn about +y, in degrees, that `m` is; refused (or taken as
     /// its turn about y) when it is any other transform.
-    fn about_y(&mut self, e: &Element, m: &Mat4) -> Result<f64, Failure> {
-        let x = transform::vector(m, [1.0, 0.0, 0.0]);
-        let y = transform::vector(m, [0.0, 1.0, 0.0]);
-        let turn = x[2].atan2(x[0]);
-        let pure = (y[0].abs() < 1e-6 && (y[1] - 1.0).abs() < 1e-6 && y[2].abs() < 1e-6)
-            && (x[1].abs() < 1e-6 && (x[0].hypot(x[2]) - 1.0).abs() < 1e-6)
-            && m[0][3] == 0.0
-            && m[1][3] == 0.0
-            && m[2][3] == 0.0;
-        if !pure {
-            self.lacks(
+    /// An environment map's orientation from its `to_world` `m`: a turn
+    /// about +y in degrees (lumen's `rotation`, Mitsuba's half-turn apart
+    /// added), and the map's axes in the world when it turns otherwise
+    /// (lumen's `frame`). Its translation does not matter (the map is at
+    /// infinity); a scale, shear or mirror is refused.
+    fn envmap_orientation(
+        &mut self,
+        e: &Element,
+        m: &Mat4,
+    ) -> Result<(f64, Option<[[f64; 3]; 3]>), Failure> {
+        let axes =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|v| transform::vector(m, v));
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let rotation = (0..3).all(|i| {
+            (0..3).all(|j| (dot(axes[i], axes[j]) - f64::from(u8::from(i == j))).abs() < 1e-4)
+        }) && crate::scene::file::matrix::det3(m) > 0.0;
+        if !rotation {
+            return Err(self.fail(
                 e,
-                "an environment map's to_world that is not a turn about +y",
-                "its turn about +y",
-            )?;
+                "an environment map's to_world must turn it (no scale, shear or mirror)".into(),
+            ));
         }
-        // Counter-clockwise seen from above (+y) turns +x towards -z.
-        Ok((-turn).to_degrees())
+        let [x, y, _] = axes;
+        let about_y = y[0].abs() < 1e-6 && (y[1] - 1.0).abs() < 1e-6 && y[2].abs() < 1e-6;
+        // Mitsuba's image centre looks along +z, lumen's along -z: half a
+        // turn apart.
+        if about_y {
+            // Counter-clockwise seen from above (+y) turns +x towards -z.
+            let turn = -x[2].atan2(x[0]).to_degrees();
+            return Ok(((180.0 + turn).rem_euclid(360.0), None));
+        }
+        Ok((180.0, Some(axes)))
     }
 
     // ----------------------------------------------------------------
