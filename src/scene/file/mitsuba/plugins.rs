@@ -20,7 +20,7 @@ use crate::material::{
 use crate::scene::desc::{
     BackgroundDesc, CameraDesc, ColorDesc, EncodingDesc, FilterDesc, LightDesc, ObjectDesc,
     PixelFilterDesc, RoughnessDesc, SamplingDesc, ScalarDesc, SceneDesc, TextureDesc,
-    TransformDesc, WrapDesc,
+    TransformDesc, Triple, WrapDesc,
 };
 use crate::scene::file::tessellate;
 use std::collections::HashMap;
@@ -829,7 +829,7 @@ impl<'d> Convert<'d> {
         &mut self,
         e: &Element,
         m: &Mat4,
-    ) -> Result<(f64, Option<[[f64; 3]; 3]>), Failure> {
+    ) -> Result<(f64, Option<[Triple; 3]>), Failure> {
         let axes =
             [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|v| transform::vector(m, v));
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
