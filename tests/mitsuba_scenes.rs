@@ -810,3 +810,58 @@ fn the_material_preview_scene_renders_and_exports() {
     assert!(a.iter().any(|c| c.max_element() > 0.1), "black");
     assert!(a == b, "the exported scene renders differently");
 }
+
+/// Mitsuba takes a PLY's texture coordinates as written, v down the image;
+/// lumen's v runs up it, so a Mitsuba `ply` shape is read with `flip_v`,
+/// which turns every v over (1 − v), and an OBJ's without.
+#[test]
+fn a_ply_shapes_texture_coordinates_are_turned_over() {
+    use lumen::scene::desc::ObjectDesc;
+    let dir = scratch_dir("mitsuba_scenes_ply_uv");
+    let ply = mitsuba_data().join("tests/ply/rectangle_uv.ply");
+    std::fs::copy(&ply, dir.join("r.ply")).unwrap();
+    std::fs::write(
+        dir.join("r.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0.25\nvt 1 0.25\nvt 1 1\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let path = dir.join("s.xml");
+    std::fs::write(
+        &path,
+        scene(
+            "  <shape type=\"ply\"><string name=\"filename\" value=\"r.ply\"/></shape>\n\
+             <shape type=\"obj\"><string name=\"filename\" value=\"r.obj\"/></shape>",
+        ),
+    )
+    .unwrap();
+    let file =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let flips: Vec<bool> = file
+        .desc
+        .objects
+        .iter()
+        .map(|o| match o {
+            ObjectDesc::Mesh { flip_v, .. } => *flip_v,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(flips, [true, false]);
+    file.compile(&Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+
+    let load = |flip_v| {
+        let options = lumen::mesh::LoadOptions {
+            flip_v,
+            ..Default::default()
+        };
+        lumen::mesh::load_with(&ply, options).unwrap().meshes[0]
+            .uvs
+            .clone()
+            .unwrap()
+    };
+    let (plain, turned) = (load(false), load(true));
+    assert!(plain
+        .iter()
+        .zip(&turned)
+        .all(|(a, b)| a[0] == b[0] && (a[1] + b[1] - 1.0).abs() < 1e-6));
+}

@@ -210,6 +210,7 @@ fn expected() -> SceneDesc {
             smooth: true,
             allow_outside: false,
             part: None,
+            flip_v: false,
             transform: vec![TransformDesc::Matrix([
                 [1.0, 0.0, 0.0, 0.5],
                 [0.0, 1.0, 0.0, 0.0],
@@ -223,6 +224,7 @@ fn expected() -> SceneDesc {
             smooth: false,
             allow_outside: false,
             part: None,
+            flip_v: false,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [1.0, 1.0, 0.0],
@@ -357,6 +359,7 @@ fn every_step_form_reads_alone() {
                     smooth: true,
                     allow_outside: false,
                     part: None,
+                    flip_v: false,
                     transform: vec![step.clone()],
                 },
             ),

@@ -97,6 +97,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
         smooth: false,
         allow_outside: false,
         part: None,
+        flip_v: false,
         transform: Vec::new(),
     });
     desc
@@ -131,6 +132,7 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
             smooth: false,
             allow_outside: false,
             part: None,
+            flip_v: false,
             transform: vec![
                 TransformDesc::Rotate {
                     axis: [0.0, 1.0, 0.0],

@@ -382,6 +382,10 @@ pub struct LoadOptions {
     /// scene files and models travel, and a model must not read the machine
     /// it is rendered on (`"uri": "/etc/passwd"`).
     pub allow_outside: bool,
+    /// Turn texture coordinates over (v becomes 1 − v) for a file written
+    /// with v down the image, as Mitsuba reads PLY files, where lumen's v
+    /// runs up it.
+    pub flip_v: bool,
 }
 
 /// Loads a mesh file, choosing the format by extension (case-insensitive):
@@ -425,6 +429,13 @@ pub fn load_with(path: &Path, options: LoadOptions) -> Result<Model, MeshError> 
         file_len,
         ..format(path, bytes, options)?
     };
+    if options.flip_v {
+        for mesh in &mut model.meshes {
+            for uv in mesh.uvs.iter_mut().chain(&mut mesh.uvs1).flatten() {
+                uv[1] = 1.0 - uv[1];
+            }
+        }
+    }
     model.generate_tangents();
     Ok(model)
 }

@@ -676,6 +676,7 @@ impl<'a> Objects<'a> {
                 smooth,
                 allow_outside,
                 part,
+                flip_v,
                 ..
             } => {
                 let override_material = material
@@ -684,6 +685,7 @@ impl<'a> Objects<'a> {
                     .transpose()?;
                 let options = mesh::LoadOptions {
                     allow_outside: *allow_outside,
+                    flip_v: *flip_v,
                 };
                 let path = self.load(i, file, options)?;
                 self.place(
@@ -828,8 +830,17 @@ impl<'a> Objects<'a> {
         options: mesh::LoadOptions,
     ) -> Result<PathBuf, SceneError> {
         let path = model_path(self.base, file);
-        if self.models.contains_key(&path) {
-            return Ok(path);
+        // A file read with its texture coordinates turned over is another
+        // model (no file's name holds a NUL).
+        let key = if options.flip_v {
+            let mut key = path.clone().into_os_string();
+            key.push("\0flip_v");
+            PathBuf::from(key)
+        } else {
+            path.clone()
+        };
+        if self.models.contains_key(&key) {
+            return Ok(key);
         }
         let fail = |message: String| invalid(format!("objects[{i}].file"), message);
         let model = mesh::load_with(&path, options).map_err(|e| fail(e.to_string()))?;
@@ -842,8 +853,8 @@ impl<'a> Objects<'a> {
         self.reports.push(FileReport::of(file, &model));
         let materials = vec![None; model.materials.len() + 1];
         self.models
-            .insert(path.clone(), LoadedModel { model, materials });
-        Ok(path)
+            .insert(key.clone(), LoadedModel { model, materials });
+        Ok(key)
     }
 
     /// The scene material of material `m` of the file at `path`

@@ -695,6 +695,11 @@ pub enum ObjectDesc {
         /// file (its `shape_index`); all when absent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         part: Option<u32>,
+        /// Turn the file's texture coordinates over (v becomes 1 − v): for
+        /// a file written with v down the image (Mitsuba's PLY files),
+        /// where lumen's v runs up it.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_v: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,

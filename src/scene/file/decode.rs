@@ -1083,6 +1083,7 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             "smooth",
             "allow_outside",
             "part",
+            "flip_v",
             "transform",
         ],
         elsewhere: &[
@@ -1195,6 +1196,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             part: t
                 .optional("part", |n, p| integer(n, p, 0, u64::from(u32::MAX)))?
                 .map(|n| n as u32),
+            flip_v: t.optional("flip_v", boolean)?.unwrap_or(false),
             transform,
         },
         ObjectKind::Triangles => ObjectDesc::Triangles {

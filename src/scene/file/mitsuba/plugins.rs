@@ -910,8 +910,10 @@ impl<'d> Convert<'d> {
                         i => return Err(self.fail(e, format!("shape_index must be ≥ 0, got {i}"))),
                     }
                 } else {
-                    // lumen reads OBJ texture coordinates as Mitsuba does by
-                    // default (flipped to v down the image), PLY's as written.
+                    // Mitsuba's v runs down the image, lumen's up: Mitsuba
+                    // turns an OBJ's over (OBJ's v runs up, as lumen's), and
+                    // takes a PLY's as written (v down), which lumen turns
+                    // over (`flip_v`).
                     known.push("flip_tex_coords");
                     let flip = p.boolean("flip_tex_coords", self)?;
                     if flip.is_some_and(|f| f != (t == "obj")) {
@@ -929,6 +931,7 @@ impl<'d> Convert<'d> {
                     smooth: !flat,
                     allow_outside: false,
                     part,
+                    flip_v: t == "ply",
                     transform: matrix(&m),
                 }
             }

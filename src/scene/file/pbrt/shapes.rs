@@ -206,6 +206,7 @@ impl Builder {
                     smooth: true,
                     allow_outside: false,
                     part: None,
+                    flip_v: false,
                     transform,
                 });
             }
