@@ -939,20 +939,59 @@ impl<'d> Convert<'d> {
                 known.extend(["center", "radius"]);
                 let center = p.point("center", self)?.unwrap_or([0.0; 3]);
                 let radius = p.float("radius", self)?.unwrap_or(1.0);
+                // Mitsuba's (u, v) go round its sphere's z (u from +x
+                // towards +y, v down from +z), lumen's round y (u from −x
+                // towards +z, v up from −y): the sphere turned about its
+                // centre by the rotation (x, y, z) → (−x, z, y) that takes
+                // one onto the other (its own inverse), which a sphere
+                // without a texture shows nowhere.
+                let [cx, cy, cz] = center;
+                let about_centre = [
+                    [-1.0, 0.0, 0.0, 2.0 * cx],
+                    [0.0, 0.0, 1.0, cy - cz],
+                    [0.0, 1.0, 0.0, cz - cy],
+                    [0.0, 0.0, 0.0, 1.0],
+                ];
                 ObjectDesc::Sphere {
                     center,
                     radius,
                     material,
-                    transform: matrix(&m),
+                    transform: matrix(&crate::scene::file::matrix::mul(&m, &about_centre)),
                 }
             }
-            "rectangle" => ObjectDesc::Quad {
-                corner: [-1.0, -1.0, 0.0],
-                u: [2.0, 0.0, 0.0],
-                v: [0.0, 2.0, 0.0],
-                material,
-                transform: matrix(&m),
-            },
+            "rectangle" => {
+                let desc = &self.desc.materials[&material];
+                let emits = matches!(desc, MaterialDesc::Emissive(_))
+                    || desc.clone().surface_mut().emission.is_some();
+                if emits {
+                    // A light stays a quad, which light sampling sees by
+                    // its solid angle.
+                    ObjectDesc::Quad {
+                        corner: [-1.0, -1.0, 0.0],
+                        u: [2.0, 0.0, 0.0],
+                        v: [0.0, 2.0, 0.0],
+                        material,
+                        transform: matrix(&m),
+                    }
+                } else {
+                    // Two triangles, so that the texture coordinates are
+                    // Mitsuba's: (0, 0) at (−1, −1), v down the image
+                    // (lumen's runs up it: 1 − v).
+                    ObjectDesc::Triangles {
+                        positions: vec![
+                            [-1.0, -1.0, 0.0],
+                            [1.0, -1.0, 0.0],
+                            [1.0, 1.0, 0.0],
+                            [-1.0, 1.0, 0.0],
+                        ],
+                        indices: vec![[0, 1, 2], [0, 2, 3]],
+                        normals: None,
+                        uvs: Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
+                        material,
+                        transform: matrix(&m),
+                    }
+                }
+            }
             "cube" => ObjectDesc::Box {
                 min: [-1.0; 3],
                 max: [1.0; 3],
