@@ -26,6 +26,9 @@ from pathlib import Path
 import mitsuba as mi
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from peerlib import compare_images  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 SPP = int(sys.argv[1]) if len(sys.argv) > 1 else 512
 DELTA = len(sys.argv) > 2 and sys.argv[2] == "delta"
@@ -119,28 +122,13 @@ def main():
                 one = mi.load_file(str(d / "alone.xml"), spp=SPP)
                 alone.append(np.array(mi.render(one, spp=SPP, seed=0)))
             blend = 0.4 * alone[0] + 0.6 * alone[1]
-    print(f"{SPP} spp; lumen mean {a.mean(axis=(0, 1))}, Mitsuba {b.mean(axis=(0, 1))}")
-    h, w = b.shape[:2]
-    for name, part in [("image", np.s_[:]), ("left", np.s_[:, : w // 2]),
-                       ("right", np.s_[:, w // 2:]), ("top", np.s_[: h // 2]),
-                       ("bottom", np.s_[h // 2:])]:
-        ratio = a[part].mean(axis=(0, 1)) / b[part].mean(axis=(0, 1))
-        print(f"{name:>6}: lumen / Mitsuba = {ratio}")
-    rms = lambda x, y: np.sqrt(((x - y) ** 2).mean()) / y.mean()
+    print(f"{SPP} spp")
+    compare_images(a, a1, b, c, "Mitsuba")
     if DELTA:
         h, w = b.shape[:2]
         sphere = np.s_[int(h * .3):int(h * .6), int(w * .6):int(w * .8)]
         mean = lambda x: x[sphere].mean(axis=(0, 1))
         print(f"right sphere, against 0.4 copper + 0.6 plastic rendered apart by Mitsuba: "
               f"lumen {mean(a) / mean(blend)}, Mitsuba {mean(b) / mean(blend)}")
-    lm, ll, mm = rms(a, b), rms(a1, a), rms(c, b)
-    print(f"relative RMS lumen - Mitsuba {lm:.4f}; seed 0 - seed 1: lumen {ll:.4f}, "
-          f"Mitsuba {mm:.4f}")
-    # Were the two images equal but for noise, the difference's mean square
-    # would be the sum of the two renderers' noises (each half its
-    # seed-to-seed value).
-    excess = lm ** 2 - (ll ** 2 + mm ** 2) / 2
-    print(f"relative RMS beyond noise: {np.sign(excess) * np.sqrt(abs(excess)):.4f}")
-
 
 main()

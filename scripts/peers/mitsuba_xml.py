@@ -17,6 +17,9 @@ from pathlib import Path
 import mitsuba as mi
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from peerlib import compare_images  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = Path(sys.argv[1]).resolve()
 SPP = int(sys.argv[2])
@@ -44,15 +47,5 @@ def mitsuba(seed):
 with tempfile.TemporaryDirectory() as d:
     a, a1 = lumen(0, d), lumen(1, d)
 b, c = mitsuba(0), mitsuba(1)
-print(f"{SCENE.name}, {SPP} spp; lumen mean {a.mean(axis=(0, 1))}, Mitsuba {b.mean(axis=(0, 1))}")
-h, w = b.shape[:2]
-for name, part in [("image", np.s_[:]), ("left", np.s_[:, : w // 2]), ("right", np.s_[:, w // 2:]),
-                   ("top", np.s_[: h // 2]), ("bottom", np.s_[h // 2:])]:
-    print(f"{name:>6}: lumen / Mitsuba = {a[part].mean(axis=(0, 1)) / b[part].mean(axis=(0, 1))}")
-rms = lambda x, y: np.sqrt(((x - y) ** 2).mean()) / y.mean()
-lm, ll, mm = rms(a, b), rms(a1, a), rms(c, b)
-print(f"relative RMS lumen - Mitsuba {lm:.4f}; seed 0 - seed 1: lumen {ll:.4f}, Mitsuba {mm:.4f}")
-# Were the images equal but for noise, the difference's mean square would
-# be the sum of the two renderers' noises (each half its seed-to-seed value).
-excess = lm ** 2 - (ll ** 2 + mm ** 2) / 2
-print(f"relative RMS beyond noise: {np.sign(excess) * np.sqrt(abs(excess)):.4f}")
+print(f"{SCENE.name}, {SPP} spp")
+compare_images(a, a1, b, c, "Mitsuba")

@@ -8,6 +8,9 @@ scripts/peers/setup_cycles.sh) and in a plain Python with numpy.
 - write_pfm(path, rgb): linear float RGB image, top row first in `rgb`.
 - timed_renders(render, seeds, ...): the timing protocol of the efficiency
   measurements (one warm-up render, then one timed render per seed).
+- compare_images(lumen, lumen_again, peer, peer_again, name): two renderers'
+  images of one scene (each rendered twice with other seeds) compared: means,
+  their ratio per half and quarter, and the difference beyond the noise.
 """
 
 import json
@@ -176,3 +179,27 @@ def rgb(x):
     if len(x) != 3 or not all(math.isfinite(float(c)) for c in x):
         raise ValueError(f"bad colour {x!r}")
     return [float(c) for c in x]
+
+
+# ------------------------------------------------------------------ compare
+def compare_images(a, a1, b, b1, name="peer"):
+    """Prints how lumen's image `a` (and `a1`, another seed) compares with a
+    peer's `b` (and `b1`): image means, their ratio per half and quarter, the
+    relative RMS difference beside each renderer's seed-to-seed noise, and
+    what is left of it beyond that noise (about 0 when the images differ by
+    noise alone)."""
+    print(f"lumen mean {a.mean(axis=(0, 1))}, {name} {b.mean(axis=(0, 1))}")
+    h, w = b.shape[:2]
+    for part_name, part in [("image", np.s_[:]), ("left", np.s_[:, : w // 2]),
+                            ("right", np.s_[:, w // 2:]), ("top", np.s_[: h // 2]),
+                            ("bottom", np.s_[h // 2:])]:
+        ratio = a[part].mean(axis=(0, 1)) / b[part].mean(axis=(0, 1))
+        print(f"{part_name:>6}: lumen / {name} = {ratio}")
+    rms = lambda x, y: np.sqrt(((x - y) ** 2).mean()) / y.mean()
+    lm, ll, mm = rms(a, b), rms(a1, a), rms(b1, b)
+    print(f"relative RMS lumen - {name} {lm:.4f}; seed 0 - seed 1: lumen {ll:.4f}, "
+          f"{name} {mm:.4f}")
+    # Were the images equal but for noise, the difference's mean square would
+    # be the sum of the two renderers' noises (each half its seed-to-seed value).
+    excess = lm ** 2 - (ll ** 2 + mm ** 2) / 2
+    print(f"relative RMS beyond noise: {np.sign(excess) * np.sqrt(abs(excess)):.4f}")
