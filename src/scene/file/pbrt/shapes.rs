@@ -7,8 +7,9 @@ use super::lex::At;
 use super::params::{Params, Problem};
 use super::scene::Builder;
 use super::Input;
-use crate::scene::desc::ObjectDesc;
-use crate::scene::file::{matrix, tessellate};
+use crate::scene::desc::{ObjectDesc, TransformDesc};
+use crate::scene::file::matrix::{self, Mat4};
+use crate::scene::file::tessellate;
 
 /// The shapes lumen reads.
 const SHAPES: &[&str] = &[
@@ -58,7 +59,17 @@ impl Builder {
                         "one that shines outwards",
                     )?;
                 }
-                let transform = self.placement();
+                // pbrt's (u, v) go round the sphere's z (u from +x towards
+                // +y, v up from −z), lumen's round y (u from −x towards +z,
+                // v up from −y): the sphere turned by (x, y, z) → (−x, z, y),
+                // which takes one onto the other (and is its own inverse).
+                const TURN: Mat4 = [
+                    [-1.0, 0.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ];
+                let transform = vec![TransformDesc::Matrix(matrix::mul(&self.state.ctm, &TURN))];
                 self.add(ObjectDesc::Sphere {
                     center: [0.0; 3],
                     radius,
