@@ -803,3 +803,60 @@ fn textures_on_spheres_fall_where_pbrt_puts_them() {
         }
     }
 }
+
+/// An area light given by an image (`filename`) shines the image over the
+/// shape's (u, v), its top row at v = 1 as pbrt looks it up, times
+/// `scale`; `L` with `filename` is refused.
+#[test]
+fn an_image_area_light_shines_its_image() {
+    use lumen::math::{Color, Interval, Vec3};
+    let dir = scratch_dir("pbrt_scenes_image_area_light");
+    let texels: [[u8; 3]; 8] = [
+        [255, 0, 0],
+        [0, 255, 0],
+        [0, 0, 255],
+        [255, 255, 0],
+        [0, 255, 255],
+        [255, 0, 255],
+        [255, 255, 255],
+        [0, 0, 0],
+    ];
+    image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(texels[(y * 4 + x) as usize]))
+        .save(dir.join("t.png"))
+        .unwrap();
+    let scene = read_in(
+        &dir,
+        "WorldBegin\n\
+         AreaLightSource \"diffuse\" \"string filename\" \"t.png\" \"float scale\" 2 \
+         \"bool twosided\" true\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] \
+         \"integer indices\" [0 1 2 0 2 3] \"point2 uv\" [0 0 1 0 1 1 0 1]\n",
+        &Options::default(),
+    )
+    .and_then(|f| f.compile(&Overrides::default()).map_err(|e| e.to_string()))
+    .unwrap_or_else(|e| panic!("{e}"));
+    for (x, y, i) in [
+        (0.125, 0.75, 0),
+        (0.375, 0.75, 1),
+        (0.625, 0.25, 6),
+        (0.875, 0.25, 7),
+    ] {
+        let ray = lumen::ray::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+        let hit = scene
+            .hit(&ray, Interval::new(1e-4, f32::INFINITY))
+            .expect("a hit");
+        let seen = scene.material(&hit).emitted(&hit, &scene.textures);
+        let want = Color::from_array(texels[i].map(|c| 2.0 * f32::from(c) / 255.0));
+        assert!(
+            (seen - want).abs().max_element() < 1e-4,
+            "({x}, {y}): {seen:?}, want {want:?}"
+        );
+    }
+    let e = read_in(
+        &dir,
+        "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n  \"string filename\" \"t.png\"\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("s.pbrt:3:") && e.contains("not both"), "{e}");
+}

@@ -870,7 +870,7 @@ impl Builder {
 /// udelta, vdelta]`. pbrt's t runs up the image, as lumen's v; lumen's
 /// transform works on v down the image, where pbrt's t = vscale·v + vdelta
 /// reads 1 − t.
-fn image(
+pub(super) fn image(
     file: String,
     encoding: EncodingDesc,
     channel: Option<crate::scene::desc::ChannelDesc>,

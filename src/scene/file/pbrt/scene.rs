@@ -6,9 +6,9 @@ use super::lex::At;
 use super::params::{Params, Problem, Spectral};
 use super::{spectra, Input};
 use crate::scene::desc::{
-    BackgroundDesc, CameraDesc, DirectionalLightDesc, IntegratorDesc, LightDesc, LightSelection,
-    ObjectDesc, PixelFilterDesc, PointLightDesc, SamplingDesc, SceneDesc, SpotLightDesc,
-    TransformDesc,
+    BackgroundDesc, CameraDesc, ColorDesc, DirectionalLightDesc, EncodingDesc, IntegratorDesc,
+    LightDesc, LightSelection, ObjectDesc, PixelFilterDesc, PointLightDesc, SamplingDesc,
+    SceneDesc, SpotLightDesc, TextureDesc, TransformDesc,
 };
 use crate::scene::file::import::Imported;
 use crate::scene::file::matrix::{self, Mat4, IDENTITY};
@@ -71,8 +71,9 @@ pub(super) struct State {
     pub material: Option<String>,
     /// Whether the current material is `interface` (no surface).
     pub interface: bool,
-    /// The area light shapes get: radiance, two-sided.
-    pub area: Option<([f64; 3], bool)>,
+    /// The area light shapes get: radiance (a colour, or an image
+    /// texture's name), two-sided.
+    pub area: Option<(ColorDesc, bool)>,
     /// Transforms apply at the shutter's open (`ActiveTransform
     /// StartTime` or `All`).
     pub start: bool,
@@ -109,8 +110,9 @@ pub(super) struct Builder {
     pub named_materials: HashMap<String, (String, bool)>,
     /// Textures: pbrt's (name, is a float texture) to what lumen has.
     pub textures: HashMap<(String, bool), super::materials::Tex>,
-    /// Emitting copies of materials, by material and light.
-    emitting: HashMap<(Option<String>, [u64; 3], bool), String>,
+    /// Emitting copies of materials, by material and light (its radiance's
+    /// bits, or its texture's name).
+    emitting: HashMap<(Option<String>, String, bool), String>,
     default_material: Option<String>,
 }
 
@@ -479,7 +481,7 @@ impl Builder {
                 let p = input.params(at)?;
                 match name {
                     "LightSource" => self.light(&ty, tat, &p, input)?,
-                    "AreaLightSource" => self.area_light(&ty, tat, &p)?,
+                    "AreaLightSource" => self.area_light(&ty, tat, &p, input)?,
                     _ => self.shape(&ty, tat, &p, input)?,
                 }
             }
@@ -1010,7 +1012,7 @@ impl Builder {
         Ok(())
     }
 
-    fn area_light(&mut self, ty: &str, at: At, p: &Params) -> Result<(), Problem> {
+    fn area_light(&mut self, ty: &str, at: At, p: &Params, input: &Input) -> Result<(), Problem> {
         if ty != "diffuse" {
             return Err((
                 at,
@@ -1018,7 +1020,6 @@ impl Builder {
                 None,
             ));
         }
-        let radiance = self.emitted(p, "L")?;
         let two_sided = p.boolean("twosided")?.unwrap_or(false);
         if p.has("power") {
             let _ = p.get("power");
@@ -1028,14 +1029,51 @@ impl Builder {
                 "the radiance `L` gives",
             )?;
         }
-        if p.has("filename") {
-            let _ = p.get("filename");
-            self.lacks(
-                at,
-                "area light textured by an image",
-                "the radiance `L` gives",
-            )?;
-        }
+        let radiance = match p.string_of("filename", "string")? {
+            None => ColorDesc::Rgb(self.emitted(p, "L")?),
+            Some((file, fat)) => {
+                if p.has("L") {
+                    return Err((
+                        fat,
+                        "an area light takes `L` or `filename`, not both".into(),
+                        None,
+                    ));
+                }
+                // The image over the shape's (u, v), its top row at v = 1,
+                // as pbrt looks it up; an 8-bit image is sRGB, a float one
+                // linear.
+                let file = input.file(file, fat)?;
+                let lower = file.to_ascii_lowercase();
+                let float_image = [".exr", ".pfm", ".hdr"].iter().any(|e| lower.ends_with(e));
+                let encoding = if float_image {
+                    EncodingDesc::Linear
+                } else {
+                    EncodingDesc::Srgb
+                };
+                let name = self.name("area-light-image");
+                self.desc.textures.insert(
+                    name.clone(),
+                    super::materials::image(file, encoding, None, [1.0, 1.0, 0.0, 0.0]),
+                );
+                match p.float("scale")?.unwrap_or(1.0) {
+                    s if !(s >= 0.0) => {
+                        return Err((at, format!("`scale` must be ≥ 0, got {s}"), None))
+                    }
+                    1.0 => ColorDesc::Texture(name),
+                    s => {
+                        let scaled = self.name("area-light-image");
+                        self.desc.textures.insert(
+                            scaled.clone(),
+                            TextureDesc::Scale {
+                                texture: ColorDesc::Texture(name),
+                                factor: [s; 3],
+                            },
+                        );
+                        ColorDesc::Texture(scaled)
+                    }
+                }
+            }
+        };
         p.finish(
             "a diffuse area light",
             &["L", "scale", "twosided", "power", "filename"],
@@ -1051,11 +1089,11 @@ impl Builder {
             Some(m) => m.clone(),
             None => self.default_material(),
         };
-        let Some((radiance, two_sided)) = self.state.area else {
+        let Some((radiance, two_sided)) = self.state.area.clone() else {
             return Ok(base);
         };
         // pbrt gives no light to an interface, nor to instanced shapes.
-        if self.state.interface || radiance == [0.0; 3] {
+        if self.state.interface || radiance == ColorDesc::Rgb([0.0; 3]) {
             return Ok(base);
         }
         if self.in_definition() {
@@ -1069,7 +1107,10 @@ impl Builder {
         }
         let key = (
             self.state.material.clone(),
-            radiance.map(f64::to_bits),
+            match &radiance {
+                ColorDesc::Rgb(c) => format!("{:?}", c.map(f64::to_bits)),
+                ColorDesc::Texture(t) => format!("texture {t}"),
+            },
             two_sided,
         );
         if let Some(name) = self.emitting.get(&key) {
@@ -1077,7 +1118,7 @@ impl Builder {
         }
         let mut desc = self.desc.materials[&base].clone();
         let s = desc.surface_mut();
-        *s.emission = Some(crate::scene::desc::ColorDesc::Rgb(radiance));
+        *s.emission = Some(radiance);
         *s.two_sided = two_sided;
         let name = self.name("light");
         self.desc.materials.insert(name.clone(), desc);
