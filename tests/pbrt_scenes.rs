@@ -860,3 +860,42 @@ fn an_image_area_light_shines_its_image() {
     .unwrap_err();
     assert!(e.contains("s.pbrt:3:") && e.contains("not both"), "{e}");
 }
+
+/// An image sky given an `illuminance` is scaled as pbrt-v4 scales it: by
+/// the illuminance over the sum of its texels above the horizon, each
+/// luminance times cosine, times 2π over the texel count. A white map
+/// sums to π/2 there (z is uniform on the equal-area sphere), so an
+/// illuminance of π makes its intensity 2, times its `scale`; a map black
+/// above the horizon is refused.
+#[test]
+fn an_image_sky_takes_its_illuminance_as_pbrt_computes_it() {
+    use lumen::scene::desc::BackgroundDesc;
+    let dir = scratch_dir("pbrt_scenes_sky_illuminance");
+    image::RgbImage::from_pixel(32, 32, image::Rgb([255, 255, 255]))
+        .save(dir.join("sky.png"))
+        .unwrap();
+    let file = read_in(
+        &dir,
+        "WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.png\" \
+         \"float illuminance\" 3.14159265 \"float scale\" 1.5\n",
+        &Options::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let BackgroundDesc::Image { intensity, .. } = file.desc.background else {
+        panic!("{:?}", file.desc.background);
+    };
+    // Within 1 %: the texels the horizon crosses count whole or not at all.
+    assert!((intensity - 3.0).abs() < 0.03, "{intensity}");
+
+    image::RgbImage::from_pixel(32, 32, image::Rgb([0; 3]))
+        .save(dir.join("black.png"))
+        .unwrap();
+    let e = read_in(
+        &dir,
+        "WorldBegin\nLightSource \"infinite\" \"string filename\" \"black.png\" \
+         \"float illuminance\" 2\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("black above its horizon"), "{e}");
+}

@@ -942,10 +942,10 @@ impl Builder {
                     if p.has("L") {
                         return Err((fat, "an infinite light takes `L` or `filename`, not both".into(), None));
                     }
-                    if p.float("illuminance")?.is_some() {
-                        self.lacks(at, "environment map scaled to an illuminance", "its `scale` alone")?;
+                    let mut scale = p.float("scale")?.unwrap_or(1.0);
+                    if let Some(e) = p.float("illuminance")?.filter(|v| *v > 0.0) {
+                        scale *= e / upper_illuminance(&input.dir.join(&file), at)?;
                     }
-                    let scale = p.float("scale")?.unwrap_or(1.0);
                     p.ignore(&["portal"]);
                     p.finish("an infinite light", &["L", "scale", "illuminance", "filename", "portal"])?;
                     // The light's frame: the transform's axes, which must
@@ -1208,4 +1208,38 @@ impl Builder {
             warnings,
         })
     }
+}
+
+/// The illuminance an equal-area environment image (the file at `path`)
+/// gives a surface facing its +z, as pbrt-v4 computes it to scale a map to
+/// an `illuminance`: the luminance of the texels above the horizon times
+/// their cosine, summed, times 2π over the number of texels (pbrt's
+/// factor, which this reproduces so that a scene is as bright as pbrt
+/// makes it).
+fn upper_illuminance(path: &std::path::Path, at: At) -> Result<f64, Problem> {
+    let image = crate::texture::Image::read(path).map_err(|e| (at, e.to_string(), None))?;
+    let (w, h) = (image.width(), image.height());
+    let mut sum = 0.0f64;
+    for y in 0..h {
+        let v = (y as f32 + 0.5) / h as f32;
+        for x in 0..w {
+            let u = (x as f32 + 0.5) / w as f32;
+            let d = crate::light::environment::equal_area_sphere([u, v]);
+            if d.z <= 0.0 {
+                continue;
+            }
+            let c = image.texel(x, y);
+            let luminance = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+            sum += f64::from(luminance * d.z);
+        }
+    }
+    let illuminance = sum * 2.0 * std::f64::consts::PI / (w * h) as f64;
+    if !(illuminance > 0.0) {
+        return Err((
+            at,
+            "the map is black above its horizon: no scale gives it an illuminance".into(),
+            None,
+        ));
+    }
+    Ok(illuminance)
 }
