@@ -952,3 +952,39 @@ fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
         );
     }
 }
+
+/// No `.serialized` file makes the reader panic: every cut of a real file,
+/// and every byte of it set to values that matter to a reader (0, 1, 0xFF,
+/// 0x7F and its own value plus one), reads or is refused.
+#[test]
+fn no_broken_serialized_file_makes_the_reader_panic() {
+    let good =
+        std::fs::read(mitsuba_data().join("tests/serialized/rectangle_normals_uv.serialized"))
+            .unwrap();
+    let dir = scratch_dir("mitsuba_scenes_serialized_fuzz");
+    let path = dir.join("m.serialized");
+    let mut variants: Vec<Vec<u8>> = (0..good.len()).map(|n| good[..n].to_vec()).collect();
+    for i in 0..good.len() {
+        for v in [0u8, 1, 0xFF, 0x7F, good[i].wrapping_add(1)] {
+            let mut bytes = good.clone();
+            bytes[i] = v;
+            variants.push(bytes);
+        }
+    }
+    let mut refused = 0;
+    for bytes in &variants {
+        std::fs::write(&path, bytes).unwrap();
+        let read = std::panic::catch_unwind(|| lumen::mesh::load(&path).is_ok());
+        match read {
+            Ok(true) => {}
+            Ok(false) => refused += 1,
+            Err(_) => panic!("the reader panicked on {bytes:?}"),
+        }
+    }
+    // Most changes are caught (the zlib stream's checksum among them).
+    assert!(
+        refused > variants.len() / 2,
+        "{refused} of {}",
+        variants.len()
+    );
+}
