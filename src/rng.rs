@@ -23,6 +23,21 @@ pub fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// A number in [0, 1) made from `values` alone: the same for the same
+/// values whatever the thread or the order of the work, and spread evenly
+/// over [0, 1) as they change (for choices made where a hit is, such as a
+/// cut-out surface stopping a ray or a mix picking a material).
+#[inline]
+pub fn unit_hash<const N: usize>(values: [f32; N]) -> f32 {
+    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    for x in values {
+        h = (h ^ u64::from(x.to_bits())).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h ^= h >> 31;
+    }
+    // The top 24 bits: every such fraction is exact in an f32.
+    (h >> 40) as f32 / (1u64 << 24) as f32
+}
+
 impl Rng {
     /// A generator whose sequence is fixed by `seed`.
     pub fn new(seed: u64) -> Self {

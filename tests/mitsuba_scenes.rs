@@ -873,22 +873,9 @@ fn a_ply_shapes_texture_coordinates_are_turned_over() {
 /// up at its texel centres.
 #[test]
 fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
-    use lumen::bsdf::Lobe;
-    use lumen::math::{Color, Interval, Vec3};
+    use lumen::math::Vec3;
     let dir = scratch_dir("mitsuba_scenes_shape_uv");
-    let texels: [[u8; 3]; 8] = [
-        [255, 0, 0],
-        [0, 255, 0],
-        [0, 0, 255],
-        [255, 255, 0],
-        [0, 255, 255],
-        [255, 0, 255],
-        [255, 255, 255],
-        [0, 0, 0],
-    ];
-    image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(texels[(y * 4 + x) as usize]))
-        .save(dir.join("t.png"))
-        .unwrap();
+    let colours = common::eight_colours_png(&dir.join("t.png"));
     let path = dir.join("s.xml");
     std::fs::write(
         &path,
@@ -904,40 +891,7 @@ fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
     let scene = SceneFile::read_with(&path, &mitsuba::Options::default())
         .and_then(|f| f.compile(&Overrides::default()))
         .unwrap_or_else(|e| panic!("{e}"));
-    // The albedo seen at `target`, looking from `from`.
-    let albedo = |from: Vec3, target: Vec3| {
-        let ray = lumen::ray::Ray::new(from, (target - from).normalize());
-        let hit = scene
-            .hit(&ray, Interval::new(1e-4, f32::INFINITY))
-            .expect("a hit");
-        match scene
-            .material(&hit)
-            .bsdf(&hit, -ray.direction, &scene.textures)
-            .map(|b| b.lobe)
-        {
-            Some(Lobe::Diffuse(d)) => d.albedo,
-            other => panic!("{other:?}"),
-        }
-    };
-    let texel = |i: usize| Color::from_array(texels[i].map(|c| f32::from(c) / 255.0));
-    let close = |a: Color, b: Color| (a - b).abs().max_element() < 1e-4;
-    for column in 0..4 {
-        let phi = (0.125 + 0.25 * column as f32) * std::f32::consts::TAU;
-        for (row, theta) in [(0, 0.25), (1, 0.75)] {
-            let theta = theta * std::f32::consts::PI;
-            let d = Vec3::new(
-                phi.cos() * theta.sin(),
-                phi.sin() * theta.sin(),
-                theta.cos(),
-            );
-            let seen = albedo(d * 3.0, d);
-            let want = texel(row * 4 + column);
-            assert!(
-                close(seen, want),
-                "sphere column {column} row {row}: {seen:?}, want {want:?}"
-            );
-        }
-    }
+    common::assert_texels_round_z(&scene, Vec3::ZERO, &colours);
     for (x, y, i) in [
         (-0.75, -0.5, 0),
         (0.75, -0.5, 3),
@@ -945,9 +899,9 @@ fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
         (0.25, 0.5, 6),
     ] {
         let p = Vec3::new(5.0 + x, y, 0.0);
-        let seen = albedo(p + Vec3::Z, p);
+        let seen = common::colour_at(&scene, p + Vec3::Z, -Vec3::Z);
         assert!(
-            close(seen, texel(i)),
+            common::colours_close(seen, colours[i]),
             "rectangle at ({x}, {y}): {seen:?}, want texel {i}"
         );
     }

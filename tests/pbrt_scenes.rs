@@ -744,22 +744,8 @@ fn mix_textures_blend_their_two_textures() {
 /// of eight pure colours is looked up at its texel centres.
 #[test]
 fn textures_on_spheres_fall_where_pbrt_puts_them() {
-    use lumen::bsdf::Lobe;
-    use lumen::math::{Color, Interval, Vec3};
     let dir = scratch_dir("pbrt_scenes_sphere_uv");
-    let texels: [[u8; 3]; 8] = [
-        [255, 0, 0],
-        [0, 255, 0],
-        [0, 0, 255],
-        [255, 255, 0],
-        [0, 255, 255],
-        [255, 0, 255],
-        [255, 255, 255],
-        [0, 0, 0],
-    ];
-    image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(texels[(y * 4 + x) as usize]))
-        .save(dir.join("t.png"))
-        .unwrap();
+    let colours = common::eight_colours_png(&dir.join("t.png"));
     let scene = read_in(
         &dir,
         "WorldBegin\n\
@@ -770,38 +756,7 @@ fn textures_on_spheres_fall_where_pbrt_puts_them() {
     )
     .and_then(|f| f.compile(&Overrides::default()).map_err(|e| e.to_string()))
     .unwrap_or_else(|e| panic!("{e}"));
-    let centre = Vec3::new(1.0, 2.0, 3.0);
-    let albedo = |d: Vec3| {
-        let ray = lumen::ray::Ray::new(centre + d * 3.0, -d);
-        let hit = scene
-            .hit(&ray, Interval::new(1e-4, f32::INFINITY))
-            .expect("a hit");
-        match scene
-            .material(&hit)
-            .bsdf(&hit, -ray.direction, &scene.textures)
-            .map(|b| b.lobe)
-        {
-            Some(Lobe::Diffuse(d)) => d.albedo,
-            other => panic!("{other:?}"),
-        }
-    };
-    for column in 0..4 {
-        let phi = (0.125 + 0.25 * column as f32) * std::f32::consts::TAU;
-        for (row, theta) in [(0, 0.25), (1, 0.75)] {
-            let theta = theta * std::f32::consts::PI;
-            let d = Vec3::new(
-                phi.cos() * theta.sin(),
-                phi.sin() * theta.sin(),
-                theta.cos(),
-            );
-            let seen = albedo(d);
-            let want = Color::from_array(texels[row * 4 + column].map(|c| f32::from(c) / 255.0));
-            assert!(
-                (seen - want).abs().max_element() < 1e-4,
-                "column {column} row {row}: {seen:?}, want {want:?}"
-            );
-        }
-    }
+    common::assert_texels_round_z(&scene, lumen::math::Vec3::new(1.0, 2.0, 3.0), &colours);
 }
 
 /// An area light given by an image (`filename`) shines the image over the
@@ -809,21 +764,9 @@ fn textures_on_spheres_fall_where_pbrt_puts_them() {
 /// `scale`; `L` with `filename` is refused.
 #[test]
 fn an_image_area_light_shines_its_image() {
-    use lumen::math::{Color, Interval, Vec3};
+    use lumen::math::Vec3;
     let dir = scratch_dir("pbrt_scenes_image_area_light");
-    let texels: [[u8; 3]; 8] = [
-        [255, 0, 0],
-        [0, 255, 0],
-        [0, 0, 255],
-        [255, 255, 0],
-        [0, 255, 255],
-        [255, 0, 255],
-        [255, 255, 255],
-        [0, 0, 0],
-    ];
-    image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(texels[(y * 4 + x) as usize]))
-        .save(dir.join("t.png"))
-        .unwrap();
+    let colours = common::eight_colours_png(&dir.join("t.png"));
     let scene = read_in(
         &dir,
         "WorldBegin\n\
@@ -841,14 +784,10 @@ fn an_image_area_light_shines_its_image() {
         (0.625, 0.25, 6),
         (0.875, 0.25, 7),
     ] {
-        let ray = lumen::ray::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
-        let hit = scene
-            .hit(&ray, Interval::new(1e-4, f32::INFINITY))
-            .expect("a hit");
-        let seen = scene.material(&hit).emitted(&hit, &scene.textures);
-        let want = Color::from_array(texels[i].map(|c| 2.0 * f32::from(c) / 255.0));
+        let seen = common::colour_at(&scene, Vec3::new(x, y, 1.0), -Vec3::Z);
+        let want = colours[i] * 2.0;
         assert!(
-            (seen - want).abs().max_element() < 1e-4,
+            common::colours_close(seen, want),
             "({x}, {y}): {seen:?}, want {want:?}"
         );
     }

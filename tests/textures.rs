@@ -4,37 +4,11 @@
 
 mod common;
 
-use common::{compile_file, pixel_stats, scene_file_error, scratch_dir, tiles_agree};
-use lumen::bsdf::Lobe;
-use lumen::math::{Color, Interval, Vec3};
-use lumen::ray::Ray;
-use lumen::scene::Scene;
-
-/// The colour of the material where the ray from `from` along `towards`
-/// first hits: its albedo, or its radiance for a light.
-fn colour_at(scene: &Scene, from: Vec3, towards: Vec3) -> Color {
-    let ray = Ray::new(from, towards.normalize());
-    let record = scene
-        .hit(&ray, Interval::new(1e-4, f32::INFINITY))
-        .expect("a hit");
-    let material = scene.material(&record);
-    if material.emits() {
-        return material.emitted(&record, &scene.textures);
-    }
-    match material
-        .bsdf(&record, -ray.direction, &scene.textures)
-        .map(|b| b.lobe)
-    {
-        Some(Lobe::Diffuse(d)) => d.albedo,
-        Some(Lobe::Metal(m)) => m.albedo,
-        Some(Lobe::Principled(p)) => p.base_color,
-        other => panic!("no colour: {other:?}"),
-    }
-}
-
-fn close(a: Color, b: Color) -> bool {
-    (a - b).abs().max_element() < 1e-4
-}
+use common::{
+    colour_at, colours_close as close, compile_file, pixel_stats, scene_file_error, scratch_dir,
+    tiles_agree,
+};
+use lumen::math::{Color, Vec3};
 
 #[test]
 fn a_checker_alternates_cubes_of_its_scale_in_space() {

@@ -145,13 +145,12 @@ pub struct EnvironmentMap {
     /// Whether the first and last rows lie at the poles (see
     /// [`EnvironmentMap::with_rows_at_poles`]).
     rows_at_poles: bool,
-    /// For a square map in the equal-area octahedral layout (see
-    /// [`EnvironmentMap::equal_area`]): the map's x, y and z axes in the
-    /// world.
-    equal_area: Option<[Vec3; 3]>,
-    /// For an equirectangular map turned by more than a turn about +y
-    /// (see [`EnvironmentMap::with_frame`]): its x, y and z axes in the
-    /// world.
+    /// A square map in the equal-area octahedral layout (see
+    /// [`EnvironmentMap::equal_area`]), rather than equirectangular.
+    equal_area: bool,
+    /// The map's x, y and z axes in the world, when they are not the
+    /// world's (an equal-area map's [`frame`](EnvironmentMap::equal_area),
+    /// an equirectangular map's [`with_frame`](EnvironmentMap::with_frame)).
     frame: Option<[Vec3; 3]>,
 }
 
@@ -251,7 +250,7 @@ impl EnvironmentMap {
             distribution,
             integral,
             rows_at_poles: false,
-            equal_area: None,
+            equal_area: false,
             frame: None,
         })
     }
@@ -291,8 +290,8 @@ impl EnvironmentMap {
             distribution,
             integral,
             rows_at_poles: false,
-            equal_area: Some(frame),
-            frame: None,
+            equal_area: true,
+            frame: Some(frame),
         }))
     }
 
@@ -304,7 +303,7 @@ impl EnvironmentMap {
         self
     }
 
-    /// World direction `d` in the equirectangular map's frame.
+    /// World direction `d` in the map's frame.
     #[inline]
     fn local(&self, d: Vec3) -> Vec3 {
         match self.frame {
@@ -313,14 +312,22 @@ impl EnvironmentMap {
         }
     }
 
+    /// The world direction of direction `d` in the map's frame.
+    #[inline]
+    fn world(&self, d: Vec3) -> Vec3 {
+        match self.frame {
+            Some([x, y, z]) => x * d.x + y * d.y + z * d.z,
+            None => d,
+        }
+    }
+
     /// The image's (u, v) seen along unit world `direction`.
     #[inline]
     fn uv(&self, direction: Vec3) -> [f32; 2] {
-        if let Some([x, y, z]) = self.equal_area {
-            let d = Vec3::new(x.dot(direction), y.dot(direction), z.dot(direction));
-            return equal_area_square(d);
-        }
         let direction = self.local(direction);
+        if self.equal_area {
+            return equal_area_square(direction);
+        }
         // Into the image's frame: turned back by the rotation.
         let (s, c) = self.rotation;
         let x = c * direction.x - s * direction.z;
@@ -342,16 +349,12 @@ impl EnvironmentMap {
         let (x, z) = (sin_theta * sin_phi, -sin_theta * cos_phi);
         let (s, c) = self.rotation;
         let turned = Vec3::new(c * x + s * z, cos_theta, -s * x + c * z);
-        let world = match self.frame {
-            Some([fx, fy, fz]) => fx * turned.x + fy * turned.y + fz * turned.z,
-            None => turned,
-        };
-        (world, sin_theta)
+        (self.world(turned), sin_theta)
     }
 
     fn color(&self, direction: Vec3) -> Color {
         let [u, mut v] = self.uv(direction);
-        if self.equal_area.is_some() {
+        if self.equal_area {
             let (w, h) = (self.image.width(), self.image.height());
             let x = ((u * w as f32) as usize).min(w - 1);
             let y = ((v * h as f32) as usize).min(h - 1);
@@ -368,10 +371,9 @@ impl EnvironmentMap {
 
     fn sample(&self, u: [f32; 2]) -> Option<(Vec3, f32)> {
         let (uv, density) = self.distribution.sample(u);
-        if let Some([x, y, z]) = self.equal_area {
+        if self.equal_area {
             // The layout keeps areas: the square covers the sphere at 4π.
-            let d = equal_area_sphere(uv);
-            let world = (x * d.x + y * d.y + z * d.z).normalize();
+            let world = self.world(equal_area_sphere(uv)).normalize();
             return Some((world, density / (4.0 * PI)));
         }
         let (direction, sin_theta) = self.direction(uv);
@@ -383,7 +385,7 @@ impl EnvironmentMap {
     }
 
     fn pdf(&self, direction: Vec3) -> f32 {
-        if self.equal_area.is_some() {
+        if self.equal_area {
             return self.distribution.density(self.uv(direction)) / (4.0 * PI);
         }
         let d = self.local(direction);

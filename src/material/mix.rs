@@ -13,7 +13,6 @@ use super::param::{self, Invalid, ScalarDesc, ScalarParam, Textures};
 use super::{Kind, Material, Shape};
 use crate::geometry::HitRecord;
 use crate::math::Vec3;
-use crate::rng::mix64;
 use crate::texture::Texture;
 
 material_desc! {
@@ -118,36 +117,32 @@ impl Mix {
         }
     }
 
-    /// Makes every material it holds one-sided, as the mix is.
-    pub(super) fn make_one_sided(&mut self) {
-        for m in &mut self.materials {
-            m.one_sided = true;
-            if let Kind::Mix(inner) = &mut m.kind {
-                inner.make_one_sided();
-            }
-        }
-    }
-
-    /// Gives the mix's normal or bump map to its materials (a map tilts the
-    /// normal both are seen about); `field` names the mix for messages.
-    pub(super) fn take_shape(
+    /// Gives the mix's own surface to the materials it holds (and to
+    /// theirs, through mixes in it): its one-sidedness when it is
+    /// one-sided, and its normal or bump map, which tilts the normal all
+    /// of them are seen about; `field` names the mix for messages.
+    pub(super) fn hand_down(
         &mut self,
         field: &str,
-        shape: Shape,
+        one_sided: bool,
+        shape: Option<Shape>,
         bump_shadowing: bool,
     ) -> Result<(), Invalid> {
         for (i, m) in self.materials.iter_mut().enumerate() {
-            if m.shape.is_some() {
+            m.one_sided |= one_sided;
+            if shape.is_some() && m.shape.is_some() {
                 return Err(Invalid::new(
                     format!("{field}.materials[{i}]"),
                     "has a normal or bump map of its own, and so has the mix: give one of them the map",
                 ));
             }
-            if let Kind::Mix(inner) = &mut m.kind {
-                inner.take_shape(field, shape, bump_shadowing)?;
-            } else {
-                m.shape = Some(shape);
-                m.bump_shadowing = bump_shadowing;
+            match &mut m.kind {
+                Kind::Mix(inner) => inner.hand_down(field, one_sided, shape, bump_shadowing)?,
+                _ if shape.is_some() => {
+                    m.shape = shape;
+                    m.bump_shadowing = bump_shadowing;
+                }
+                _ => {}
             }
         }
         Ok(())
@@ -163,15 +158,10 @@ impl Mix {
     }
 }
 
-/// A number in [0, 1) fixed by point `p` and direction `wo`, spread evenly
-/// over its range as they change.
+/// A number in [0, 1) fixed by point `p` and direction `wo`.
 #[inline]
 fn unit_hash(p: Vec3, wo: Vec3) -> f32 {
-    let h = [p.x, p.y, p.z, wo.x, wo.y, wo.z]
-        .into_iter()
-        .fold(0u64, |h, v| mix64(h ^ u64::from(v.to_bits())));
-    // The top 24 bits: every such fraction is exact in an f32.
-    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    crate::rng::unit_hash([p.x, p.y, p.z, wo.x, wo.y, wo.z])
 }
 
 #[cfg(test)]

@@ -203,6 +203,13 @@ macro_rules! material_kinds {
                 }
             }
 
+            /// The fields every kind has.
+            pub fn surface(&self) -> SurfaceDesc<'_> {
+                match self {
+                    $(MaterialDesc::$variant(d) => d.surface(),)*
+                }
+            }
+
             /// The fields every kind has, to be changed.
             pub fn surface_mut(&mut self) -> SurfaceMut<'_> {
                 match self {
@@ -407,12 +414,9 @@ impl SurfaceDesc<'_> {
                 "shadows the bumps of a normal_map or bump_map, which the material does not have",
             ));
         }
-        if let (Kind::Mix(mix), true) = (&mut material.kind, self.one_sided) {
-            mix.make_one_sided();
-        }
-        match (&mut material.kind, shape) {
-            (Kind::Mix(mix), Some(shape)) => mix.take_shape(field, shape, self.bump_shadowing)?,
-            (_, shape) => {
+        match &mut material.kind {
+            Kind::Mix(mix) => mix.hand_down(field, self.one_sided, shape, self.bump_shadowing)?,
+            _ => {
                 material.shape = shape;
                 material.bump_shadowing = self.bump_shadowing;
             }
@@ -815,7 +819,7 @@ impl Material {
     }
 
     /// How many materials it is: 1, or for a mix those it holds.
-    pub fn parts(&self) -> usize {
+    fn parts(&self) -> usize {
         match &self.kind {
             Kind::Mix(m) => m.materials.iter().map(Material::parts).sum(),
             _ => 1,

@@ -16,7 +16,7 @@
 //! Texture coordinates are Mitsuba's, v down the image (v = 0 its top
 //! row); lumen's v runs up the image, so v is turned over as it is read.
 
-use super::{MeshError, Model, TriangleMesh, NO_MATERIAL};
+use super::{MeshError, Model};
 use flate2::read::ZlibDecoder;
 use glam::Mat4;
 use std::io::Read;
@@ -35,6 +35,7 @@ const DOUBLE_PRECISION: u32 = 0x2000;
 /// Version 5's vertex layout bits.
 const V5_NORMALS: u32 = 0x1;
 const V5_TANGENTS: u32 = 0x2;
+const V5_TEXCOORDS: u32 = 0x4;
 
 /// The most a deflate stream expands: 1,032 bytes out per byte in (a
 /// block of 258-byte matches, each coded in two bits). A mesh declaring
@@ -48,7 +49,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
     let starts = mesh_starts(&bytes).map_err(fail)?;
     let mut model = Model::default();
     for (i, &(start, end)) in starts.iter().enumerate() {
-        let mesh = read_mesh(&bytes[start..end]).map_err(|e| {
+        let mut one = read_mesh(&bytes[start..end]).map_err(|e| {
             let which = if starts.len() > 1 {
                 format!("mesh {i} (at byte {start}): ")
             } else {
@@ -56,9 +57,9 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<Model, MeshError> {
             };
             fail(format!("{which}{e}"))
         })?;
-        model.skipped_degenerate += mesh.1;
+        model.skipped_degenerate += one.skipped_degenerate;
         model.instances.push((model.meshes.len(), Mat4::IDENTITY));
-        model.meshes.push(mesh.0);
+        model.meshes.append(&mut one.meshes);
     }
     Ok(model)
 }
@@ -120,9 +121,9 @@ fn mesh_starts(bytes: &[u8]) -> Result<Vec<(usize, usize)>, String> {
     Ok(starts)
 }
 
-/// The mesh (and how many degenerate triangles were skipped) whose header
-/// and compressed data are `bytes`.
-fn read_mesh(bytes: &[u8]) -> Result<(TriangleMesh, usize), String> {
+/// The mesh (as a model of it alone) whose header and compressed data
+/// are `bytes`.
+fn read_mesh(bytes: &[u8]) -> Result<Model, String> {
     let version = u16::from_le_bytes([bytes[2], bytes[3]]);
     let budget = (bytes.len() as u64 - 4).saturating_mul(MAX_EXPANSION);
     let mut z = Stream {
@@ -130,132 +131,109 @@ fn read_mesh(bytes: &[u8]) -> Result<(TriangleMesh, usize), String> {
         budget,
     };
     let flags = z.u32()?;
-    let (vertices, faces, normals, uvs, colors, double, layout) = if version == 5 {
-        let name = z.u32()?;
-        z.skip(u64::from(name))?;
-        let layout = flags & 0x7;
-        if layout & V5_TANGENTS != 0 {
-            return Err("it stores tangent frames, which lumen does not read".into());
-        }
-        let (v, f) = (z.u64()?, z.u64()?);
-        (
-            v,
-            f,
-            layout & V5_NORMALS != 0,
-            false,
-            false,
-            false,
-            Some(layout),
-        )
+    let arrays = if version == 5 {
+        packed(&mut z, flags)?
     } else {
-        if version == 4 {
-            // The name, ended by a NUL.
-            while z.u8()? != 0 {}
-        }
-        let (v, f) = (z.u64()?, z.u64()?);
-        (
-            v,
-            f,
-            flags & HAS_NORMALS != 0,
-            flags & HAS_TEXCOORDS != 0,
-            flags & HAS_COLORS != 0,
-            flags & DOUBLE_PRECISION != 0,
-            None,
-        )
+        legacy(&mut z, version, flags)?
     };
+    // With face normals the mesh is shaded flat: its vertex normals unused.
+    let normals = arrays.normals.filter(|_| flags & FACE_NORMALS == 0);
+    Model::from_arrays(arrays.positions, &arrays.triangles, normals, arrays.uvs)
+}
+
+/// A mesh's arrays, texture coordinates turned to lumen's v up.
+struct Arrays {
+    positions: Vec<[f32; 3]>,
+    normals: Option<Vec<[f32; 3]>>,
+    uvs: Option<Vec<[f32; 2]>>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// The counts of vertices and triangles that follow in `z`, refused past
+/// what a mesh's `u32` indices reach.
+fn counts(z: &mut Stream) -> Result<(u64, u64), String> {
+    let (vertices, faces) = (z.u64()?, z.u64()?);
     if vertices > u64::from(u32::MAX) || faces > u64::from(u32::MAX) {
         return Err(format!(
             "it declares {vertices} vertices and {faces} triangles; lumen reads up to {} of each",
             u32::MAX
         ));
     }
-    let flat = flags & FACE_NORMALS != 0;
-    let mut mesh = if let Some(layout) = layout {
-        let (p, n) = (z.u64()?, z.u64()?);
-        z.declares(vertices * 32 + faces * 16)?;
-        let records = z.f32s(vertices * 8, false)?;
-        let face_records = z.u32s(faces * 4)?;
-        // The maps to surface points and normal groups: not needed.
-        z.skip(if p > 0 { vertices * 4 } else { 0 } + if n > 0 { vertices * 4 } else { 0 })?;
-        let vertex = |i: usize, lanes: std::ops::Range<usize>| &records[8 * i..][lanes];
-        let count = vertices as usize;
-        let positions = (0..count).map(|i| {
-            let v = vertex(i, 0..3);
-            [v[0], v[1], v[2]]
-        });
-        TriangleMesh {
-            positions: positions.collect(),
-            normals: (layout & V5_NORMALS != 0 && !flat).then(|| {
-                (0..count)
-                    .map(|i| {
-                        let v = vertex(i, 3..6);
-                        [v[0], v[1], v[2]]
-                    })
-                    .collect()
-            }),
-            uvs: (layout & 0x4 != 0).then(|| {
-                (0..count)
-                    .map(|i| {
-                        let v = vertex(i, 6..8);
-                        [v[0], 1.0 - v[1]]
-                    })
-                    .collect()
-            }),
-            ..TriangleMesh::default()
-        }
-        .with_faces(face_records.chunks_exact(4).map(|f| [f[0], f[1], f[2]]))
-    } else {
-        let real = if double { 8 } else { 4 };
-        let per_vertex = 3 + 3 * u64::from(normals) + 2 * u64::from(uvs) + 3 * u64::from(colors);
-        z.declares(vertices * per_vertex * real + faces * 12)?;
-        let positions = z.f32s(vertices * 3, double)?;
-        let normal_values = if normals {
-            Some(z.f32s(vertices * 3, double)?)
-        } else {
-            None
-        };
-        let uv_values = if uvs {
-            Some(z.f32s(vertices * 2, double)?)
-        } else {
-            None
-        };
-        if colors {
-            z.skip(vertices * 3 * real)?;
-        }
-        let indices = z.u32s(faces * 3)?;
-        let triples = |v: Vec<f32>| v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        TriangleMesh {
-            positions: triples(positions),
-            normals: normal_values.filter(|_| !flat).map(triples),
-            uvs: uv_values.map(|v| v.chunks_exact(2).map(|c| [c[0], 1.0 - c[1]]).collect()),
-            ..TriangleMesh::default()
-        }
-        .with_faces(indices.chunks_exact(3).map(|f| [f[0], f[1], f[2]]))
-    }?;
-    let skipped = mesh.1;
-    mesh.0.shrink_to_fit();
-    Ok((mesh.0, skipped))
+    Ok((vertices, faces))
 }
 
-impl TriangleMesh {
-    /// The mesh with `faces` added (indices checked against its vertices,
-    /// triangles without area skipped and counted).
-    fn with_faces(
-        mut self,
-        faces: impl Iterator<Item = [u32; 3]>,
-    ) -> Result<(TriangleMesh, usize), String> {
-        let n = self.positions.len();
-        let mut skipped = 0;
-        for (t, tri) in faces.enumerate() {
-            if let Some(&i) = tri.iter().find(|&&i| i as usize >= n) {
-                return Err(format!(
-                    "triangle {t} names vertex {i}, but there are {n} vertices"
-                ));
-            }
-            skipped += usize::from(!self.push_triangle(tri, NO_MATERIAL));
-        }
-        Ok((self, skipped))
+/// A version 5 mesh after its flags: its name, counts, packed vertex and
+/// face records, and the maps after them (read past, not kept).
+fn packed(z: &mut Stream, flags: u32) -> Result<Arrays, String> {
+    let name = z.u32()?;
+    z.skip(u64::from(name))?;
+    let layout = flags & 0x7;
+    if layout & V5_TANGENTS != 0 {
+        return Err("it stores tangent frames, which lumen does not read".into());
     }
+    let (vertices, faces) = counts(z)?;
+    let (points, groups) = (z.u64()?, z.u64()?);
+    z.declares(vertices * 32 + faces * 16)?;
+    let records = z.f32s(vertices * 8, false)?;
+    let face_records = z.u32s(faces * 4)?;
+    // The maps to surface points and normal groups: not needed.
+    z.skip(if points > 0 { vertices * 4 } else { 0 } + if groups > 0 { vertices * 4 } else { 0 })?;
+    let vertex = || records.chunks_exact(8);
+    Ok(Arrays {
+        positions: vertex().map(|r| [r[0], r[1], r[2]]).collect(),
+        normals: (layout & V5_NORMALS != 0).then(|| vertex().map(|r| [r[3], r[4], r[5]]).collect()),
+        uvs: (layout & V5_TEXCOORDS != 0).then(|| vertex().map(|r| [r[6], 1.0 - r[7]]).collect()),
+        triangles: face_records
+            .chunks_exact(4)
+            .map(|f| [f[0], f[1], f[2]])
+            .collect(),
+    })
+}
+
+/// A version 3 or 4 mesh after its flags: its name (version 4), counts,
+/// and arrays of positions, normals, texture coordinates and colours (read
+/// past, not kept) as the flags say, then the triangles' indices.
+fn legacy(z: &mut Stream, version: u16, flags: u32) -> Result<Arrays, String> {
+    if version == 4 {
+        // The name, ended by a NUL.
+        while z.u8()? != 0 {}
+    }
+    let (vertices, faces) = counts(z)?;
+    let (normals, uvs, colors) = (
+        flags & HAS_NORMALS != 0,
+        flags & HAS_TEXCOORDS != 0,
+        flags & HAS_COLORS != 0,
+    );
+    let double = flags & DOUBLE_PRECISION != 0;
+    let real = if double { 8 } else { 4 };
+    let per_vertex = 3 + 3 * u64::from(normals) + 2 * u64::from(uvs) + 3 * u64::from(colors);
+    z.declares(vertices * per_vertex * real + faces * 12)?;
+    let triples = |v: Vec<f32>| v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let positions = triples(z.f32s(vertices * 3, double)?);
+    let normals = if normals {
+        Some(triples(z.f32s(vertices * 3, double)?))
+    } else {
+        None
+    };
+    let uvs = if uvs {
+        let values = z.f32s(vertices * 2, double)?;
+        Some(values.chunks_exact(2).map(|c| [c[0], 1.0 - c[1]]).collect())
+    } else {
+        None
+    };
+    if colors {
+        z.skip(vertices * 3 * real)?;
+    }
+    let indices = z.u32s(faces * 3)?;
+    Ok(Arrays {
+        positions,
+        normals,
+        uvs,
+        triangles: indices
+            .chunks_exact(3)
+            .map(|f| [f[0], f[1], f[2]])
+            .collect(),
+    })
 }
 
 /// A mesh's decompressed data, read in order.

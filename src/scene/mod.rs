@@ -229,12 +229,7 @@ fn beyond(t: f32) -> f32 {
 #[inline]
 fn cutout_random(ray: &Ray, t: f32) -> f32 {
     let (o, d) = (ray.origin(), ray.direction);
-    let mut h = 0x9e37_79b9_7f4a_7c15u64;
-    for x in [o.x, o.y, o.z, d.x, d.y, d.z, t] {
-        h = (h ^ u64::from(x.to_bits())).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        h ^= h >> 31;
-    }
-    (h >> 40) as f32 / (1u64 << 24) as f32
+    crate::rng::unit_hash([o.x, o.y, o.z, d.x, d.y, d.z, t])
 }
 
 /// A mesh file a scene reads.

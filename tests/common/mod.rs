@@ -589,3 +589,83 @@ pub fn children_peak_mb() -> f64 {
     // ru_maxrss is in kilobytes on Linux.
     usage.ru_maxrss as f64 / 1024.0
 }
+
+/// The colour of the material where the ray from `from` along `towards`
+/// first hits: its albedo, or its radiance for a light.
+pub fn colour_at(
+    scene: &Scene,
+    from: lumen::math::Vec3,
+    towards: lumen::math::Vec3,
+) -> lumen::math::Color {
+    use lumen::bsdf::Lobe;
+    let ray = lumen::ray::Ray::new(from, towards.normalize());
+    let record = scene
+        .hit(&ray, lumen::math::Interval::new(1e-4, f32::INFINITY))
+        .expect("a hit");
+    let material = scene.material(&record);
+    if material.emits() {
+        return material.emitted(&record, &scene.textures);
+    }
+    match material
+        .bsdf(&record, -ray.direction, &scene.textures)
+        .map(|b| b.lobe)
+    {
+        Some(Lobe::Diffuse(d)) => d.albedo,
+        Some(Lobe::Metal(m)) => m.albedo,
+        Some(Lobe::Principled(p)) => p.base_color,
+        other => panic!("no colour: {other:?}"),
+    }
+}
+
+/// Whether two colours agree to 10⁻⁴ in every channel.
+pub fn colours_close(a: lumen::math::Color, b: lumen::math::Color) -> bool {
+    (a - b).abs().max_element() < 1e-4
+}
+
+/// Writes `path`, a 4 × 2 PNG of eight pure colours (8-bit 0 and 255,
+/// which sRGB decodes to exactly 0 and 1), and returns them row by row
+/// from the top, as linear colours.
+pub fn eight_colours_png(path: &std::path::Path) -> [lumen::math::Color; 8] {
+    let texels: [[u8; 3]; 8] = [
+        [255, 0, 0],
+        [0, 255, 0],
+        [0, 0, 255],
+        [255, 255, 0],
+        [0, 255, 255],
+        [255, 0, 255],
+        [255, 255, 255],
+        [0, 0, 0],
+    ];
+    image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(texels[(y * 4 + x) as usize]))
+        .save(path)
+        .unwrap();
+    texels.map(|t| lumen::math::Color::from_array(t.map(|c| f32::from(c) / 255.0)))
+}
+
+/// Checks that the sphere of radius below 3 about `centre`, textured by
+/// [`eight_colours_png`], shows each texel at its centre where Mitsuba and
+/// pbrt put it: u round the sphere's z from +x towards +y, the image's top
+/// row at +z.
+pub fn assert_texels_round_z(
+    scene: &Scene,
+    centre: lumen::math::Vec3,
+    colours: &[lumen::math::Color; 8],
+) {
+    for column in 0..4 {
+        let phi = (0.125 + 0.25 * column as f32) * std::f32::consts::TAU;
+        for (row, theta) in [(0, 0.25), (1, 0.75)] {
+            let theta = theta * std::f32::consts::PI;
+            let d = lumen::math::Vec3::new(
+                phi.cos() * theta.sin(),
+                phi.sin() * theta.sin(),
+                theta.cos(),
+            );
+            let seen = colour_at(scene, centre + d * 3.0, -d);
+            let want = colours[row * 4 + column];
+            assert!(
+                colours_close(seen, want),
+                "sphere column {column} row {row}: {seen:?}, want {want:?}"
+            );
+        }
+    }
+}

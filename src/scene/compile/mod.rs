@@ -105,29 +105,25 @@ impl Scene {
         let mut material_index = HashMap::with_capacity(desc.materials.len());
         let mut table = TextureTable::new(&desc.textures, base)?;
         let mut sources = Vec::new();
+        let mut context = MaterialTextures {
+            textures: &mut table,
+            sources: &mut sources,
+            materials: &desc.materials,
+            resolving: Vec::new(),
+        };
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);
-            let mut context = MaterialTextures {
-                textures: &mut table,
-                sources: &mut sources,
-                materials: &desc.materials,
-                resolving: vec![name.as_str()],
-            };
+            context.resolving = vec![name.as_str()];
             materials.push(
                 m.compile(&format!("materials.{name}"), &mut context)
                     .map_err(|e| invalid(e.field, e.message))?,
             );
         }
+        context.resolving.clear();
         let mut light_sources = Vec::with_capacity(desc.lights.len());
         for (i, l) in desc.lights.iter().enumerate() {
-            let mut textures = MaterialTextures {
-                textures: &mut table,
-                sources: &mut sources,
-                materials: &desc.materials,
-                resolving: Vec::new(),
-            };
             light_sources.push(
-                l.compile(&format!("lights[{i}]"), &mut textures)
+                l.compile(&format!("lights[{i}]"), &mut context)
                     .map_err(|e| invalid(e.field, e.message))?,
             );
         }

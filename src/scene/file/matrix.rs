@@ -12,6 +12,22 @@ pub const IDENTITY: Mat4 = [
     [0.0, 0.0, 0.0, 1.0],
 ];
 
+/// The turn about `center` that gives a lumen sphere Mitsuba's and
+/// pbrt's texture coordinates. Theirs go round the sphere's z (u from +x
+/// towards +y, v from −z to +z, the image's top row at +z), lumen's round
+/// its y (u from −x towards +z, v from −y to +y): the rotation
+/// (x, y, z) → (−x, z, y), its own inverse, takes one onto the other. A
+/// sphere without a texture shows it nowhere.
+pub fn z_up_sphere([cx, cy, cz]: [f64; 3]) -> Mat4 {
+    // translate(c) · turn · translate(−c), written out exactly.
+    [
+        [-1.0, 0.0, 0.0, 2.0 * cx],
+        [0.0, 0.0, 1.0, cy - cz],
+        [0.0, 1.0, 0.0, cz - cy],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+}
+
 /// a · b.
 pub fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut m = [[0.0; 4]; 4];

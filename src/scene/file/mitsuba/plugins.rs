@@ -818,15 +818,13 @@ impl<'d> Convert<'d> {
         }
     }
 
-    /// The turn about +y, in degrees, that `m` is; refused (or taken as
-    /// its turn about y) when it is any other transform.
     /// An environment map's orientation from its `to_world` `m`: a turn
     /// about +y in degrees (lumen's `rotation`, Mitsuba's half-turn apart
     /// added), and the map's axes in the world when it turns otherwise
     /// (lumen's `frame`). Its translation does not matter (the map is at
     /// infinity); a scale, shear or mirror is refused.
     fn envmap_orientation(
-        &mut self,
+        &self,
         e: &Element,
         m: &Mat4,
     ) -> Result<(f64, Option<[Triple; 3]>), Failure> {
@@ -939,30 +937,19 @@ impl<'d> Convert<'d> {
                 known.extend(["center", "radius"]);
                 let center = p.point("center", self)?.unwrap_or([0.0; 3]);
                 let radius = p.float("radius", self)?.unwrap_or(1.0);
-                // Mitsuba's (u, v) go round its sphere's z (u from +x
-                // towards +y, v down from +z), lumen's round y (u from −x
-                // towards +z, v up from −y): the sphere turned about its
-                // centre by the rotation (x, y, z) → (−x, z, y) that takes
-                // one onto the other (its own inverse), which a sphere
-                // without a texture shows nowhere.
-                let [cx, cy, cz] = center;
-                let about_centre = [
-                    [-1.0, 0.0, 0.0, 2.0 * cx],
-                    [0.0, 0.0, 1.0, cy - cz],
-                    [0.0, 1.0, 0.0, cz - cy],
-                    [0.0, 0.0, 0.0, 1.0],
-                ];
+                // Turned so that its (u, v) are Mitsuba's.
+                let turn = crate::scene::file::matrix::z_up_sphere(center);
                 ObjectDesc::Sphere {
                     center,
                     radius,
                     material,
-                    transform: matrix(&crate::scene::file::matrix::mul(&m, &about_centre)),
+                    transform: matrix(&crate::scene::file::matrix::mul(&m, &turn)),
                 }
             }
             "rectangle" => {
                 let desc = &self.desc.materials[&material];
-                let emits = matches!(desc, MaterialDesc::Emissive(_))
-                    || desc.clone().surface_mut().emission.is_some();
+                let emits =
+                    matches!(desc, MaterialDesc::Emissive(_)) || desc.surface().emission.is_some();
                 if emits {
                     // A light stays a quad, which light sampling sees by
                     // its solid angle.

@@ -23,6 +23,22 @@ pub enum Tex {
     Named(String),
 }
 
+impl From<Tex> for ColorDesc {
+    fn from(t: Tex) -> ColorDesc {
+        match t {
+            Tex::Constant(c) => ColorDesc::Rgb(c),
+            Tex::Named(n) => ColorDesc::Texture(n),
+        }
+    }
+}
+
+/// Whether image file `file` holds floating-point values (read linear),
+/// by its name.
+pub(super) fn float_image(file: &str) -> bool {
+    let lower = file.to_ascii_lowercase();
+    [".exr", ".pfm", ".hdr"].iter().any(|e| lower.ends_with(e))
+}
+
 /// The materials lumen reads.
 const MATERIALS: &[&str] = &[
     "diffuse",
@@ -509,10 +525,7 @@ impl Builder {
             Some((Spectral::Samples(v), sat)) => {
                 ColorDesc::Rgb(spectra::reflectance_samples(&v).map_err(|m| (sat, m, None))?)
             }
-            Some((Spectral::Texture(t), tat)) => match self.texture_of(&t, false, tat)? {
-                Tex::Constant(c) => ColorDesc::Rgb(c),
-                Tex::Named(n) => ColorDesc::Texture(n),
-            },
+            Some((Spectral::Texture(t), tat)) => self.texture_of(&t, false, tat)?.into(),
             Some((_, sat)) => {
                 return Err((sat, format!("`{name}` must be a colour or a texture"), None))
             }
@@ -614,17 +627,9 @@ impl Builder {
                     None,
                 ))?;
                 let file = input.file(file, fat)?;
-                let lower = file.to_ascii_lowercase();
-                let float_image = [".exr", ".pfm", ".hdr"].iter().any(|e| lower.ends_with(e));
                 let encoding = match p.string("encoding")? {
-                    _ if float_image => EncodingDesc::Linear,
-                    None | Some("sRGB") => {
-                        if lower.ends_with(".png") || !float_image {
-                            EncodingDesc::Srgb
-                        } else {
-                            EncodingDesc::Linear
-                        }
-                    }
+                    _ if float_image(&file) => EncodingDesc::Linear,
+                    None | Some("sRGB") => EncodingDesc::Srgb,
                     Some("linear") => EncodingDesc::Linear,
                     Some(other) => {
                         self.lacks(at, &format!("image encoding `{other}`"), "sRGB")?;
@@ -724,12 +729,8 @@ impl Builder {
             // A float checkerboard is a checkerboard of greys: lumen's
             // scalar checkerboard.
             "checkerboard" if p.int("dimension")?.unwrap_or(2) == 2 => {
-                let colour = |t: Tex| match t {
-                    Tex::Constant(c) => ColorDesc::Rgb(c),
-                    Tex::Named(n) => ColorDesc::Texture(n),
-                };
-                let even = colour(value(self, "tex1", 1.0)?);
-                let odd = colour(value(self, "tex2", 0.0)?);
+                let even = value(self, "tex1", 1.0)?.into();
+                let odd = value(self, "tex2", 0.0)?.into();
                 let [su, sv, du, dv] = mapping(p)?;
                 p.finish(
                     "a checkerboard texture",
@@ -777,16 +778,12 @@ impl Builder {
                         Tex::Constant([0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t))
                     }
                     (first, second, amount) => {
-                        let colour = |t: Tex| match t {
-                            Tex::Constant(c) => ColorDesc::Rgb(c),
-                            Tex::Named(n) => ColorDesc::Texture(n),
-                        };
                         let lumen = self.name("mix");
                         self.desc.textures.insert(
                             lumen.clone(),
                             TextureDesc::Mix {
-                                first: colour(first),
-                                second: colour(second),
+                                first: first.into(),
+                                second: second.into(),
                                 amount,
                             },
                         );
@@ -834,7 +831,7 @@ impl Builder {
     }
 
     /// Texture `t` times `factor`, as a texture of its own.
-    fn scaled(&mut self, t: String, factor: [f64; 3]) -> Tex {
+    pub(super) fn scaled(&mut self, t: String, factor: [f64; 3]) -> Tex {
         let name = self.name("scaled");
         self.desc.textures.insert(
             name.clone(),

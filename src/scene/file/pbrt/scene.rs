@@ -8,7 +8,7 @@ use super::{spectra, Input};
 use crate::scene::desc::{
     BackgroundDesc, CameraDesc, ColorDesc, DirectionalLightDesc, EncodingDesc, IntegratorDesc,
     LightDesc, LightSelection, ObjectDesc, PixelFilterDesc, PointLightDesc, SamplingDesc,
-    SceneDesc, SpotLightDesc, TextureDesc, TransformDesc,
+    SceneDesc, SpotLightDesc, TransformDesc,
 };
 use crate::scene::file::import::Imported;
 use crate::scene::file::matrix::{self, Mat4, IDENTITY};
@@ -1043,9 +1043,7 @@ impl Builder {
                 // as pbrt looks it up; an 8-bit image is sRGB, a float one
                 // linear.
                 let file = input.file(file, fat)?;
-                let lower = file.to_ascii_lowercase();
-                let float_image = [".exr", ".pfm", ".hdr"].iter().any(|e| lower.ends_with(e));
-                let encoding = if float_image {
+                let encoding = if super::materials::float_image(&file) {
                     EncodingDesc::Linear
                 } else {
                     EncodingDesc::Srgb
@@ -1060,17 +1058,7 @@ impl Builder {
                         return Err((at, format!("`scale` must be ≥ 0, got {s}"), None))
                     }
                     1.0 => ColorDesc::Texture(name),
-                    s => {
-                        let scaled = self.name("area-light-image");
-                        self.desc.textures.insert(
-                            scaled.clone(),
-                            TextureDesc::Scale {
-                                texture: ColorDesc::Texture(name),
-                                factor: [s; 3],
-                            },
-                        );
-                        ColorDesc::Texture(scaled)
-                    }
+                    s => self.scaled(name, [s; 3]).into(),
                 }
             }
         };
@@ -1228,9 +1216,7 @@ fn upper_illuminance(path: &std::path::Path, at: At) -> Result<f64, Problem> {
             if d.z <= 0.0 {
                 continue;
             }
-            let c = image.texel(x, y);
-            let luminance = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-            sum += f64::from(luminance * d.z);
+            sum += f64::from(crate::light::luminance(image.texel(x, y)) * d.z);
         }
     }
     let illuminance = sum * 2.0 * std::f64::consts::PI / (w * h) as f64;

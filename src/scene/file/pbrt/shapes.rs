@@ -8,8 +8,7 @@ use super::params::{Params, Problem};
 use super::scene::Builder;
 use super::Input;
 use crate::scene::desc::{ObjectDesc, TransformDesc};
-use crate::scene::file::matrix::{self, Mat4};
-use crate::scene::file::tessellate;
+use crate::scene::file::{matrix, tessellate};
 
 /// The shapes lumen reads.
 const SHAPES: &[&str] = &[
@@ -59,17 +58,9 @@ impl Builder {
                         "one that shines outwards",
                     )?;
                 }
-                // pbrt's (u, v) go round the sphere's z (u from +x towards
-                // +y, v up from −z), lumen's round y (u from −x towards +z,
-                // v up from −y): the sphere turned by (x, y, z) → (−x, z, y),
-                // which takes one onto the other (and is its own inverse).
-                const TURN: Mat4 = [
-                    [-1.0, 0.0, 0.0, 0.0],
-                    [0.0, 0.0, 1.0, 0.0],
-                    [0.0, 1.0, 0.0, 0.0],
-                    [0.0, 0.0, 0.0, 1.0],
-                ];
-                let transform = vec![TransformDesc::Matrix(matrix::mul(&self.state.ctm, &TURN))];
+                // Turned so that its (u, v) are pbrt's.
+                let turn = matrix::z_up_sphere([0.0; 3]);
+                let transform = vec![TransformDesc::Matrix(matrix::mul(&self.state.ctm, &turn))];
                 self.add(ObjectDesc::Sphere {
                     center: [0.0; 3],
                     radius,
