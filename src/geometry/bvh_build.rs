@@ -5,7 +5,7 @@
 //! `i + 1`, and each interior node stores the index of its right child.
 //! [`super::bvh::Bvh`] then collapses this binary tree into its wide form.
 
-use crate::geometry::primitive::{Kind, PrimitiveSet};
+use crate::geometry::primitive::{Kind, PrimitiveSet, KINDS};
 use crate::math::{Point3, Vec3};
 
 /// Leaves hold at most this many primitives, all of one kind: one packet,
@@ -139,7 +139,7 @@ pub struct BinaryTree {
     /// `offset..offset + count` are `primitives[order[offset]]`, ….
     pub order: Vec<u32>,
     /// The number of leaves of each [`Kind`] (every leaf holds one kind).
-    pub leaves: [usize; 4],
+    pub leaves: [usize; KINDS],
 }
 
 /// The binary SAH tree over `primitives`.
@@ -171,7 +171,7 @@ pub fn build_binary<P: PrimitiveSet + ?Sized>(primitives: &P) -> BinaryTree {
         nodes.shrink_to_fit();
         nodes
     };
-    let mut leaves = [0; 4];
+    let mut leaves = [0; KINDS];
     for n in nodes.iter().filter(|n| n.is_leaf()) {
         leaves[items[n.offset as usize].kind as usize] += 1;
     }
@@ -521,7 +521,7 @@ mod tests {
             );
             // Every primitive in one leaf of one kind, counted by kind.
             let mut seen = vec![false; n];
-            let mut leaves = [0; 4];
+            let mut leaves = [0; KINDS];
             for leaf in tree.nodes.iter().filter(|l| l.is_leaf()) {
                 let members = &tree.order[leaf.offset as usize..][..leaf.count as usize];
                 assert!(members.len() <= MAX_LEAF);

@@ -35,7 +35,7 @@
 
 use super::bvh::{
     comes_before, leaf_parts, Bvh, Enter, Hit, InstancePacket, Node, Node8, Nodes, QuadPacket,
-    Rays, SpherePacket, TrianglePacket, NO_CHILD, SLACK,
+    QuadricPacket, Rays, SpherePacket, TrianglePacket, NO_CHILD, SLACK,
 };
 use crate::geometry::primitive::Kind;
 use crate::geometry::quad;
@@ -490,6 +490,29 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
             }
         }
     }
+
+    /// The disks and cylinders of packet `p` for the lanes of `enter`
+    /// (bits), one ray and one shape at a time, as `Bvh::hit` tests them.
+    #[inline(never)]
+    fn quadrics(&mut self, p: &QuadricPacket, mut enter: u32) {
+        while enter != 0 {
+            let l = enter.trailing_zeros() as usize;
+            enter &= enter - 1;
+            let ray = self.rays.ray(l);
+            for (shape, &index) in p.shapes.iter().zip(&p.index) {
+                let Some(shape) = shape else {
+                    break;
+                };
+                let Some(t) = shape.hit(&ray, self.t_min) else {
+                    continue;
+                };
+                if t <= self.closest[l] && comes_before((t, index), (self.closest[l], self.best[l]))
+                {
+                    (self.closest[l], self.best[l], self.sub[l]) = (t, index, 0);
+                }
+            }
+        }
+    }
 }
 
 /// The leaf tests of [`BundleRays`] on AVX lanes, each compiled for AVX2
@@ -703,9 +726,13 @@ impl<const SPHERES: bool> Rays for BundleRays<'_, SPHERES> {
     fn leaf(&mut self, bvh: &Bvh, leaf: u32, entry: &Lanes) -> bool {
         let (kind, i) = leaf_parts(leaf);
         let kind = if SPHERES { Kind::Sphere } else { kind };
-        if kind == Kind::Instance {
+        if kind >= Kind::Instance {
             let enter = F8::bits(self.entering::<F8>(entry));
-            self.instances(bvh, bvh.instance_packet(i), enter);
+            if kind == Kind::Instance {
+                self.instances(bvh, bvh.instance_packet(i), enter);
+            } else {
+                self.quadrics(bvh.quadric_packet(i), enter);
+            }
             return false;
         }
         // SAFETY (the AVX2 calls): `avx2` is true only when `Isa::detect`

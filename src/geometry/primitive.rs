@@ -1,9 +1,9 @@
-//! The closed set of shapes a BVH holds: spheres, triangles and quads, and
-//! instances of other trees. Each operation is one `match` over the kind;
+//! The closed set of shapes a BVH holds: spheres, triangles, quads, disks
+//! and cylinders, and instances of other trees. Each operation is one `match` over the kind;
 //! each kind's intersection is one kernel (see [`crate::lanes`]).
 
 use crate::geometry::bvh_build::Aabb;
-use crate::geometry::{Quad, Sphere, Triangle};
+use crate::geometry::{Quad, Quadric, Sphere, Triangle};
 use crate::math::Interval;
 use crate::ray::Ray;
 
@@ -19,17 +19,24 @@ pub enum Kind {
     Quad = 2,
     /// A placed copy of another tree.
     Instance = 3,
+    /// A disk or a cylinder ([`Quadric`]). It and the instances are tested
+    /// out of line, one at a time (see `Bvh`'s leaf tests).
+    Quadric = 4,
 }
+
+/// How many kinds there are.
+pub const KINDS: usize = 5;
 
 impl Kind {
     /// The kind numbered `n` (its discriminant).
     #[inline(always)]
     pub fn from_index(n: u32) -> Kind {
-        match n & 3 {
+        match n & 7 {
             0 => Kind::Sphere,
             1 => Kind::Triangle,
             2 => Kind::Quad,
-            _ => Kind::Instance,
+            3 => Kind::Instance,
+            _ => Kind::Quadric,
         }
     }
 }
@@ -69,6 +76,8 @@ pub enum Primitive {
     Triangle(Triangle),
     /// A parallelogram.
     Quad(Quad),
+    /// A disk or a cylinder.
+    Quadric(Quadric),
     /// Instance number `index` of the scene, whose world bounds are `bounds`.
     Instance {
         /// The instance's world-space bounding box.
@@ -85,6 +94,7 @@ impl Primitive {
             Primitive::Sphere(_) => Kind::Sphere,
             Primitive::Triangle(_) => Kind::Triangle,
             Primitive::Quad(_) => Kind::Quad,
+            Primitive::Quadric(_) => Kind::Quadric,
             Primitive::Instance { .. } => Kind::Instance,
         }
     }
@@ -95,6 +105,7 @@ impl Primitive {
             Primitive::Sphere(s) => Aabb::new(s.bounds()),
             Primitive::Triangle(t) => Aabb::new(t.bounds()),
             Primitive::Quad(q) => Aabb::new(q.bounds()),
+            Primitive::Quadric(q) => q.bounds(),
             Primitive::Instance { bounds, .. } => *bounds,
         }
     }
@@ -108,6 +119,7 @@ impl Primitive {
             Primitive::Sphere(s) => s.hit(ray, interval),
             Primitive::Triangle(t) => t.hit(ray, interval),
             Primitive::Quad(q) => q.hit(ray, interval),
+            Primitive::Quadric(q) => q.hit(ray, interval.min).filter(|&t| t < interval.max),
             Primitive::Instance { .. } => None,
         }
     }
