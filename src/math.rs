@@ -39,3 +39,16 @@ impl Interval {
 pub fn lerp(a: Color, b: Color, t: f32) -> Color {
     (1.0 - t) * a + t * b
 }
+
+/// Two unit vectors that make a right-handed orthonormal frame (s, t, n)
+/// with unit `n`: Duff et al.'s branchless construction (2017), the one
+/// Mitsuba's `coordinate_system` and pbrt-v4's `CoordinateSystem` use, so
+/// that angles about an axis start where theirs do.
+pub fn frame(n: glam::DVec3) -> [glam::DVec3; 3] {
+    let sign = 1f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let s = glam::DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let t = glam::DVec3::new(b, sign + n.y * n.y * a, -n.y);
+    [s, t, n]
+}

@@ -155,8 +155,12 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
             vec!["bad.xml:2:", "unknown index of refraction `glas`", "bk7"],
         ),
         (
-            scene("  <shape type=\"disk\"/>"),
-            vec!["bad.xml:2:3", "a disk shape", "--approximate"],
+            scene("  <shape type=\"cylinder\"><boolean name=\"flip_normals\" value=\"true\"/></shape>"),
+            vec!["bad.xml:2:3", "flip_normals", "--approximate"],
+        ),
+        (
+            scene("  <shape type=\"cylinder\"><point name=\"p1\" value=\"0, 0, 0\"/></shape>"),
+            vec!["bad.xml:2:3", "p0 and p1 must differ"],
         ),
         (
             scene("  <shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"500:0.5, 400:0.5\"/></bsdf></shape>"),
@@ -229,7 +233,10 @@ fn includes_that_loop_or_leave_the_folder_and_unused_parameters_are_refused() {
 #[test]
 fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     let dir = scratch_dir("mitsuba_scenes_approximate");
-    let text = scene("  <shape type=\"disk\"/>\n  <shape type=\"cylinder\"/>");
+    let flipped = "<boolean name=\"flip_normals\" value=\"true\"/>";
+    let text = scene(&format!(
+        "  <shape type=\"sphere\">{flipped}</shape>\n  <shape type=\"cylinder\">{flipped}</shape>"
+    ));
     let path = dir.join("s.xml");
     std::fs::write(&path, &text).unwrap();
     let options = mitsuba::Options {
@@ -241,11 +248,11 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("s.xml:2:3: a disk shape")));
+        .any(|w| w.contains("s.xml:2:3: flip_normals")));
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("s.xml:3:3: a cylinder shape")));
+        .any(|w| w.contains("s.xml:3:3: flip_normals")));
     file.compile(&Overrides::default()).unwrap();
 }
 

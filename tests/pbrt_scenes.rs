@@ -296,7 +296,8 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("ConcatTransform [ 1 0 0 1  0 1 0 0  0 0 1 0  0 0 0 1 ]\n", "a projective matrix"),
         ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "is not among lumen's conductors"),
         ("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-BK8\"\n", "did you mean `glass-BK7`?"),
-        ("WorldBegin\nShape \"disk\"\n", "--approximate renders a polygon of 128 sides of its area instead"),
+        ("WorldBegin\nShape \"disk\" \"float innerradius\" 0.5\n", "--approximate renders a polygon of 128 sides of its area instead"),
+        ("WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1\n", "zmin and zmax are both 1"),
         ("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n", "file `sky.exr` not found"),
         ("WorldBegin\nCoordSysTransform \"camra\"\n", "no coordinate system `camra`"),
         ("WorldBegin\n\"float x\" 1\n", "expected a directive"),
@@ -349,12 +350,12 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     };
     let file = read_in(
         &dir,
-        "WorldBegin\nShape \"disk\"\nMaterial \"hair\"\nShape \"sphere\"\n",
+        "WorldBegin\nShape \"disk\" \"float innerradius\" 0.5\nMaterial \"hair\"\nShape \"sphere\"\n",
         &options,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(file.import_warnings.len(), 2, "{:?}", file.import_warnings);
-    assert!(file.import_warnings[0].contains("s.pbrt:2:7: `disk` shape"));
+    assert!(file.import_warnings[0].contains("s.pbrt:2:7: a disk with a hole"));
     assert!(file.import_warnings[1].contains("`hair` material"));
     file.compile(&Overrides::default()).unwrap();
 }

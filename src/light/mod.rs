@@ -2,12 +2,13 @@
 //! that a path can aim at them (next-event estimation) instead of only
 //! meeting them by chance.
 //!
-//! Every emissive sphere, quad and triangle becomes a [`Light`] in world
-//! space; the [`Environment`] (what escaping rays see) is one more. A
-//! [`Lights`] list chooses one in proportion to its power (emitted radiance
-//! × area × π, twice that for two-sided lights; see [`LightSelection`]) or
-//! uniformly, and samples a point on it: spheres by the solid angle of the
-//! cap seen from the shaded point, quads and triangles uniformly by area, the
+//! Every emissive sphere, quad, disk, cylinder and triangle becomes a
+//! [`Light`] in world space; the [`Environment`] (what escaping rays see) is
+//! one more. A [`Lights`] list chooses one in proportion to its power
+//! (emitted radiance × area × π, twice that for two-sided lights; see
+//! [`LightSelection`]) or uniformly, and samples a point on it: spheres by
+//! the solid angle of the cap seen from the shaded point, the other shapes
+//! uniformly by area (rectangles close up by solid angle), the
 //! environment by its brightness. [`Lights::pdf`] gives the density,
 //! per unit solid angle, with which a direction that happens to meet a light
 //! would have been sampled, which multiple importance sampling needs.
@@ -22,7 +23,7 @@ pub use environment::{Environment, EnvironmentMap};
 pub use source::{LightDesc, LightSource};
 
 use crate::distribution::Distribution1D;
-use crate::geometry::Sphere;
+use crate::geometry::{Quadric, Sphere};
 use crate::material::Emissive;
 use crate::math::{Color, Point3, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -55,6 +56,9 @@ pub enum Shape {
         /// The corners.
         vertices: [Point3; 3],
     },
+    /// A disk, or a cylinder whose cross-sections are circles (see
+    /// [`Quadric::round`]): its outward side is its own.
+    Quadric(Quadric),
 }
 
 impl Shape {
@@ -76,6 +80,7 @@ impl Shape {
             Shape::Triangle {
                 vertices: [a, b, c],
             } => 0.5 * length((b - a).cross(c - a), b - a, c - a),
+            Shape::Quadric(q) => q.area(),
         }
     }
 }
@@ -99,7 +104,8 @@ pub struct LightTexture {
     pub texture: u32,
     /// The texture coordinates at a triangle's corners a, b, c, or at a
     /// quad's corner Q, Q + u and Q + v (unused for spheres, whose
-    /// coordinates follow from the normal).
+    /// coordinates follow from the normal, and for disks and cylinders,
+    /// whose own they are).
     pub uvs: [[f32; 2]; 3],
 }
 
@@ -146,6 +152,7 @@ impl Light {
         };
         let uv = match self.shape {
             Shape::Sphere { .. } => Sphere::uv(outward),
+            Shape::Quadric(_) => st,
             // Affine in (s, t) from the coordinates at the corner and at the
             // ends of the two edges (a triangle's barycentrics b₁, b₂).
             Shape::Quad { .. } | Shape::Triangle { .. } => {
@@ -508,6 +515,12 @@ impl Surface {
     fn of(shape: &Shape) -> Self {
         let normal = match *shape {
             Shape::Sphere { .. } => Vec3::ZERO,
+            // A disk's normal is everywhere the same; a cylinder's is its
+            // sample's.
+            Shape::Quadric(q) => match q.form {
+                crate::geometry::QuadricForm::Disk => q.at([0.0, 0.0]).outward,
+                crate::geometry::QuadricForm::Cylinder => Vec3::ZERO,
+            },
             Shape::Quad { u, v, .. } => u.cross(v).normalize(),
             Shape::Triangle {
                 vertices: [a, b, c],
@@ -551,7 +564,8 @@ impl Surface {
 /// A uniform point on the area of `shape`, whose unit normal is `normal`
 /// if it is flat ([`Surface::of`]), its outward unit normal, and its
 /// parameters: a quad's (α, β), a triangle's barycentrics (b₁, b₂) of its
-/// second and third corners (a sphere's follow from the normal).
+/// second and third corners, a disk's or cylinder's texture coordinates (a
+/// sphere's follow from the normal).
 fn sample_area(shape: &Shape, normal: Vec3, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
     match *shape {
         Shape::Sphere { center, radius } => {
@@ -569,6 +583,10 @@ fn sample_area(shape: &Shape, normal: Vec3, [s, t]: [f32; 2]) -> (Point3, Vec3, 
                 (s, t)
             };
             (a + s * (b - a) + t * (c - a), normal, [s, t])
+        }
+        Shape::Quadric(q) => {
+            let hit = q.sample([s, t]);
+            (hit.point, hit.outward, hit.uv)
         }
     }
 }

@@ -53,6 +53,10 @@ fn solid_angle_estimate(shape: Shape, from: Point3) -> (f64, f64) {
             Shape::Triangle {
                 vertices: [a, b, c],
             } => (b - a).cross(c - a).normalize(),
+            Shape::Quadric(q) => {
+                let ray = crate::ray::Ray::new(from, s.direction);
+                q.surface(&ray, s.distance).outward
+            }
         };
         let pdf = lights.pdf(0, from, point, outward);
         assert!(
@@ -123,6 +127,73 @@ fn a_rectangle_is_sampled_by_solid_angle_close_up_and_by_area_farther() {
     };
     let e = solid_angle_estimate(slanted, Vec3::new(0.0, 0.5, 0.0));
     assert!(e.1 > 1e-3 * e.0, "{e:?}");
+}
+
+#[test]
+fn disks_and_cylinders_are_sampled_uniformly_by_area() {
+    use crate::geometry::transform::{Transform, TransformStep};
+    use crate::geometry::{Quadric, QuadricForm};
+    let place = |form, steps: &[TransformStep]| {
+        Shape::Quadric(Quadric::new(form, &Transform::from_steps(steps).unwrap()))
+    };
+    // A disk of radius R seen from its axis, at height h, covers
+    // 2π(1 − h/√(h² + R²)), whichever way it is turned.
+    let (radius, h) = (1.5f64, 2.0f64);
+    let turn = TransformStep::Rotate {
+        axis: [1.0, -2.0, 0.5],
+        degrees: 70.0,
+    };
+    let disk = place(
+        QuadricForm::Disk,
+        &[TransformStep::Scale([radius; 3]), turn],
+    );
+    let from = Transform::from_steps(&[turn])
+        .unwrap()
+        .point(Vec3::new(0.0, 0.0, h as f32));
+    let exact = 2.0 * std::f64::consts::PI * (1.0 - h / (h * h + radius * radius).sqrt());
+    assert_close("disk", solid_angle_estimate(disk, from), exact);
+    // A turned cylinder of radius r and length L: the area behind each
+    // sample, d² / (|cos θ| pdf), is 2π r L (in every sample: the pdf is
+    // uniform by area).
+    let (r, length) = (0.4f64, 3.0f64);
+    let tube = place(
+        QuadricForm::Cylinder,
+        &[
+            TransformStep::Scale([r, r, length]),
+            TransformStep::Rotate {
+                axis: [0.3, 1.0, 0.2],
+                degrees: 50.0,
+            },
+            TransformStep::Translate([1.0, 2.0, -1.0]),
+        ],
+    );
+    let Shape::Quadric(q) = tube else {
+        unreachable!()
+    };
+    let lights = area_lights(vec![light(tube)]);
+    let mut rng = Rng::new(5);
+    let from = Vec3::new(-1.0, 0.5, 2.0);
+    let area = estimate(20_000, || {
+        let s = lights.sample(from, &mut rng).expect("a sample");
+        let ray = crate::ray::Ray::new(from, s.direction);
+        let outward = q.surface(&ray, s.distance).outward;
+        let pdf = lights.pdf(0, from, from + s.distance * s.direction, outward);
+        let cos = f64::from(outward.dot(s.direction).abs());
+        // The normal found again is rounded: grazing, the cosine is
+        // relatively less exact.
+        let tolerance = 1e-3 + 1e-6 / cos;
+        assert!(
+            f64::from((pdf - s.pdf).abs()) <= tolerance * f64::from(s.pdf),
+            "pdf {pdf} at the sampled point, sampled with {}",
+            s.pdf
+        );
+        f64::from(s.distance).powi(2) / (cos * f64::from(s.pdf))
+    });
+    let exact = 2.0 * std::f64::consts::PI * r * length;
+    assert!(
+        (area.0 - exact).abs() < 1e-3 * exact,
+        "cylinder: {area:?}, expected {exact}"
+    );
 }
 
 #[test]

@@ -2,8 +2,8 @@
 //! shading needs of each (materials, normals, texture coordinates), so that
 //! a hit found by the tree becomes a [`HitRecord`].
 //!
-//! The tree's items are numbered spheres first, then quads, then the
-//! triangles of each mesh placed once (stored in world space), then the
+//! The tree's items are numbered spheres first, then quads, then disks and
+//! cylinders, then the triangles of each mesh placed once (stored in world space), then the
 //! instances of meshes placed several times (stored once, in object space,
 //! with a tree of their own). A shape's number is its place in the order of
 //! hits at exactly the same distance.
@@ -12,7 +12,7 @@ use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;
 use crate::geometry::transform::Transform;
 use crate::geometry::{
-    Bvh, HitRecord, Instance, Kind, Primitive, PrimitiveSet, Quad, Sphere, Triangle,
+    Bvh, HitRecord, Instance, Kind, Primitive, PrimitiveSet, Quad, Quadric, Sphere, Triangle,
 };
 use crate::light::{Light, LightTexture, Shape as LightShape};
 use crate::material::{Emissive, Material};
@@ -75,6 +75,8 @@ impl Mesh {
 pub(crate) struct Shapes {
     pub(crate) spheres: Vec<Surface>,
     pub(crate) quads: Vec<(Quad, u32)>,
+    /// Disks and cylinders, with their materials.
+    pub(crate) quadrics: Vec<(Quadric, u32)>,
     meshes: Vec<Mesh>,
     /// Per mesh, the number of triangles of it and the meshes before it:
     /// where its triangles end among the triangle items.
@@ -88,6 +90,7 @@ pub(crate) struct Shapes {
 enum Shape {
     Sphere(usize),
     Quad(usize),
+    Quadric(usize),
     /// Mesh, triangle in it.
     Triangle(usize, usize),
 }
@@ -109,7 +112,10 @@ impl Shapes {
 
     /// How many of the tree's items are shapes (the instances come after).
     fn shape_count(&self) -> usize {
-        self.spheres.len() + self.quads.len() + self.mesh_end.last().copied().unwrap_or(0)
+        self.spheres.len()
+            + self.quads.len()
+            + self.quadrics.len()
+            + self.mesh_end.last().copied().unwrap_or(0)
     }
 
     /// The kind of shape item `index`.
@@ -117,6 +123,7 @@ impl Shapes {
         match self.locate(index) {
             Ok(Shape::Sphere(_)) => Kind::Sphere,
             Ok(Shape::Quad(_)) => Kind::Quad,
+            Ok(Shape::Quadric(_)) => Kind::Quadric,
             Ok(Shape::Triangle(..)) => Kind::Triangle,
             Err(_) => panic!("shape {index} of {}", self.shape_count()),
         }
@@ -130,6 +137,7 @@ impl Shapes {
                 Primitive::Sphere(Sphere::new(s.center, s.radius))
             }
             Ok(Shape::Quad(k)) => Primitive::Quad(self.quads[k].0.grown()),
+            Ok(Shape::Quadric(k)) => Primitive::Quadric(self.quadrics[k].0),
             Ok(Shape::Triangle(m, k)) => Primitive::Triangle(self.meshes[m].triangle(k)),
             Err(_) => panic!("shape {index} of {}", self.shape_count()),
         }
@@ -146,6 +154,10 @@ impl Shapes {
             return Ok(Shape::Quad(index));
         }
         index -= self.quads.len();
+        if index < self.quadrics.len() {
+            return Ok(Shape::Quadric(index));
+        }
+        index -= self.quadrics.len();
         // The first mesh ending after `index`.
         let m = self.mesh_end.partition_point(|&end| end <= index);
         match self.meshes.get(m) {
@@ -237,6 +249,10 @@ impl Shapes {
                     error,
                 }
             }
+            Shape::Quadric(k) => {
+                let (quadric, material) = &self.quadrics[k];
+                quadric_record(ray, t, quadric, *material, index, error_scale)
+            }
             Shape::Triangle(m, k) => {
                 let mesh = &self.meshes[m];
                 triangle_record(ray, t, mesh, k, index, error_scale, margin)
@@ -299,6 +315,36 @@ fn sphere_derivatives(n: Vec3, r: f32) -> (Vec3, Vec3) {
         Vec3::ZERO
     };
     (dpdu, dpdv)
+}
+
+/// The record of a hit on a disk or a cylinder: the point moved onto the
+/// surface in the shape's own space, and placed back in the world.
+#[inline(never)]
+fn quadric_record(
+    ray: &Ray,
+    t: f32,
+    quadric: &Quadric,
+    material: u32,
+    index: u32,
+    error_scale: f32,
+) -> HitRecord {
+    let s = quadric.surface(ray, t);
+    let (normal, front_face) = face_normal(ray, s.outward);
+    HitRecord {
+        point: s.point,
+        normal,
+        shading_normal: normal,
+        uv: s.uv,
+        t,
+        front_face,
+        material,
+        object: index,
+        uv1: s.uv,
+        dpdu: s.dpdu,
+        dpdv: s.dpdv,
+        color: glam::Vec4::ONE,
+        error: (s.point.abs().max_element() + s.extent) * error_scale,
+    }
 }
 
 /// The record of a hit on triangle `k` of `mesh`. The point is rebuilt
@@ -691,9 +737,10 @@ impl World {
     }
 
     /// The world's shapes as placed, or `None` when some are placed by
-    /// instances (which another intersector would need as instances too).
+    /// instances (which another intersector would need as instances too) or
+    /// are disks or cylinders (which it would need to trace as lumen does).
     pub(crate) fn placed_shapes(&self) -> Option<PlacedShapes> {
-        if !self.placed.is_empty() {
+        if !self.placed.is_empty() || !self.top.quadrics.is_empty() {
             return None;
         }
         let top = &self.top;
@@ -926,6 +973,11 @@ impl World {
                 add(shape, e, uvs, &mut lights)
             }));
         }
+        for (q, material) in &top.quadrics {
+            ids.top.push(emitter(*material).map_or(NO_LIGHT, |e| {
+                add(LightShape::Quadric(*q), e, CORNER_UVS, &mut lights)
+            }));
+        }
         for mesh in &top.meshes {
             for k in 0..mesh.data.triangles.len() {
                 ids.top
@@ -946,7 +998,10 @@ impl World {
             // A moving light is found by the bounces only: its samples would
             // have to be drawn where it is at each path's time.
             let moves = self.bvh.instances()[i].motion != Vec3::ZERO;
-            if !any || moves || !group.shapes.spheres.is_empty() || !group.shapes.quads.is_empty() {
+            let only_meshes = group.shapes.spheres.is_empty()
+                && group.shapes.quads.is_empty()
+                && group.shapes.quadrics.is_empty();
+            if !any || moves || !only_meshes {
                 ids.instance_first.push(NO_LIGHT);
                 continue;
             }

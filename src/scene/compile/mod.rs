@@ -15,7 +15,7 @@ use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::filter::PixelFilter;
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::{Transform, TransformStep};
-use crate::geometry::{Quad, Sphere};
+use crate::geometry::{Quad, Quadric, QuadricForm, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
 use crate::material::param::{self, ColorRange, Range};
 use crate::material::{ColorParam, Invalid, Material, ScalarParam, Textures};
@@ -464,7 +464,7 @@ impl<'a> Objects<'a> {
         for placed in &mut self.instances[instances..] {
             placed.motion = motion;
         }
-        if !(shapes.spheres.is_empty() && shapes.quads.is_empty()) {
+        if !(shapes.spheres.is_empty() && shapes.quads.is_empty() && shapes.quadrics.is_empty()) {
             let group =
                 Group::new(shapes).map_err(|e| invalid(format!("objects[{i}]"), e.to_string()))?;
             self.groups.push(group);
@@ -592,6 +592,57 @@ impl<'a> Objects<'a> {
                 let quad =
                     place_quad(i, "the quad", &transform, vec3(*corner), vec3(*u), vec3(*v))?;
                 self.top.quads.push((quad, m));
+            }
+            ObjectDesc::Disk {
+                center,
+                normal,
+                radius,
+                material,
+                ..
+            } => {
+                let field = |name: &str| format!("objects[{i}].{name}");
+                finite(field("center"), center)?;
+                finite(field("normal"), normal)?;
+                let radius = positive(&field("radius"), *radius)?;
+                let n = glam::DVec3::from(*normal);
+                if n == glam::DVec3::ZERO {
+                    return Err(invalid(field("normal"), "must not be zero"));
+                }
+                let [s, t, n] = crate::math::frame(n.normalize());
+                let unit = [
+                    s * radius,
+                    t * radius,
+                    n * radius,
+                    glam::DVec3::from(*center),
+                ];
+                let m = self.material(i, material)?;
+                self.place_quadric(i, QuadricForm::Disk, unit, &transform, m)?;
+            }
+            ObjectDesc::Cylinder {
+                p0,
+                p1,
+                radius,
+                material,
+                ..
+            } => {
+                let field = |name: &str| format!("objects[{i}].{name}");
+                finite(field("p0"), p0)?;
+                finite(field("p1"), p1)?;
+                let radius = positive(&field("radius"), *radius)?;
+                let (p0, axis) = (
+                    glam::DVec3::from(*p0),
+                    glam::DVec3::from(*p1) - glam::DVec3::from(*p0),
+                );
+                if !(axis.length() > 0.0) {
+                    return Err(invalid(
+                        field("p1"),
+                        "must not be p0: the cylinder has no length",
+                    ));
+                }
+                let [s, t, _] = crate::math::frame(axis.normalize());
+                let unit = [s * radius, t * radius, axis, p0];
+                let m = self.material(i, material)?;
+                self.place_quadric(i, QuadricForm::Cylinder, unit, &transform, m)?;
             }
             ObjectDesc::Box {
                 min, max, material, ..
@@ -736,6 +787,51 @@ impl<'a> Objects<'a> {
                 )?;
             }
         }
+        Ok(())
+    }
+
+    /// Adds the unit `form` placed by the axes and origin `unit` (columns
+    /// of its matrix) and then by `transform`, in material `m`: for object
+    /// `i`.
+    fn place_quadric(
+        &mut self,
+        i: usize,
+        form: QuadricForm,
+        [x, y, z, origin]: [glam::DVec3; 4],
+        transform: &Transform,
+        m: u32,
+    ) -> Result<(), SceneError> {
+        let rows = [0, 1, 2].map(|r| [x[r], y[r], z[r], origin[r]]);
+        let matrix = TransformStep::Matrix([rows[0], rows[1], rows[2], [0.0, 0.0, 0.0, 1.0]]);
+        let what = match form {
+            QuadricForm::Disk => "the disk",
+            QuadricForm::Cylinder => "the cylinder",
+        };
+        let own = Transform::from_steps(&[matrix]).map_err(|e| {
+            invalid(
+                format!("objects[{i}]"),
+                format!("{what} is too thin or too large: {}", e.message),
+            )
+        })?;
+        let placed = own.then(transform).ok_or_else(|| {
+            invalid(
+                format!("objects[{i}].transform"),
+                format!("flattens {what} or places it beyond the range of f32"),
+            )
+        })?;
+        let quadric = Quadric::new(form, &placed);
+        let b = quadric.bounds();
+        if !(b.min.is_finite() && b.max.is_finite()) {
+            return Err(out_of_range(i));
+        }
+        placed_within(i, what, b.min.abs().max(b.max.abs()).max_element())?;
+        if !quadric.round() && self.materials[m as usize].emits() {
+            return Err(invalid(
+                format!("objects[{i}]"),
+                "a cylinder that gives off light must keep round cross-sections square to its axis (its transform may turn, move and scale it evenly across the axis), so that its light can be sampled evenly by area",
+            ));
+        }
+        self.top.quadrics.push((quadric, m));
         Ok(())
     }
 
@@ -1066,6 +1162,18 @@ fn model_path(base: &Path, file: &str) -> PathBuf {
         base.join(file)
     };
     std::fs::canonicalize(&path).unwrap_or(path)
+}
+
+/// `value` of `field` when it is finite and above 0 once in `f32`.
+fn positive(field: &str, value: f64) -> Result<f64, SceneError> {
+    finite(field, &[value])?;
+    if !(value as f32 > 0.0) {
+        return Err(invalid(
+            field,
+            format!("must be greater than 0, got {value}"),
+        ));
+    }
+    Ok(value)
 }
 
 /// The uniform scale of `transform` when it is a similarity (rotation,

@@ -658,6 +658,41 @@ pub enum ObjectDesc {
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
     },
+    /// A flat disk (an ellipse once stretched by its transform), one-sided
+    /// for one-sided materials and lights: its outside is along `normal`.
+    /// Texture coordinates (u, v) = (r/radius, φ/2π), φ measured about the
+    /// normal from the first axis of the normal's frame (see
+    /// `docs/scene-format.md`).
+    Disk {
+        /// Centre.
+        center: Triple,
+        /// The side it faces (any length but zero).
+        normal: Triple,
+        /// Radius, > 0.
+        radius: f64,
+        /// Name of a material in `materials`.
+        material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
+    /// The curved side of a cylinder from the centre of one end, `p0`, to
+    /// the other, `p1`, open at both ends; its outside faces away from the
+    /// axis. Texture coordinates (u, v) = (φ/2π, the share of the way from
+    /// `p0` to `p1`).
+    Cylinder {
+        /// The centre of the first end.
+        p0: Triple,
+        /// The centre of the second end (not `p0`).
+        p1: Triple,
+        /// Radius, > 0.
+        radius: f64,
+        /// Name of a material in `materials`.
+        material: String,
+        /// Placement, applied to the object in the order written.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        transform: Vec<TransformDesc>,
+    },
     /// An axis-aligned box from `min` to `max` (six quads), before its
     /// transform.
     Box {
@@ -779,6 +814,8 @@ impl ObjectDesc {
         match self {
             ObjectDesc::Sphere { transform, .. }
             | ObjectDesc::Quad { transform, .. }
+            | ObjectDesc::Disk { transform, .. }
+            | ObjectDesc::Cylinder { transform, .. }
             | ObjectDesc::Box { transform, .. }
             | ObjectDesc::Mesh { transform, .. }
             | ObjectDesc::Triangles { transform, .. }
@@ -791,6 +828,8 @@ impl ObjectDesc {
         match self {
             ObjectDesc::Sphere { transform, .. }
             | ObjectDesc::Quad { transform, .. }
+            | ObjectDesc::Disk { transform, .. }
+            | ObjectDesc::Cylinder { transform, .. }
             | ObjectDesc::Box { transform, .. }
             | ObjectDesc::Mesh { transform, .. }
             | ObjectDesc::Triangles { transform, .. }

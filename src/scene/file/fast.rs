@@ -303,6 +303,15 @@ fn object(o: &ObjectDesc) -> bool {
     let shape = match o {
         ObjectDesc::Sphere { center, radius, .. } => finite(center) && finite(&[*radius]),
         ObjectDesc::Quad { corner, u, v, .. } => finite(corner) && finite(u) && finite(v),
+        ObjectDesc::Disk {
+            center,
+            normal,
+            radius,
+            ..
+        } => finite(center) && finite(normal) && finite(&[*radius]),
+        ObjectDesc::Cylinder { p0, p1, radius, .. } => {
+            finite(p0) && finite(p1) && finite(&[*radius])
+        }
         ObjectDesc::Box { min, max, .. } => finite(min) && finite(max),
         ObjectDesc::Mesh { .. } => true,
         ObjectDesc::Triangles {

@@ -22,7 +22,6 @@ use crate::scene::desc::{
     PixelFilterDesc, RoughnessDesc, SamplingDesc, ScalarDesc, SceneDesc, TextureDesc,
     TransformDesc, Triple, WrapDesc,
 };
-use crate::scene::file::tessellate;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -878,7 +877,8 @@ impl<'d> Convert<'d> {
             "exterior",
             "id",
         ];
-        if p.boolean("flip_normals", self)? == Some(true) {
+        let flip = p.boolean("flip_normals", self)? == Some(true);
+        if flip && t != "disk" {
             self.lacks(e, "flip_normals", "the normals as they are")?;
         }
         if p.has("interior") || p.has("exterior") {
@@ -986,31 +986,57 @@ impl<'d> Convert<'d> {
                 transform: matrix(&m),
             },
             "disk" => {
-                self.lacks(
-                    e,
-                    "a disk shape",
-                    "a polygon of 128 sides of the disk's area",
-                )?;
-                tessellate::object(tessellate::disk(1.0, 0.0, 0.0), material, matrix(&m))
+                // Mitsuba's v runs down the image, lumen's up: the disk
+                // turned over in y (v = φ/2π becomes 1 − φ/2π), which
+                // keeps its side; turned over in z as well to flip it,
+                // which together is half a turn about x.
+                let mirror = if flip {
+                    [1.0, -1.0, -1.0]
+                } else {
+                    [1.0, -1.0, 1.0]
+                };
+                let m = crate::scene::file::matrix::mul(
+                    &m,
+                    &crate::scene::file::matrix::scaling(mirror),
+                );
+                ObjectDesc::Disk {
+                    center: [0.0; 3],
+                    normal: [0.0, 0.0, 1.0],
+                    radius: 1.0,
+                    material,
+                    transform: matrix(&m),
+                }
             }
             "cylinder" => {
                 known.extend(["p0", "p1", "radius"]);
                 let p0 = p.point("p0", self)?.unwrap_or([0.0; 3]);
                 let p1 = p.point("p1", self)?.unwrap_or([0.0, 0.0, 1.0]);
                 let radius = p.float("radius", self)?.unwrap_or(1.0);
-                if p0[0] != p1[0] || p0[1] != p1[1] || !(p1[2] > p0[2]) || !(radius > 0.0) {
-                    self.lacks(e, "a cylinder off the z axis", "nothing")?;
-                    p.finish(&known, self).ok();
-                    return Ok(());
+                if !(radius > 0.0 && radius.is_finite()) {
+                    return Err(self.fail(
+                        e,
+                        format!("a cylinder's radius must be above 0, got {radius}"),
+                    ));
                 }
-                self.lacks(
-                    e,
-                    "a cylinder shape",
-                    "a prism of 128 sides of the cylinder's area",
-                )?;
-                let mut t = matrix(&m);
-                t.insert(0, TransformDesc::Translate([p0[0], p0[1], 0.0]));
-                tessellate::object(tessellate::cylinder(radius, p0[2], p1[2]), material, t)
+                let Some(unit) = crate::scene::file::matrix::cylinder(p0, p1, radius) else {
+                    return Err(self.fail(e, "a cylinder's p0 and p1 must differ".into()));
+                };
+                // Mitsuba's v (along the axis) runs down the image, lumen's
+                // up: z becomes 1 − z.
+                let along = [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, -1.0, 1.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ];
+                use crate::scene::file::matrix::mul;
+                ObjectDesc::Cylinder {
+                    p0: [0.0; 3],
+                    p1: [0.0, 0.0, 1.0],
+                    radius: 1.0,
+                    material,
+                    transform: matrix(&mul(&m, &mul(&unit, &along))),
+                }
             }
             "shapegroup" => {
                 return Err(self.fail(

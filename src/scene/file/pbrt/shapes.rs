@@ -259,30 +259,82 @@ impl Builder {
                 if phimax < 360.0 {
                     self.lacks(at, &format!("part of a {ty} (phimax)"), "the whole")?;
                 }
-                self.lacks(
-                    at,
-                    &format!("`{ty}` shape"),
-                    "a polygon of 128 sides of its area",
-                )?;
-                let (positions, triangles, normals) = if ty == "disk" {
-                    let inner = p.float("innerradius")?.unwrap_or(0.0);
+                let inner = p.float("innerradius")?.unwrap_or(0.0);
+                if ty == "disk" && inner > 0.0 {
+                    // A ring: as triangles, with its hole.
+                    self.lacks(
+                        at,
+                        "a disk with a hole (innerradius)",
+                        "a polygon of 128 sides of its area",
+                    )?;
                     let height = p.float("height")?.unwrap_or(0.0);
-                    tessellate::disk(radius, inner.clamp(0.0, radius), height)
+                    let mesh = tessellate::disk(radius, inner.min(radius), height);
+                    let (positions, triangles, normals) = mesh;
+                    return self.triangles(
+                        positions,
+                        at,
+                        triangles,
+                        Some(normals),
+                        None,
+                        p,
+                        at,
+                        "a disk",
+                    );
+                }
+                // pbrt turns a shape's outside over for ReverseOrientation
+                // and for a transform that mirrors; lumen keeps the outside
+                // a mirror gives.
+                let ctm = self.state.ctm;
+                let turned = self.state.reverse != (matrix::det3(&ctm) < 0.0);
+                let object = if ty == "disk" {
+                    let height = p.float("height")?.unwrap_or(0.0);
+                    let material = self.surface(p, at)?;
+                    p.finish(
+                        "a disk",
+                        &["radius", "height", "innerradius", "phimax", "alpha"],
+                    )?;
+                    // Turned over in z about its own plane where pbrt turns
+                    // it.
+                    let side = if turned { -1.0 } else { 1.0 };
+                    let place = matrix::mul(
+                        &matrix::translation([0.0, 0.0, height]),
+                        &matrix::scaling([1.0, 1.0, side]),
+                    );
+                    ObjectDesc::Disk {
+                        center: [0.0; 3],
+                        normal: [0.0, 0.0, 1.0],
+                        radius,
+                        material,
+                        transform: vec![TransformDesc::Matrix(matrix::mul(&ctm, &place))],
+                    }
                 } else {
                     let z0 = p.float("zmin")?.unwrap_or(-1.0);
                     let z1 = p.float("zmax")?.unwrap_or(1.0);
-                    tessellate::cylinder(radius, z0.min(z1), z0.max(z1))
+                    if z0 == z1 {
+                        return Err((
+                            at,
+                            format!("a cylinder's zmin and zmax are both {z0}"),
+                            None,
+                        ));
+                    }
+                    if turned && self.state.area.is_some() {
+                        self.lacks(
+                            at,
+                            "cylinder light that shines inwards (ReverseOrientation or a mirroring transform)",
+                            "one that shines outwards",
+                        )?;
+                    }
+                    let material = self.surface(p, at)?;
+                    p.finish("a cylinder", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
+                    ObjectDesc::Cylinder {
+                        p0: [0.0, 0.0, z0.min(z1)],
+                        p1: [0.0, 0.0, z0.max(z1)],
+                        radius,
+                        material,
+                        transform: vec![TransformDesc::Matrix(ctm)],
+                    }
                 };
-                self.triangles(
-                    positions,
-                    at,
-                    triangles,
-                    Some(normals),
-                    None,
-                    p,
-                    at,
-                    &format!("a {ty}"),
-                )?;
+                self.add(object);
             }
             "curve" | "cone" | "paraboloid" | "hyperboloid" => {
                 p.ignore_all();
