@@ -38,6 +38,9 @@ pub struct CameraSettings {
     /// Rays start this far in front of the lens along the view direction
     /// (nothing nearer is seen); 0: at the lens.
     pub near_clip: f32,
+    /// Nothing farther than this along the view direction is seen (camera
+    /// rays end on that plane); ∞: no limit.
+    pub far_clip: f32,
     /// The image is the window `[x, y, …]` of a full image of
     /// `[…, width, height]` pixels; `None`: the whole image.
     pub crop: Option<[u32; 4]>,
@@ -55,6 +58,7 @@ impl Default for CameraSettings {
             shutter: [0.0, 0.0],
             mirror: false,
             near_clip: 0.0,
+            far_clip: f32::INFINITY,
             crop: None,
         }
     }
@@ -117,6 +121,9 @@ pub enum CameraError {
     #[error("near_clip must be finite and not negative, got {0}")]
     /// A negative or non-finite near clipping distance.
     NearClip(f32),
+    #[error("far_clip must be beyond near_clip ({1}), got {0}")]
+    /// A far clipping distance not beyond the near one.
+    FarClip(f32, f32),
 }
 
 /// A camera ready to generate rays for an image of a given size.
@@ -137,6 +144,8 @@ pub struct Camera {
     filter: crate::filter::PixelFilter,
     /// How far in front of the lens rays start.
     near_clip: f32,
+    /// How far in front of the lens they end.
+    far_clip: f32,
 }
 
 impl Camera {
@@ -187,6 +196,9 @@ impl Camera {
         }
         if !(s.near_clip >= 0.0 && s.near_clip.is_finite()) {
             return Err(CameraError::NearClip(s.near_clip));
+        }
+        if !(s.far_clip > s.near_clip) {
+            return Err(CameraError::FarClip(s.far_clip, s.near_clip));
         }
         if !view.length_squared().is_finite() {
             return Err(CameraError::Overflow);
@@ -282,7 +294,20 @@ impl Camera {
             basis: [u, v, w],
             filter: crate::filter::PixelFilter::Box,
             near_clip: s.near_clip,
+            far_clip: s.far_clip,
         })
+    }
+
+    /// The distance along camera ray `ray` (as [`Camera::ray`] makes it)
+    /// to the far clipping plane: ∞ without one.
+    #[inline]
+    pub fn far(&self, ray: &Ray) -> f32 {
+        if self.far_clip == f32::INFINITY {
+            return f32::INFINITY;
+        }
+        // From the near plane (or the lens) along the ray, over the cosine
+        // to the view.
+        (self.far_clip - self.near_clip) / -ray.direction.dot(self.basis[2])
     }
 
     /// The ray from the centre of the lens through the centre of pixel
@@ -343,6 +368,7 @@ mod tests {
             shutter: [0.0, 0.0],
             mirror: false,
             near_clip: 0.0,
+            far_clip: f32::INFINITY,
             crop: None,
         }
     }

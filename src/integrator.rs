@@ -416,7 +416,13 @@ pub fn trace_path(
     let mut colour = None;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
-        let hit = scene.intersect_leaving(&ray, from.as_ref(), f32::INFINITY);
+        // The camera's ray ends at its far plane.
+        let t_max = if depth == 0 {
+            scene.camera.far(&ray)
+        } else {
+            f32::INFINITY
+        };
+        let hit = scene.intersect_leaving(&ray, from.as_ref(), t_max);
         match step(scene, &ray, hit, depth, &mut path, sampler) {
             Step::Continue(next, left) => (ray, from) = (next, left),
             Step::Done(c) => {
@@ -517,11 +523,19 @@ fn find_hits(
     // Where bundles do not pay off, no group is large enough for one.
     let pays = scene.bundles_pay_off() || (reference.is_some() && scene.camera_bundles_pay_off());
     let min_bundle = if pays { MIN_BUNDLE } else { usize::MAX };
+    // Camera rays (the first round's) end at the camera's far plane.
+    let t_max = |ray: &Ray| {
+        if reference.is_some() {
+            scene.camera.far(ray)
+        } else {
+            f32::INFINITY
+        }
+    };
     for group in live.chunks(LANES) {
         if group.len() < min_bundle {
             for &i in group {
                 let i = i as usize;
-                hits[i] = scene.intersect_leaving(&rays[i], from[i].as_ref(), f32::INFINITY);
+                hits[i] = scene.intersect_leaving(&rays[i], from[i].as_ref(), t_max(&rays[i]));
             }
             continue;
         }
@@ -529,8 +543,10 @@ fn find_hits(
         let found = scene.hit_bundle(rays, group, reference, ALL);
         for (&i, hit) in group.iter().zip(found) {
             let i = i as usize;
-            hits[i] = hit;
-            scene.keep_counted(&rays[i], &mut hits[i], from[i].as_ref(), f32::INFINITY);
+            // The nearest of all, or none when it lies beyond the end.
+            let end = t_max(&rays[i]);
+            hits[i] = hit.filter(|h| h.t < end);
+            scene.keep_counted(&rays[i], &mut hits[i], from[i].as_ref(), end);
         }
     }
 }

@@ -364,6 +364,54 @@ fn a_thin_dielectric_is_a_thin_sheet() {
     file.compile(&Overrides::default()).unwrap();
 }
 
+/// The sensor's far clipping plane (10⁴ by default) is read, and hides
+/// what lies beyond it from the camera, not from the light.
+#[test]
+fn far_clipping_planes_are_read_and_hide_what_lies_beyond() {
+    let dir = scratch_dir("mitsuba_scenes_far");
+    let path = dir.join("s.xml");
+    let text = |clip: &str| {
+        scene(&format!(
+            "  <sensor type=\"perspective\">{clip}<film type=\"hdrfilm\">\
+             <integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/>\
+             </film><sampler type=\"independent\"><integer name=\"sample_count\" value=\"4\"/></sampler></sensor>\n\
+             <shape type=\"sphere\"><point name=\"center\" value=\"0, 0, 10\"/><float name=\"radius\" value=\"2\"/>\
+             <emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>"
+        ))
+    };
+    let centre = |clip: &str| {
+        std::fs::write(&path, text(clip)).unwrap();
+        let file = SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap();
+        let far = file.desc.camera.far_clip;
+        let scene = file.compile(&Overrides::default()).unwrap();
+        let (film, _) = lumen::render::render(&scene, &|_| {});
+        (far, film.linear()[4 * 8 + 4])
+    };
+    let (far, seen) = centre("");
+    assert_eq!(far, Some(1e4));
+    assert!(seen.x > 0.5, "{seen}");
+    let (far, hidden) = centre("<float name=\"far_clip\" value=\"7\"/>");
+    assert_eq!(far, Some(7.0));
+    assert_eq!(hidden.max_element(), 0.0);
+    let (_, seen) = centre("<float name=\"far_clip\" value=\"9\"/>");
+    assert!(seen.x > 0.5, "{seen}");
+    // Not beyond the near plane: refused.
+    std::fs::write(
+        &path,
+        text("<float name=\"near_clip\" value=\"2\"/><float name=\"far_clip\" value=\"1\"/>"),
+    )
+    .unwrap();
+    let e = SceneFile::read_with(&path, &mitsuba::Options::default())
+        .unwrap()
+        .compile(&Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("camera.far_clip") && e.contains("beyond near_clip"),
+        "{e}"
+    );
+}
+
 /// A film's crop window renders that window of the image; the sensor's
 /// near clipping plane (10⁻² by default) is where camera rays start.
 #[test]

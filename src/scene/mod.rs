@@ -83,6 +83,7 @@ impl SceneError {
                 CameraError::Shutter(..) => "camera.shutter".into(),
                 CameraError::Crop(..) => "render.crop".into(),
                 CameraError::NearClip(_) => "camera.near_clip".into(),
+                CameraError::FarClip(..) => "camera.far_clip".into(),
             },
             SceneError::Invalid { field, .. } | SceneError::UnknownMaterial { field, .. } => {
                 field.clone()

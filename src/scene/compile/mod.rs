@@ -340,6 +340,7 @@ fn compile_camera(
             },
             mirror: cam.mirror,
             near_clip: cam.near_clip as f32,
+            far_clip: cam.far_clip.map_or(f32::INFINITY, |f| f as f32),
             crop: settings.crop,
         },
         settings.width,

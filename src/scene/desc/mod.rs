@@ -324,6 +324,11 @@ pub struct CameraDesc {
     /// rays start on the plane this far in front of the lens.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub near_clip: f64,
+    /// Nothing farther than this along the view direction is seen: what
+    /// lies beyond shows the background to the camera (it still casts
+    /// light and shadows). None: no limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub far_clip: Option<f64>,
 }
 
 /// Which camera of the scene's glTF models.
@@ -360,6 +365,7 @@ impl Default for CameraDesc {
             gltf: None,
             mirror: false,
             near_clip: 0.0,
+            far_clip: None,
         }
     }
 }

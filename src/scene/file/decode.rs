@@ -616,6 +616,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "gltf",
             "mirror",
             "near_clip",
+            "far_clip",
         ],
         &[],
     )?;
@@ -633,6 +634,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         gltf: t.optional("gltf", gltf_camera)?,
         mirror: t.optional("mirror", boolean)?.unwrap_or(false),
         near_clip: t.optional("near_clip", float)?.unwrap_or(d.near_clip),
+        far_clip: t.optional("far_clip", float)?,
     })
 }
 

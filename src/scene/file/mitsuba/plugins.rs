@@ -482,7 +482,7 @@ impl<'d> Convert<'d> {
         let vfov = 2.0 * ((x_fov / 2.0).tan() / aspect).atan();
         // Mitsuba's camera rays start on the near plane (10⁻² by default).
         let near_clip = p.float("near_clip", self)?.unwrap_or(1e-2);
-        let _ = p.float("far_clip", self)?; // not applied
+        let far_clip = p.float("far_clip", self)?.unwrap_or(1e4);
         if !(near_clip >= 0.0) {
             return Err(self.fail(
                 e,
@@ -545,6 +545,7 @@ impl<'d> Convert<'d> {
         }
         p.finish(&known, self)?;
         camera.near_clip = near_clip;
+        camera.far_clip = Some(far_clip);
         self.desc.camera = camera;
         self.desc.render.width = width;
         self.desc.render.height = Some(height);
