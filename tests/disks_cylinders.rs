@@ -10,7 +10,7 @@
 mod common;
 
 use common::{
-    assert_tiles_agree, compile_file, pixel_stats, scene_file_error, scratch_dir, PixelStats, K,
+    assert_tiles_agree, compile_file, path_and_bsdf, pixel_stats, scene_file_error, scratch_dir, K,
 };
 use lumen::scene::{Integrator, Scene};
 
@@ -87,21 +87,12 @@ radius = 0.2
 material = "tube"
 "#;
 
-/// `text`'s scene rendered with each integrator.
-fn both(dir: &std::path::Path, text: &str) -> (PixelStats, PixelStats) {
-    let mut path = compile_file(dir, "scene.toml", text);
-    path.settings.integrator = Integrator::Path;
-    let mut bsdf = path.clone();
-    bsdf.settings.integrator = Integrator::Bsdf;
-    (pixel_stats(&path), pixel_stats(&bsdf))
-}
-
 #[test]
 fn path_and_bsdf_agree_under_disk_and_cylinder_lights() {
     let dir = scratch_dir("quadrics-lights");
     let scene = compile_file(&dir, "scene.toml", SHAPES);
     assert_eq!(scene.lights.len(), 2, "the disk and the tube are lights");
-    let (path, bsdf) = both(&dir, SHAPES);
+    let (path, bsdf) = path_and_bsdf(&dir, SHAPES);
     assert_tiles_agree("disk and cylinder lights", &path, &bsdf);
     // Each light alone (the other made matte), so that neither hides the
     // other's error.
@@ -109,7 +100,7 @@ fn path_and_bsdf_agree_under_disk_and_cylinder_lights() {
         let other = if light == "lamp" { "tube" } else { "lamp" };
         let text = SHAPES.replace(&format!("material = \"{other}\""), "material = \"matte\"");
         assert_eq!(compile_file(&dir, "scene.toml", &text).lights.len(), 1);
-        let (path, bsdf) = both(&dir, &text);
+        let (path, bsdf) = path_and_bsdf(&dir, &text);
         assert_tiles_agree(alone, &path, &bsdf);
     }
 }
@@ -124,7 +115,7 @@ fn a_moving_disk_renders_as_placed() {
         "radius = 0.6\nmaterial = \"matte\"\ntransform = [ { motion = [0, 0.3, 0] } ]\n",
     );
     assert_ne!(text, SHAPES);
-    let (path, bsdf) = both(&dir, &text);
+    let (path, bsdf) = path_and_bsdf(&dir, &text);
     assert_tiles_agree("a moving disk", &path, &bsdf);
 }
 

@@ -10,19 +10,10 @@
 mod common;
 
 use common::{
-    assert_tiles_agree, ball_in_light, builtin_desc, compile_file, pixel_stats, scratch_dir,
-    tiles_agree, PixelStats, K,
+    assert_tiles_agree, ball_in_light, builtin_desc, compile_file, path_and_bsdf, pixel_stats,
+    scratch_dir, tiles_agree, K,
 };
 use lumen::scene::{Integrator, Sampling, Scene};
-
-/// `text`'s scene rendered with each integrator.
-fn both(dir: &std::path::Path, text: &str) -> (PixelStats, PixelStats) {
-    let mut path = compile_file(dir, "scene.toml", text);
-    path.settings.integrator = Integrator::Path;
-    let mut bsdf = path.clone();
-    bsdf.settings.integrator = Integrator::Bsdf;
-    (pixel_stats(&path), pixel_stats(&bsdf))
-}
 
 #[test]
 fn path_and_bsdf_agree_on_the_cornell_box() {
@@ -102,7 +93,7 @@ material = "panel"
 #[test]
 fn path_and_bsdf_agree_under_sphere_and_quad_lights() {
     let dir = scratch_dir("lights-sphere");
-    let (path, bsdf) = both(&dir, SPHERE_LIGHT);
+    let (path, bsdf) = path_and_bsdf(&dir, SPHERE_LIGHT);
     assert_tiles_agree("sphere light", &path, &bsdf);
 }
 
@@ -129,7 +120,7 @@ fn path_and_bsdf_agree_under_instanced_mirrored_triangle_lights() {
     assert_eq!(scene.stats.instances, 2, "the lamp is instanced");
     // The sphere, the panel and four triangles.
     assert_eq!(scene.lights.len(), 6);
-    let (path, bsdf) = both(&dir, &text);
+    let (path, bsdf) = path_and_bsdf(&dir, &text);
     assert_tiles_agree("triangle lights", &path, &bsdf);
 }
 
@@ -330,7 +321,7 @@ u = [2, 0, 0]
 v = [0, 0, 2]
 material = "lamp"
 "#;
-    let (path, bsdf) = both(&dir, text);
+    let (path, bsdf) = path_and_bsdf(&dir, text);
     assert_tiles_agree("light near a far floor", &path, &bsdf);
 }
 
@@ -386,6 +377,6 @@ u = [0, 0, 2]
 v = [0, 0.6, 0]
 material = "lamp"
 "#;
-    let (path, bsdf) = both(&dir, text);
+    let (path, bsdf) = path_and_bsdf(&dir, text);
     assert_tiles_agree("smooth mesh", &path, &bsdf);
 }

@@ -939,7 +939,9 @@ fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
              <shape type=\"sphere\"><point name=\"center\" x=\"0\" y=\"0\" z=\"0\"/>\
              <bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"t\"/></bsdf></shape>\n\
              <shape type=\"rectangle\"><transform name=\"to_world\"><translate x=\"5\"/></transform>\
-             <bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"t\"/></bsdf></shape>",
+             <bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"t\"/></bsdf></shape>\n\
+             <shape type=\"rectangle\"><transform name=\"to_world\"><translate x=\"-5\"/></transform>\
+             <emitter type=\"area\"><ref name=\"radiance\" id=\"t\"/></emitter></shape>",
         ),
     )
     .unwrap();
@@ -953,13 +955,19 @@ fn textures_on_spheres_and_rectangles_fall_where_mitsuba_puts_them() {
         (-0.75, 0.5, 4),
         (0.25, 0.5, 6),
     ] {
-        let p = Vec3::new(5.0 + x, y, 0.0);
-        let seen = common::colour_at(&scene, p + Vec3::Z, -Vec3::Z);
-        assert!(
-            common::colours_close(seen, colours[i]),
-            "rectangle at ({x}, {y}): {seen:?}, want texel {i}"
-        );
+        // The lit rectangle, a quad, as the other, two triangles.
+        for centre in [5.0, -5.0] {
+            let p = Vec3::new(centre + x, y, 0.0);
+            let seen = common::colour_at(&scene, p + Vec3::Z, -Vec3::Z);
+            assert!(
+                common::colours_close(seen, colours[i]),
+                "rectangle at ({centre} + {x}, {y}): {seen:?}, want texel {i}"
+            );
+        }
     }
+    // The lit one shines towards +z only, as Mitsuba's.
+    let behind = common::colour_at(&scene, Vec3::new(-5.0, 0.0, -1.0), Vec3::Z);
+    assert_eq!(behind, lumen::math::Color::ZERO);
 }
 
 /// No `.serialized` file makes the reader panic: every cut of a real file,

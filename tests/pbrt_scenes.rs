@@ -268,6 +268,74 @@ AttributeEnd
     assert!(glow.two_sided);
 }
 
+/// An area light given by its `power` Φ shines with L · Φ / (sides · A ·
+/// π), A the area pbrt gives each of its lights: a sphere's (in its own
+/// space), a disk's, each triangle's as placed, each bilinear patch's.
+#[test]
+fn area_lights_given_by_their_power_shine_with_it() {
+    let pi = std::f64::consts::PI;
+    let d = read(
+        "area_power",
+        r#"WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 2 3 ] "float power" 100
+  Shape "sphere" "float radius" 2
+  Shape "disk" "float radius" 0.5
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "float power" 10 "bool twosided" true
+  Scale 2 2 2
+  Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  1 1 0  0 1 0 ] "integer indices" [ 0 1 2  0 2 3 ]
+  Shape "bilinearmesh" "point3 P" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]
+AttributeEnd
+"#,
+    );
+    let radiance = |i: usize| {
+        let material = match &d.objects[i] {
+            ObjectDesc::Sphere { material, .. }
+            | ObjectDesc::Disk { material, .. }
+            | ObjectDesc::Triangles { material, .. } => material,
+            other => panic!("{other:?}"),
+        };
+        let MaterialDesc::Diffuse(glow) = &d.materials[material] else {
+            panic!()
+        };
+        let Some(ColorDesc::Rgb(e)) = glow.emission else {
+            panic!()
+        };
+        e
+    };
+    let k = 100.0 / (4.0 * pi * 4.0 * pi);
+    assert!(
+        close(radiance(0), [k, 2.0 * k, 3.0 * k]),
+        "{:?}",
+        radiance(0)
+    );
+    let k = 100.0 / (pi * 0.25 * pi);
+    assert!(
+        close(radiance(1), [k, 2.0 * k, 3.0 * k]),
+        "{:?}",
+        radiance(1)
+    );
+    // Each triangle of area 2 (the square of side 2, halved), two-sided.
+    let k = 10.0 / (2.0 * 2.0 * pi);
+    assert!(close(radiance(2), [k; 3]), "{:?}", radiance(2));
+    // The patch, of area 4, as two triangles.
+    let k = 10.0 / (2.0 * 4.0 * pi);
+    assert!(close(radiance(3), [k; 3]), "{:?}", radiance(3));
+    // Triangles of different areas would each shine differently in pbrt:
+    // refused.
+    let dir = scratch_dir("pbrt_scenes_area_power");
+    let e = read_in(
+        &dir,
+        "WorldBegin\nAreaLightSource \"diffuse\" \"float power\" 10\n\
+         Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  3 3 0 ] \"integer indices\" [ 0 1 2  1 3 2 ]\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("s.pbrt:3:7") && e.contains("by its power"), "{e}");
+}
+
 #[test]
 fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
     let dir = scratch_dir("pbrt_scenes_bad");
@@ -294,7 +362,7 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("Include \"loop.pbrt\"\n", "loop.pbrt: includes itself"),
         ("Include \"../outside.pbrt\"\n", "no such file"),
         ("ConcatTransform [ 1 0 0 1  0 1 0 0  0 0 1 0  0 0 0 1 ]\n", "a projective matrix"),
-        ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-CuZn-eta\"\n", "is not among lumen's conductors"),
+        ("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Zn-eta\"\n", "is not among lumen's conductors"),
         ("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-BK8\"\n", "did you mean `glass-BK7`?"),
         ("WorldBegin\nShape \"disk\" \"float innerradius\" 0.5\n", "--approximate renders a polygon of 128 sides of its area instead"),
         ("WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1\n", "zmin and zmax are both 1"),

@@ -669,3 +669,13 @@ pub fn assert_texels_round_z(
         }
     }
 }
+
+/// The scene `text` (written to `dir/scene.toml`) rendered with each
+/// integrator: (`path`, `bsdf`).
+pub fn path_and_bsdf(dir: &std::path::Path, text: &str) -> (PixelStats, PixelStats) {
+    let mut path = compile_file(dir, "scene.toml", text);
+    path.settings.integrator = lumen::scene::Integrator::Path;
+    let mut bsdf = path.clone();
+    bsdf.settings.integrator = lumen::scene::Integrator::Bsdf;
+    (pixel_stats(&path), pixel_stats(&bsdf))
+}

@@ -953,13 +953,16 @@ impl<'d> Convert<'d> {
                     matches!(desc, MaterialDesc::Emissive(_)) || desc.surface().emission.is_some();
                 if emits {
                     // A light stays a quad, which light sampling sees by
-                    // its solid angle.
+                    // its solid angle, turned over in y so that its (α, β)
+                    // are Mitsuba's (u, v) with v up the image (a mirror
+                    // keeps a quad's side).
+                    let mirror = crate::scene::file::matrix::scaling([1.0, -1.0, 1.0]);
                     ObjectDesc::Quad {
                         corner: [-1.0, -1.0, 0.0],
                         u: [2.0, 0.0, 0.0],
                         v: [0.0, 2.0, 0.0],
                         material,
-                        transform: matrix(&m),
+                        transform: matrix(&crate::scene::file::matrix::mul(&m, &mirror)),
                     }
                 } else {
                     // Two triangles, so that the texture coordinates are

@@ -844,9 +844,15 @@ impl Builder {
     }
 
     /// A shape's material (the current one, shining with the current area
-    /// light), cut by its `alpha`.
-    pub(super) fn surface(&mut self, p: &Params, at: At) -> Result<String, Problem> {
-        let material = self.shape_material(at)?;
+    /// light, each of whose lights has `area`; see `shape_material`), cut
+    /// by its `alpha`.
+    pub(super) fn surface(
+        &mut self,
+        p: &Params,
+        at: At,
+        area: Option<f64>,
+    ) -> Result<String, Problem> {
+        let material = self.shape_material(at, area)?;
         let Some((a, aat)) = p.float_or_texture("alpha")? else {
             return Ok(material);
         };

@@ -74,6 +74,9 @@ pub(super) struct State {
     /// The area light shapes get: radiance (a colour, or an image
     /// texture's name), two-sided.
     pub area: Option<(ColorDesc, bool)>,
+    /// The power each light of a shape gives off (`power`): its radiance
+    /// is then scaled to it by the light's area.
+    pub area_power: Option<f64>,
     /// Transforms apply at the shutter's open (`ActiveTransform
     /// StartTime` or `All`).
     pub start: bool,
@@ -157,6 +160,7 @@ impl Builder {
                 material: None,
                 interface: false,
                 area: None,
+                area_power: None,
                 start: true,
             },
             stack: Vec::new(),
@@ -1021,12 +1025,12 @@ impl Builder {
             ));
         }
         let two_sided = p.boolean("twosided")?.unwrap_or(false);
-        if p.has("power") {
-            let _ = p.get("power");
+        let power = p.float("power")?.filter(|v| *v > 0.0);
+        if power.is_some() && p.has("filename") {
             self.lacks(
                 at,
-                "area light given by its power",
-                "the radiance `L` gives",
+                "an image area light given by its power",
+                "the image times `scale`",
             )?;
         }
         let radiance = match p.string_of("filename", "string")? {
@@ -1066,13 +1070,18 @@ impl Builder {
             "a diffuse area light",
             &["L", "scale", "twosided", "power", "filename"],
         )?;
+        self.state.area_power = power.filter(|_| matches!(radiance, ColorDesc::Rgb(_)));
         self.state.area = Some((radiance, two_sided));
         Ok(())
     }
 
     /// The material a shape is made of now: the current one, shining with
-    /// the current area light.
-    pub fn shape_material(&mut self, at: At) -> Result<String, Problem> {
+    /// the current area light. `area` is the area pbrt gives each of the
+    /// shape's lights (`None` where lumen does not know it): an area light
+    /// given by its `power` Φ has its radiance L scaled by
+    /// Φ / (sides · area · π), as pbrt-v4's (which leaves an RGB L's own
+    /// brightness in).
+    pub fn shape_material(&mut self, at: At, area: Option<f64>) -> Result<String, Problem> {
         let base = match &self.state.material {
             Some(m) => m.clone(),
             None => self.default_material(),
@@ -1084,6 +1093,22 @@ impl Builder {
         if self.state.interface || radiance == ColorDesc::Rgb([0.0; 3]) {
             return Ok(base);
         }
+        let radiance = match (self.state.area_power, &radiance, area) {
+            (Some(power), ColorDesc::Rgb(c), Some(area)) if area > 0.0 => {
+                let sides = if two_sided { 2.0 } else { 1.0 };
+                let k = power / (sides * area * std::f64::consts::PI);
+                ColorDesc::Rgb(c.map(|x| x * k))
+            }
+            (Some(_), _, _) => {
+                self.lacks(
+                    at,
+                    "area light given by its power on a shape whose lights' areas lumen does not know (a PLY mesh, triangles of different areas)",
+                    "the radiance `L` gives",
+                )?;
+                radiance
+            }
+            _ => radiance,
+        };
         if self.in_definition() {
             // As pbrt: the shapes of an instanced object give no light.
             self.warnings.push((

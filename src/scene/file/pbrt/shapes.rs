@@ -49,7 +49,9 @@ impl Builder {
                         "the whole sphere",
                     )?;
                 }
-                let material = self.surface(p, at)?;
+                // pbrt's area of a sphere: in its own space.
+                let area = 4.0 * std::f64::consts::PI * radius * radius;
+                let material = self.surface(p, at, Some(area))?;
                 p.finish("a sphere", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
                 if self.state.reverse && self.state.area.is_some() {
                     self.lacks(
@@ -187,7 +189,7 @@ impl Builder {
                         "the undisplaced mesh",
                     )?;
                 }
-                let material = self.surface(p, at)?;
+                let material = self.surface(p, at, None)?;
                 p.finish(
                     "a plymesh",
                     &["filename", "displacement", "edgelength", "alpha"],
@@ -288,7 +290,8 @@ impl Builder {
                 let turned = self.state.reverse != (matrix::det3(&ctm) < 0.0);
                 let object = if ty == "disk" {
                     let height = p.float("height")?.unwrap_or(0.0);
-                    let material = self.surface(p, at)?;
+                    let area = std::f64::consts::PI * radius * radius;
+                    let material = self.surface(p, at, Some(area))?;
                     p.finish(
                         "a disk",
                         &["radius", "height", "innerradius", "phimax", "alpha"],
@@ -324,7 +327,8 @@ impl Builder {
                             "one that shines outwards",
                         )?;
                     }
-                    let material = self.surface(p, at)?;
+                    let area = 2.0 * std::f64::consts::PI * radius * (z1 - z0).abs();
+                    let material = self.surface(p, at, Some(area))?;
                     p.finish("a cylinder", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
                     ObjectDesc::Cylinder {
                         p0: [0.0, 0.0, z0.min(z1)],
@@ -388,7 +392,19 @@ impl Builder {
             }
         }
         p.ignore(&["S", "faceIndices"]);
-        let material = self.surface(p, at)?;
+        // pbrt makes a light of each triangle, each patch of a bilinear
+        // mesh (two triangles here) and the whole of a ring, of its area as
+        // placed: known to lumen when all are alike.
+        let per_light = match what {
+            "a bilinearmesh" => 2,
+            "a disk" => triangles.len().max(1),
+            _ => 1,
+        };
+        let area = self
+            .state
+            .area_power
+            .and_then(|_| light_area(&positions, &triangles, per_light, &self.state.ctm));
+        let material = self.surface(p, at, area)?;
         p.finish(
             what,
             &["P", "indices", "N", "uv", "S", "faceIndices", "alpha"],
@@ -459,4 +475,28 @@ fn triples(indices: &[u32], n: usize, at: At) -> Result<Vec<[u32; 3]>, Problem> 
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect())
+}
+
+/// The area each light of `triangles` over `positions`, placed by `ctm`,
+/// has when they are alike (to 10⁻⁶), a light being `per_light`
+/// consecutive triangles: `None` when they differ.
+fn light_area(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    per_light: usize,
+    ctm: &matrix::Mat4,
+) -> Option<f64> {
+    let area = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| glam::DVec3::from(matrix::point(ctm, positions[i as usize])));
+        0.5 * (b - a).cross(c - a).length()
+    };
+    let areas: Vec<f64> = triangles
+        .chunks(per_light)
+        .map(|light| light.iter().map(area).sum())
+        .collect();
+    let first = *areas.first()?;
+    areas
+        .iter()
+        .all(|a| (a - first).abs() <= 1e-6 * first)
+        .then_some(first)
 }

@@ -21,7 +21,7 @@ const GLASSES: &[(&str, f64)] = &[
 
 /// The metals pbrt-v4 names (`metal-Au-eta`, `metal-Au-k`) that lumen's
 /// table of conductors has, by the name pbrt uses.
-const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "MgO", "TiO2"];
+const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"];
 
 /// The index of refraction of named glass `name`.
 pub fn glass(name: &str) -> Option<f64> {
@@ -153,7 +153,8 @@ mod tests {
     fn named_metals_and_glasses_are_found() {
         assert_eq!(metal("metal-Au-eta"), Ok(("Au", false)));
         assert_eq!(metal("metal-TiO2-k"), Ok(("TiO2", true)));
-        assert!(metal("metal-CuZn-k").unwrap_err().contains("metal-Cu"));
+        assert_eq!(metal("metal-CuZn-k"), Ok(("CuZn", true)));
+        assert!(metal("metal-Zn-k").unwrap_err().contains("metal-CuZn"));
         assert!(metal("metal-Au").is_err());
         assert_eq!(glass("glass-BK7"), Some(1.5168));
         for m in METALS {
