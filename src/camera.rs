@@ -298,11 +298,17 @@ impl Camera {
         })
     }
 
+    /// Whether camera rays end at a far clipping plane.
+    #[inline]
+    pub fn clips_far(&self) -> bool {
+        self.far_clip < f32::INFINITY
+    }
+
     /// The distance along camera ray `ray` (as [`Camera::ray`] makes it)
     /// to the far clipping plane: ∞ without one.
     #[inline]
     pub fn far(&self, ray: &Ray) -> f32 {
-        if self.far_clip == f32::INFINITY {
+        if !self.clips_far() {
             return f32::INFINITY;
         }
         // From the near plane (or the lens) along the ray, over the cosine

@@ -416,13 +416,10 @@ pub fn trace_path(
     let mut colour = None;
     for depth in 0..scene.settings.max_depth {
         *rays += 1;
-        // The camera's ray ends at its far plane.
-        let t_max = if depth == 0 {
-            scene.camera.far(&ray)
-        } else {
-            f32::INFINITY
-        };
-        let hit = scene.intersect_leaving(&ray, from.as_ref(), t_max);
+        let mut hit = scene.intersect_leaving(&ray, from.as_ref(), f32::INFINITY);
+        if depth == 0 && scene.camera.clips_far() {
+            clip_far(scene, &ray, &mut hit);
+        }
         match step(scene, &ray, hit, depth, &mut path, sampler) {
             Step::Continue(next, left) => (ray, from) = (next, left),
             Step::Done(c) => {
@@ -438,6 +435,18 @@ pub fn trace_path(
 /// How many rounds of bounces [`trace_paths`] runs between looks at its
 /// `halt`.
 const HALT_CHECK_ROUNDS: u32 = 256;
+
+/// Ends camera ray `ray` at the camera's far plane: its nearest hit
+/// `hit`, when beyond the plane, is none (the nearest before it would have
+/// been the nearest of all).
+#[cold]
+#[inline(never)]
+fn clip_far(scene: &Scene, ray: &Ray, hit: &mut Option<Hit>) {
+    let end = scene.camera.far(ray);
+    if hit.is_some_and(|h| h.t >= end) {
+        *hit = None;
+    }
+}
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
 /// each with its own sampler: `colours[i]` gets exactly what
@@ -523,19 +532,11 @@ fn find_hits(
     // Where bundles do not pay off, no group is large enough for one.
     let pays = scene.bundles_pay_off() || (reference.is_some() && scene.camera_bundles_pay_off());
     let min_bundle = if pays { MIN_BUNDLE } else { usize::MAX };
-    // Camera rays (the first round's) end at the camera's far plane.
-    let t_max = |ray: &Ray| {
-        if reference.is_some() {
-            scene.camera.far(ray)
-        } else {
-            f32::INFINITY
-        }
-    };
     for group in live.chunks(LANES) {
         if group.len() < min_bundle {
             for &i in group {
                 let i = i as usize;
-                hits[i] = scene.intersect_leaving(&rays[i], from[i].as_ref(), t_max(&rays[i]));
+                hits[i] = scene.intersect_leaving(&rays[i], from[i].as_ref(), f32::INFINITY);
             }
             continue;
         }
@@ -543,10 +544,13 @@ fn find_hits(
         let found = scene.hit_bundle(rays, group, reference, ALL);
         for (&i, hit) in group.iter().zip(found) {
             let i = i as usize;
-            // The nearest of all, or none when it lies beyond the end.
-            let end = t_max(&rays[i]);
-            hits[i] = hit.filter(|h| h.t < end);
-            scene.keep_counted(&rays[i], &mut hits[i], from[i].as_ref(), end);
+            hits[i] = hit;
+            scene.keep_counted(&rays[i], &mut hits[i], from[i].as_ref(), f32::INFINITY);
+        }
+    }
+    if reference.is_some() && scene.camera.clips_far() {
+        for &i in live {
+            clip_far(scene, &rays[i as usize], &mut hits[i as usize]);
         }
     }
 }
