@@ -396,16 +396,12 @@ fn far_clipping_planes_are_read_and_hide_what_lies_beyond() {
     let (_, seen) = centre("<float name=\"far_clip\" value=\"9\"/>");
     assert!(seen.x > 0.5, "{seen}");
     // Not beyond the near plane: refused.
-    std::fs::write(
-        &path,
-        text("<float name=\"near_clip\" value=\"2\"/><float name=\"far_clip\" value=\"1\"/>"),
-    )
-    .unwrap();
-    let e = SceneFile::read_with(&path, &mitsuba::Options::default())
-        .unwrap()
-        .compile(&Overrides::default())
-        .unwrap_err()
-        .to_string();
+    let e = refused(
+        &dir,
+        "s.xml",
+        &text("<float name=\"near_clip\" value=\"2\"/><float name=\"far_clip\" value=\"1\"/>"),
+        &mitsuba::Options::default(),
+    );
     assert!(
         e.contains("camera.far_clip") && e.contains("beyond near_clip"),
         "{e}"
