@@ -94,7 +94,12 @@ material = "gold"
     };
     match kind("gold").kind {
         Kind::Conductor(c) => {
-            assert!((c.eta.x - 0.143).abs() < 0.01 && (c.k.x - 3.98).abs() < 0.01);
+            let (lumen::material::ColorParam::Const(eta), lumen::material::ColorParam::Const(k)) =
+                (c.eta, c.k)
+            else {
+                panic!("gold's index is a constant")
+            };
+            assert!((eta.x - 0.143).abs() < 0.01 && (k.x - 3.98).abs() < 0.01);
             assert!(c.roughness.squared);
         }
         other => panic!("gold is {other:?}"),

@@ -1001,3 +1001,53 @@ fn no_broken_serialized_file_makes_the_reader_panic() {
         variants.len()
     );
 }
+
+/// A conductor's `eta` and `k` may be textures, as any Mitsuba parameter:
+/// each point of the surface takes the index its texture gives there.
+#[test]
+fn a_conductors_index_of_refraction_may_be_textured() {
+    use lumen::bsdf::Lobe;
+    use lumen::math::Vec3;
+    let dir = scratch_dir("mitsuba_scenes_textured_eta");
+    let path = dir.join("s.xml");
+    // A checkerboard in u (two squares across the rectangle): eta 0.2 or
+    // 0.9, and k 0.7 or 0.5, on the two halves (a checkerboard's squares
+    // are read as reflectances, within [0, 1]).
+    let board = |name: &str, a: f64, b: f64| {
+        format!(
+            "<texture name=\"{name}\" type=\"checkerboard\"><rgb name=\"color0\" value=\"{a}\"/>\
+             <rgb name=\"color1\" value=\"{b}\"/><transform name=\"to_uv\"><scale x=\"1\" y=\"0.5\"/></transform></texture>"
+        )
+    };
+    std::fs::write(
+        &path,
+        scene(&format!(
+            "  <shape type=\"rectangle\"><bsdf type=\"conductor\">{}{}</bsdf></shape>",
+            board("eta", 0.2, 0.9),
+            board("k", 0.7, 0.5)
+        )),
+    )
+    .unwrap();
+    let scene = SceneFile::read_with(&path, &mitsuba::Options::default())
+        .and_then(|f| f.compile(&Overrides::default()))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut seen = Vec::new();
+    for x in [-0.5f32, 0.5] {
+        let ray = lumen::ray::Ray::new(Vec3::new(x, 0.0, 1.0), -Vec3::Z);
+        let record = scene
+            .hit(&ray, lumen::math::Interval::new(1e-4, f32::INFINITY))
+            .expect("a hit");
+        let lobe = scene
+            .material(&record)
+            .bsdf(&record, -ray.direction, &scene.textures)
+            .map(|b| b.lobe);
+        let Some(Lobe::Conductor(c)) = lobe else {
+            panic!("{lobe:?}")
+        };
+        seen.push((c.eta.x, c.k.x));
+    }
+    seen.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let close = |a: f32, b: f64| (f64::from(a) - b).abs() < 1e-5;
+    assert!(close(seen[0].0, 0.2) && close(seen[0].1, 0.7), "{seen:?}");
+    assert!(close(seen[1].0, 0.9) && close(seen[1].1, 0.5), "{seen:?}");
+}

@@ -2,12 +2,13 @@
 //! measured one by name, or η and k given), smooth or rough.
 
 use super::metals;
-use super::param::{Invalid, Textures, Triple};
+use super::param::{ColorParam, ColorRange, Invalid, Textures, Triple};
 use super::roughness::Roughness;
 use super::{Kind, Material};
 use crate::bsdf::conductor::Conductor as ConductorLobe;
 use crate::geometry::HitRecord;
 use crate::math::{Color, Vec3};
+use crate::scene::desc::ColorDesc;
 use crate::texture::Texture;
 
 material_desc! {
@@ -20,12 +21,14 @@ material_desc! {
         /// `k` are given.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub metal: Option<String>,
-        /// The real part of the index of refraction per channel, ≥ 0.
+        /// The real part of the index of refraction per channel, ≥ 0, or
+        /// the name of a colour texture giving it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub eta: Option<Triple>,
-        /// The imaginary part (absorption) per channel, ≥ 0.
+        pub eta: Option<ColorDesc>,
+        /// The imaginary part (absorption) per channel, ≥ 0, or the name
+        /// of a colour texture giving it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        pub k: Option<Triple>,
+        pub k: Option<ColorDesc>,
     }
 }
 
@@ -44,7 +47,7 @@ impl ConductorDesc {
         field: &str,
         textures: &mut dyn Textures,
     ) -> Result<Material, Invalid> {
-        let (eta, k) = match (&self.metal, self.eta, self.k) {
+        let (eta, k) = match (&self.metal, &self.eta, &self.k) {
             (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
                 return Err(Invalid::new(
                     format!("{field}.metal"),
@@ -63,12 +66,22 @@ impl ConductorDesc {
                     }
                     Invalid::new(format!("{field}.metal"), message)
                 })?;
-                (Color::from_array(m.eta), Color::from_array(m.k))
+                (
+                    ColorParam::Const(Color::from_array(m.eta)),
+                    ColorParam::Const(Color::from_array(m.k)),
+                )
             }
-            (None, Some(eta), Some(k)) => (
-                index(&format!("{field}.eta"), eta)?,
-                index(&format!("{field}.k"), k)?,
-            ),
+            (None, Some(eta), Some(k)) => {
+                let part = |name: &str, c: &ColorDesc, textures: &mut dyn Textures| match c {
+                    ColorDesc::Rgb(v) => {
+                        index(&format!("{field}.{name}"), *v).map(ColorParam::Const)
+                    }
+                    texture => {
+                        textures.color(&format!("{field}.{name}"), texture, ColorRange::NonNegative)
+                    }
+                };
+                (part("eta", eta, textures)?, part("k", k, textures)?)
+            }
             (None, Some(_), None) | (None, None, Some(_)) => {
                 return Err(Invalid::new(
                     format!("{field}.{}", if self.eta.is_some() { "k" } else { "eta" }),
@@ -109,9 +122,9 @@ fn index(field: &str, v: Triple) -> Result<Color, Invalid> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor {
     /// The real part of the index of refraction.
-    pub eta: Color,
+    pub eta: ColorParam,
     /// The imaginary part.
-    pub k: Color,
+    pub k: ColorParam,
     /// The microfacet width.
     pub roughness: Roughness,
     /// Return the energy single scattering loses.
@@ -123,8 +136,8 @@ impl Conductor {
     #[inline]
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> ConductorLobe {
         ConductorLobe {
-            eta: self.eta,
-            k: self.k,
+            eta: self.eta.at(hit, textures),
+            k: self.k.at(hit, textures),
             tint: Color::ONE,
             roughness: self.roughness.at(hit, textures),
             multiscatter: self.multiscatter,

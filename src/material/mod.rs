@@ -855,7 +855,10 @@ impl Material {
             Kind::Diffuse(d) => d.albedo.texture().into_iter().collect(),
             Kind::Metal(m) => m.albedo.texture().into_iter().collect(),
             Kind::Dielectric(d) => d.roughness.iter().flat_map(|r| r.textures()).collect(),
-            Kind::Conductor(c) => c.roughness.textures().collect(),
+            Kind::Conductor(c) => (c.roughness.textures())
+                .chain(c.eta.texture())
+                .chain(c.k.texture())
+                .collect(),
             Kind::Plastic(p) => p.textures(),
             Kind::Principled(p) => p.textures(),
             Kind::Mix(m) => m.textures(),

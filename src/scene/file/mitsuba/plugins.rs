@@ -1210,8 +1210,8 @@ impl<'d> Convert<'d> {
             "conductor" | "roughconductor" => {
                 let mut d = ConductorDesc::default();
                 let material = p.string("material", self)?;
-                let eta = self.constant(e, &p, "eta")?;
-                let k = self.constant(e, &p, "k")?;
+                let eta = self.unbounded(&p, "eta")?;
+                let k = self.unbounded(&p, "k")?;
                 match (material, eta, k) {
                     (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
                         return Err(
@@ -1220,8 +1220,8 @@ impl<'d> Convert<'d> {
                     }
                     (Some("none") | None, None, None) => {
                         // Mitsuba's default: a perfect mirror.
-                        d.eta = Some([0.0; 3]);
-                        d.k = Some([1.0; 3]);
+                        d.eta = Some(ColorDesc::Rgb([0.0; 3]));
+                        d.k = Some(ColorDesc::Rgb([1.0; 3]));
                     }
                     (Some(name), None, None) => {
                         if crate::material::metals::find(name).is_none() {
@@ -1232,8 +1232,8 @@ impl<'d> Convert<'d> {
                         d.metal = Some(name.to_string());
                     }
                     (None, eta, k) => {
-                        d.eta = Some(eta.unwrap_or([0.0; 3]));
-                        d.k = Some(k.unwrap_or([1.0; 3]));
+                        d.eta = Some(eta.unwrap_or(ColorDesc::Rgb([0.0; 3])));
+                        d.k = Some(k.unwrap_or(ColorDesc::Rgb([1.0; 3])));
                     }
                 }
                 self.unit_factor(e, &p, "specular_reflectance")?;
@@ -1550,15 +1550,14 @@ impl<'d> Convert<'d> {
         }
     }
 
-    /// A constant colour (a conductor's `eta`, `k`).
-    fn constant(&self, e: &Element, p: &Props, n: &str) -> Result<Option<[f64; 3]>, Failure> {
-        match p.colour(n, Use::Unbounded, self)? {
-            None => Ok(None),
-            Some(Colour::Rgb(c)) => Ok(Some(c)),
-            Some(Colour::Texture(_)) => {
-                Err(self.fail(e, format!("a textured `{n}` is not supported")))
-            }
-        }
+    /// A colour not bounded by 1, or a texture (a conductor's `eta`,
+    /// `k`).
+    fn unbounded(&mut self, p: &Props<'d>, n: &str) -> Result<Option<ColorDesc>, Failure> {
+        Ok(match p.colour(n, Use::Unbounded, self)? {
+            None => None,
+            Some(Colour::Rgb(c)) => Some(ColorDesc::Rgb(c)),
+            Some(Colour::Texture(t)) => Some(ColorDesc::Texture(self.texture(t, false)?)),
+        })
     }
 
     /// The microfacets of a rough BSDF: α (one, a pair or a texture) and

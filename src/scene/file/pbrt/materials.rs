@@ -264,7 +264,14 @@ impl Builder {
                 let m = crate::material::metals::find(m).expect("checked");
                 (m.eta.map(f64::from), m.k.map(f64::from))
             }
-            None => (metal.eta.unwrap_or([1.0; 3]), metal.k.unwrap_or([0.0; 3])),
+            // `metal` gives colours only (a textured index is refused).
+            None => {
+                let rgb = |c: &Option<ColorDesc>, default| match c {
+                    Some(ColorDesc::Rgb(v)) => *v,
+                    _ => default,
+                };
+                (rgb(&metal.eta, [1.0; 3]), rgb(&metal.k, [0.0; 3]))
+            }
         };
         let f0 = [0, 1, 2].map(|i| {
             let (n, k) = (eta[i], k[i]);
@@ -350,11 +357,11 @@ impl Builder {
                 }
             };
             // pbrt's metal of that reflectance at normal incidence.
-            d.eta = Some([1.0; 3]);
-            d.k = Some(r.map(|r| {
+            d.eta = Some(ColorDesc::Rgb([1.0; 3]));
+            d.k = Some(ColorDesc::Rgb(r.map(|r| {
                 let r = r.clamp(0.0, 0.9999);
                 2.0 * r.sqrt() / (1.0 - r).sqrt()
-            }));
+            })));
             return Ok(());
         }
         let part = |cx: &mut Builder,
@@ -411,8 +418,8 @@ impl Builder {
                         (if k { m.k } else { m.eta }).map(f64::from)
                     }
                 };
-                d.eta = Some(named(eta, false));
-                d.k = Some(named(k, true));
+                d.eta = Some(ColorDesc::Rgb(named(eta, false)));
+                d.k = Some(ColorDesc::Rgb(named(k, true)));
             }
         }
         Ok(())
