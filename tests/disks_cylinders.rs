@@ -302,10 +302,6 @@ fn bad_disks_and_cylinders_are_refused_with_the_field_named() {
         ),
         (tube.replace("p0", "center"), "spheres and disks"),
         (
-            tube.replace("\"m\"", "\"glow\"") + "transform = [ { scale = [1, 2, 1] } ]\n",
-            "round cross-sections",
-        ),
-        (
             disk.to_string() + "transform = [ { scale = [1, 1e30, 1] } ]\n",
             "objects[0].transform",
         ),
@@ -316,12 +312,34 @@ fn bad_disks_and_cylinders_are_refused_with_the_field_named() {
             "`{object}`: expected {expected:?} in: {message}"
         );
     }
-    // A cylinder stretched unevenly is fine as a surface.
-    compile_file(
-        &dir,
-        "ok.toml",
-        &format!("{base}{tube}transform = [ {{ scale = [1, 2, 1] }} ]\n"),
+    // A cylinder stretched across its axis is fine as a surface, and as a
+    // light is found by the bounces alone (not sampled).
+    let stretched = format!("{tube}transform = [ {{ scale = [1, 2, 1] }} ]\n");
+    let scene = compile_file(&dir, "ok.toml", &format!("{base}{stretched}"));
+    assert_eq!(scene.lights.len(), 0);
+    let glowing = stretched.replace("\"m\"", "\"glow\"");
+    let scene = compile_file(&dir, "ok.toml", &format!("{base}{glowing}"));
+    assert_eq!(scene.lights.len(), 0, "not sampled");
+    assert!(scene.materials.iter().any(|m| m.emits()));
+}
+
+#[test]
+fn a_cylinder_light_stretched_across_its_axis_is_found_by_the_bounces() {
+    // The tube of the scene above flattened across its axis: not a
+    // sampled light, and both estimators still agree.
+    let dir = scratch_dir("quadrics-stretched-light");
+    let text = SHAPES.replace(
+        "radius = 0.2\nmaterial = \"tube\"\n",
+        "radius = 0.2\nmaterial = \"tube\"\ntransform = [ { scale = [1, 1, 2.5] } ]\n",
     );
+    assert_ne!(text, SHAPES);
+    assert_eq!(
+        compile_file(&dir, "scene.toml", &text).lights.len(),
+        1,
+        "the disk alone"
+    );
+    let (path, bsdf) = path_and_bsdf(&dir, &text);
+    common::tiles_agree("a stretched tube", &path, &bsdf);
 }
 
 #[test]

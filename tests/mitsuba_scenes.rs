@@ -395,6 +395,18 @@ fn far_clipping_planes_are_read_and_hide_what_lies_beyond() {
     assert_eq!(hidden.max_element(), 0.0);
     let (_, seen) = centre("<float name=\"far_clip\" value=\"9\"/>");
     assert!(seen.x > 0.5, "{seen}");
+    // A thin lens focuses on the far plane unless told otherwise, as
+    // Mitsuba's does.
+    std::fs::write(
+        &path,
+        text("<float name=\"far_clip\" value=\"50\"/>").replace(
+            "type=\"perspective\">",
+            "type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>",
+        ),
+    )
+    .unwrap();
+    let file = SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap();
+    assert_eq!(file.desc.camera.focus_dist, Some(50.0));
     // Not beyond the near plane: refused.
     let e = refused(
         &dir,

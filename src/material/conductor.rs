@@ -136,8 +136,9 @@ impl Conductor {
     #[inline]
     pub fn at(&self, hit: &HitRecord, textures: &[Texture]) -> ConductorLobe {
         ConductorLobe {
-            eta: self.eta.at(hit, textures),
-            k: self.k.at(hit, textures),
+            // A texture may hold negative values; an index has none.
+            eta: self.eta.at(hit, textures).max(Color::ZERO),
+            k: self.k.at(hit, textures).max(Color::ZERO),
             tint: Color::ONE,
             roughness: self.roughness.at(hit, textures),
             multiscatter: self.multiscatter,

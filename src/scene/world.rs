@@ -974,7 +974,11 @@ impl World {
             }));
         }
         for (q, material) in &top.quadrics {
-            ids.top.push(emitter(*material).map_or(NO_LIGHT, |e| {
+            // A cylinder stretched across its axis is found by the bounces
+            // only (as a stretched sphere): uniform (u, v) is not uniform
+            // over its area.
+            let sampled = emitter(*material).filter(|_| q.round());
+            ids.top.push(sampled.map_or(NO_LIGHT, |e| {
                 add(LightShape::Quadric(*q), e, CORNER_UVS, &mut lights)
             }));
         }

@@ -826,12 +826,6 @@ impl<'a> Objects<'a> {
             return Err(out_of_range(i));
         }
         placed_within(i, what, b.min.abs().max(b.max.abs()).max_element())?;
-        if !quadric.round() && self.materials[m as usize].emits() {
-            return Err(invalid(
-                format!("objects[{i}]"),
-                "a cylinder that gives off light must keep round cross-sections square to its axis (its transform may turn, move and scale it evenly across the axis), so that its light can be sampled evenly by area",
-            ));
-        }
         self.top.quadrics.push((quadric, m));
         Ok(())
     }

@@ -533,7 +533,8 @@ impl<'d> Convert<'d> {
             let radius = p.float("aperture_radius", self)?.ok_or_else(|| {
                 self.fail(e, "a thinlens sensor needs an `aperture_radius`".into())
             })?;
-            let focus = p.float("focus_distance", self)?.unwrap_or(1e4);
+            // Mitsuba focuses at the far clipping plane by default.
+            let focus = p.float("focus_distance", self)?.unwrap_or(far_clip);
             if !(radius >= 0.0 && focus > 0.0) {
                 return Err(self.fail(
                     e,

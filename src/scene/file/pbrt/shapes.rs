@@ -261,8 +261,12 @@ impl Builder {
                 if phimax < 360.0 {
                     self.lacks(at, &format!("part of a {ty} (phimax)"), "the whole")?;
                 }
-                let inner = p.float("innerradius")?.unwrap_or(0.0);
-                if ty == "disk" && inner > 0.0 {
+                let inner = if ty == "disk" {
+                    p.float("innerradius")?.unwrap_or(0.0)
+                } else {
+                    0.0
+                };
+                if inner > 0.0 {
                     // A ring: as triangles, with its hole.
                     self.lacks(
                         at,
@@ -392,18 +396,19 @@ impl Builder {
             }
         }
         p.ignore(&["S", "faceIndices"]);
-        // pbrt makes a light of each triangle, each patch of a bilinear
-        // mesh (two triangles here) and the whole of a ring, of its area as
-        // placed: known to lumen when all are alike.
-        let per_light = match what {
-            "a bilinearmesh" => 2,
-            "a disk" => triangles.len().max(1),
-            _ => 1,
+        // pbrt makes a light of each triangle and each patch of a bilinear
+        // mesh (two triangles here), of its area as placed (known to lumen
+        // when all are alike), and one of a ring, of its area in its own
+        // space (which its triangles keep).
+        let (per_light, space) = match what {
+            "a bilinearmesh" => (2, self.state.ctm),
+            "a disk" => (triangles.len().max(1), matrix::IDENTITY),
+            _ => (1, self.state.ctm),
         };
         let area = self
             .state
             .area_power
-            .and_then(|_| light_area(&positions, &triangles, per_light, &self.state.ctm));
+            .and_then(|_| light_area(&positions, &triangles, per_light, &space));
         let material = self.surface(p, at, area)?;
         p.finish(
             what,
