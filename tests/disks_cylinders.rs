@@ -17,23 +17,11 @@ use lumen::scene::{Integrator, Scene};
 /// A floor, a matte cylinder and a matte disk, lit by a one-sided disk
 /// stretched into an ellipse and turned, and a two-sided cylinder of
 /// light lying on its side; black sky.
-const SHAPES: &str = r#"[render]
-width = 32
-height = 24
-samples_per_pixel = 128
-max_depth = 6
-seed = 5
-
-[camera]
-vfov = 55
-lookfrom = [0, 2.5, 6]
-lookat = [0, 0.5, 0]
-
-[background]
-type = "solid"
-color = [0, 0, 0]
-
-[materials.lamp]
+fn shapes() -> String {
+    common::on_dark_floor(
+        5,
+        "vfov = 55\nlookfrom = [0, 2.5, 6]\nlookat = [0, 0.5, 0]",
+        r#"[materials.lamp]
 type = "emissive"
 radiance = [8, 7, 6]
 
@@ -45,17 +33,6 @@ two_sided = true
 [materials.matte]
 type = "diffuse"
 albedo = [0.7, 0.5, 0.4]
-
-[materials.floor]
-type = "diffuse"
-albedo = [0.5, 0.5, 0.5]
-
-[[objects]]
-type = "quad"
-corner = [-10, 0, -10]
-u = [0, 0, 20]
-v = [20, 0, 0]
-material = "floor"
 
 [[objects]]
 type = "cylinder"
@@ -85,20 +62,22 @@ p0 = [-2, 2, -1.5]
 p1 = [1, 2.5, -1.5]
 radius = 0.2
 material = "tube"
-"#;
+"#,
+    )
+}
 
 #[test]
 fn path_and_bsdf_agree_under_disk_and_cylinder_lights() {
     let dir = scratch_dir("quadrics-lights");
-    let scene = compile_file(&dir, "scene.toml", SHAPES);
+    let scene = compile_file(&dir, "scene.toml", &shapes());
     assert_eq!(scene.lights.len(), 2, "the disk and the tube are lights");
-    let (path, bsdf) = path_and_bsdf(&dir, SHAPES);
+    let (path, bsdf) = path_and_bsdf(&dir, &shapes());
     assert_tiles_agree("disk and cylinder lights", &path, &bsdf);
     // Each light alone (the other made matte), so that neither hides the
     // other's error.
     for (light, alone) in [("lamp", "the disk light alone"), ("tube", "the tube alone")] {
         let other = if light == "lamp" { "tube" } else { "lamp" };
-        let text = SHAPES.replace(&format!("material = \"{other}\""), "material = \"matte\"");
+        let text = shapes().replace(&format!("material = \"{other}\""), "material = \"matte\"");
         assert_eq!(compile_file(&dir, "scene.toml", &text).lights.len(), 1);
         let (path, bsdf) = path_and_bsdf(&dir, &text);
         assert_tiles_agree(alone, &path, &bsdf);
@@ -110,11 +89,11 @@ fn a_moving_disk_renders_as_placed() {
     // The same scene with its matte disk moving (traced in a tree of its
     // own) still agrees between the estimators.
     let dir = scratch_dir("quadrics-moving");
-    let text = SHAPES.replace(
+    let text = shapes().replace(
         "radius = 0.6\nmaterial = \"matte\"\n",
         "radius = 0.6\nmaterial = \"matte\"\ntransform = [ { motion = [0, 0.3, 0] } ]\n",
     );
-    assert_ne!(text, SHAPES);
+    assert_ne!(text, shapes());
     let (path, bsdf) = path_and_bsdf(&dir, &text);
     assert_tiles_agree("a moving disk", &path, &bsdf);
 }
@@ -328,11 +307,11 @@ fn a_cylinder_light_stretched_across_its_axis_is_found_by_the_bounces() {
     // The tube of the scene above flattened across its axis: not a
     // sampled light, and both estimators still agree.
     let dir = scratch_dir("quadrics-stretched-light");
-    let text = SHAPES.replace(
+    let text = shapes().replace(
         "radius = 0.2\nmaterial = \"tube\"\n",
         "radius = 0.2\nmaterial = \"tube\"\ntransform = [ { scale = [1, 1, 2.5] } ]\n",
     );
-    assert_ne!(text, SHAPES);
+    assert_ne!(text, shapes());
     assert_eq!(
         compile_file(&dir, "scene.toml", &text).lights.len(),
         1,

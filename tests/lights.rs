@@ -30,23 +30,11 @@ fn path_and_bsdf_agree_on_the_cornell_box() {
 
 /// A floor and a matte ball under a small one-sided ball of light (and a
 /// two-sided panel), black sky: direct light dominates.
-const SPHERE_LIGHT: &str = r#"[render]
-width = 32
-height = 24
-samples_per_pixel = 128
-max_depth = 6
-seed = 4
-
-[camera]
-vfov = 50
-lookfrom = [0, 2, 6]
-lookat = [0, 0.5, 0]
-
-[background]
-type = "solid"
-color = [0, 0, 0]
-
-[materials.bulb]
+fn sphere_light() -> String {
+    common::on_dark_floor(
+        4,
+        "vfov = 50\nlookfrom = [0, 2, 6]\nlookat = [0, 0.5, 0]",
+        r#"[materials.bulb]
 type = "emissive"
 radiance = [12, 10, 8]
 
@@ -58,17 +46,6 @@ two_sided = true
 [materials.matte]
 type = "diffuse"
 albedo = [0.7, 0.6, 0.5]
-
-[materials.floor]
-type = "diffuse"
-albedo = [0.5, 0.5, 0.5]
-
-[[objects]]
-type = "quad"
-corner = [-10, 0, -10]
-u = [0, 0, 20]
-v = [20, 0, 0]
-material = "floor"
 
 [[objects]]
 type = "sphere"
@@ -88,12 +65,14 @@ corner = [-3, 0.5, -2]
 u = [0, 2, 0]
 v = [0, 0, 2]
 material = "panel"
-"#;
+"#,
+    )
+}
 
 #[test]
 fn path_and_bsdf_agree_under_sphere_and_quad_lights() {
     let dir = scratch_dir("lights-sphere");
-    let (path, bsdf) = path_and_bsdf(&dir, SPHERE_LIGHT);
+    let (path, bsdf) = path_and_bsdf(&dir, &sphere_light());
     assert_tiles_agree("sphere light", &path, &bsdf);
 }
 
@@ -108,7 +87,7 @@ fn path_and_bsdf_agree_under_instanced_mirrored_triangle_lights() {
         "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 0 0.5\nv -0.5 0 0.5\nf 1 2 3\nf 1 3 4\n",
     )
     .unwrap();
-    let text = SPHERE_LIGHT.replace(
+    let text = sphere_light().replace(
         "material = \"panel\"\n",
         "material = \"panel\"\n\n\
          [[objects]]\ntype = \"mesh\"\nfile = \"lamp.obj\"\nmaterial = \"lamp\"\n\
@@ -262,7 +241,7 @@ fn black_lights_render_black_without_nan() {
     // Emissive objects of zero radiance are no lights to sample: the scene
     // renders, black, with either integrator.
     let dir = scratch_dir("lights-black");
-    let text = SPHERE_LIGHT
+    let text = sphere_light()
         .replace("radiance = [12, 10, 8]", "radiance = [0, 0, 0]")
         .replace("radiance = [1, 2, 3]", "radiance = [0, 0, 0]")
         .replace("samples_per_pixel = 128", "samples_per_pixel = 4");

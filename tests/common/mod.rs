@@ -679,3 +679,39 @@ pub fn path_and_bsdf(dir: &std::path::Path, text: &str) -> (PixelStats, PixelSta
     bsdf.settings.integrator = lumen::scene::Integrator::Bsdf;
     (pixel_stats(&path), pixel_stats(&bsdf))
 }
+
+/// A scene of 32 × 24 pixels at 128 samples a pixel (paths of up to six
+/// segments, seed `seed`) seen by `camera` (the `[camera]` table's lines),
+/// under a black sky, on a grey floor 20 wide at y = 0 (material
+/// `floor`), with `rest` (more materials and objects) after the floor:
+/// where direct light dominates, to compare estimators.
+pub fn on_dark_floor(seed: u64, camera: &str, rest: &str) -> String {
+    format!(
+        r#"[render]
+width = 32
+height = 24
+samples_per_pixel = 128
+max_depth = 6
+seed = {seed}
+
+[camera]
+{camera}
+
+[background]
+type = "solid"
+color = [0, 0, 0]
+
+[materials.floor]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[objects]]
+type = "quad"
+corner = [-10, 0, -10]
+u = [0, 0, 20]
+v = [20, 0, 0]
+material = "floor"
+
+{rest}"#
+    )
+}
