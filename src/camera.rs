@@ -305,12 +305,9 @@ impl Camera {
     }
 
     /// The distance along camera ray `ray` (as [`Camera::ray`] makes it)
-    /// to the far clipping plane: ∞ without one.
+    /// to the far clipping plane: ∞ without one (∞ over the cosine).
     #[inline]
     pub fn far(&self, ray: &Ray) -> f32 {
-        if !self.clips_far() {
-            return f32::INFINITY;
-        }
         // From the near plane (or the lens) along the ray, over the cosine
         // to the view.
         (self.far_clip - self.near_clip) / -ray.direction.dot(self.basis[2])

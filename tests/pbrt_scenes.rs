@@ -318,18 +318,27 @@ AttributeEnd
         panic!()
     };
     assert!(close(color, [0.5; 3]), "illuminance / π × L: {color:?}");
-    let ObjectDesc::Sphere { material, .. } = &d.objects[0] else {
-        panic!()
-    };
-    let surface = d.materials[material].clone();
-    let MaterialDesc::Diffuse(glow) = surface else {
-        panic!()
-    };
-    let Some(ColorDesc::Rgb(e)) = glow.emission else {
-        panic!()
-    };
+    let (glow, e) = glow(&d, 0);
     assert!((y(e) - 4.0).abs() < 1e-9 && e[0] > e[2], "warm: {e:?}");
     assert!(glow.two_sided);
+}
+
+/// The material of object `i` of `d`, a pbrt area light read as a
+/// glowing diffuse material, and its radiance.
+fn glow(d: &SceneDesc, i: usize) -> (&lumen::scene::desc::DiffuseDesc, [f64; 3]) {
+    let material = match &d.objects[i] {
+        ObjectDesc::Sphere { material, .. }
+        | ObjectDesc::Disk { material, .. }
+        | ObjectDesc::Triangles { material, .. } => material,
+        other => panic!("{other:?}"),
+    };
+    let MaterialDesc::Diffuse(glow) = &d.materials[material] else {
+        panic!("{:?}", d.materials[material])
+    };
+    let Some(ColorDesc::Rgb(e)) = glow.emission else {
+        panic!("{:?}", glow.emission)
+    };
+    (glow, e)
 }
 
 /// An area light given by its `power` Φ shines with L · Φ / (sides · A ·
@@ -354,21 +363,7 @@ AttributeBegin
 AttributeEnd
 "#,
     );
-    let radiance = |i: usize| {
-        let material = match &d.objects[i] {
-            ObjectDesc::Sphere { material, .. }
-            | ObjectDesc::Disk { material, .. }
-            | ObjectDesc::Triangles { material, .. } => material,
-            other => panic!("{other:?}"),
-        };
-        let MaterialDesc::Diffuse(glow) = &d.materials[material] else {
-            panic!()
-        };
-        let Some(ColorDesc::Rgb(e)) = glow.emission else {
-            panic!()
-        };
-        e
-    };
+    let radiance = |i: usize| glow(&d, i).1;
     let k = 100.0 / (4.0 * pi * 4.0 * pi);
     assert!(
         close(radiance(0), [k, 2.0 * k, 3.0 * k]),

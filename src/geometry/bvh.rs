@@ -210,6 +210,23 @@ pub(super) struct QuadricPacket {
     pub(super) index: [u32; 8],
 }
 
+impl QuadricPacket {
+    /// The distance and index of each of the packet's shapes that `ray`
+    /// hits beyond `t_min`.
+    #[inline]
+    pub(super) fn hits<'a>(
+        &'a self,
+        ray: &'a Ray,
+        t_min: f32,
+    ) -> impl Iterator<Item = (f32, u32)> + 'a {
+        self.shapes
+            .iter()
+            .map_while(Option::as_ref)
+            .zip(self.index)
+            .filter_map(move |(shape, index)| Some((shape.hit(ray, t_min)?, index)))
+    }
+}
+
 impl SpherePacket {
     /// The packet's spheres, one per lane.
     #[inline(always)]
@@ -834,19 +851,13 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
     /// the first hit in the order (distance, index) as for any primitive.
     #[inline(never)]
     fn quadrics(&mut self, p: &QuadricPacket) -> bool {
-        for (shape, &index) in p.shapes.iter().zip(&p.index) {
-            let Some(shape) = shape else {
-                break;
-            };
-            let Some(t) = shape.hit(&self.ray, self.t_min) else {
-                continue;
-            };
+        for (t, index) in p.hits(&self.ray, self.t_min) {
             if Q::ANY {
                 if t < self.closest {
                     (self.closest, self.best) = (t, index);
                     return true;
                 }
-            } else if t <= self.closest && comes_before((t, index), (self.closest, self.best)) {
+            } else if comes_before((t, index), (self.closest, self.best)) {
                 (self.closest, self.best, self.sub) = (t, index, 0);
             }
         }

@@ -499,15 +499,8 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
             let l = enter.trailing_zeros() as usize;
             enter &= enter - 1;
             let ray = self.rays.ray(l);
-            for (shape, &index) in p.shapes.iter().zip(&p.index) {
-                let Some(shape) = shape else {
-                    break;
-                };
-                let Some(t) = shape.hit(&ray, self.t_min) else {
-                    continue;
-                };
-                if t <= self.closest[l] && comes_before((t, index), (self.closest[l], self.best[l]))
-                {
+            for (t, index) in p.hits(&ray, self.t_min) {
+                if comes_before((t, index), (self.closest[l], self.best[l])) {
                     (self.closest[l], self.best[l], self.sub[l]) = (t, index, 0);
                 }
             }

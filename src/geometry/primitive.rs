@@ -1,6 +1,7 @@
 //! The closed set of shapes a BVH holds: spheres, triangles, quads, disks
-//! and cylinders, and instances of other trees. Each operation is one `match` over the kind;
-//! each kind's intersection is one kernel (see [`crate::lanes`]).
+//! and cylinders, and instances of other trees. Each operation is one
+//! `match` over the kind; each kind's intersection is one kernel (see
+//! [`crate::lanes`]), disks and cylinders one at a time.
 
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::{Quad, Quadric, Sphere, Triangle};

@@ -182,8 +182,21 @@ impl Quadric {
 
     /// The surface at texture coordinates `uv` (the disk's (r, φ/2π), the
     /// cylinder's (φ/2π, z)).
-    pub fn at(&self, [u, v]: [f64; 2]) -> QuadricHit {
-        let (point, normal, dpdu, dpdv) = match self.form {
+    pub fn at(&self, uv: [f64; 2]) -> QuadricHit {
+        let (point, normal, dpdu, dpdv) = self.local(uv);
+        QuadricHit {
+            point: Vec3::from(self.world_point(point).as_vec3()),
+            outward: self.outward(normal),
+            uv: uv.map(|x| x as f32),
+            dpdu: self.world_vector(dpdu),
+            dpdv: self.world_vector(dpdv),
+            extent: self.extent(),
+        }
+    }
+
+    /// The point, normal and derivatives at `uv` in the shape's own space.
+    fn local(&self, [u, v]: [f64; 2]) -> (DVec3, DVec3, DVec3, DVec3) {
+        match self.form {
             QuadricForm::Disk => {
                 let (sin, cos) = (v * TAU).sin_cos();
                 let radial = DVec3::new(cos, sin, 0.0);
@@ -196,37 +209,25 @@ impl Quadric {
                 let around = DVec3::new(-sin, cos, 0.0) * TAU;
                 (radial + DVec3::new(0.0, 0.0, v), radial, around, DVec3::Z)
             }
-        };
-        let world = self.world_point(point);
-        QuadricHit {
-            point: Vec3::from(world.as_vec3()),
-            outward: self.outward(normal),
-            uv: [u as f32, v as f32],
-            dpdu: self.world_vector(dpdu),
-            dpdv: self.world_vector(dpdv),
-            extent: self.extent(),
         }
     }
 
     /// The world unit normal of object normal `n`: the inverse transpose,
     /// which keeps the outside outside under a mirroring transform.
     fn outward(&self, n: DVec3) -> Vec3 {
-        let m = &self.to_object;
-        let w = DVec3::new(
-            f64::from(m[0][0]) * n.x + f64::from(m[1][0]) * n.y + f64::from(m[2][0]) * n.z,
-            f64::from(m[0][1]) * n.x + f64::from(m[1][1]) * n.y + f64::from(m[2][1]) * n.z,
-            f64::from(m[0][2]) * n.x + f64::from(m[1][2]) * n.y + f64::from(m[2][2]) * n.z,
-        );
+        let row = |j: usize| {
+            let r = self.to_object[j].map(f64::from);
+            DVec3::new(r[0], r[1], r[2])
+        };
+        let w = row(0) * n.x + row(1) * n.y + row(2) * n.z;
         Vec3::from(w.normalize().as_vec3())
     }
 
     /// The translation's largest coordinate plus the lengths of the three
     /// axes: the size of what a point's world coordinates are summed from.
     pub fn extent(&self) -> f32 {
-        let m = &self.to_world;
-        let axis = |j: usize| Vec3::new(m[0][j], m[1][j], m[2][j]).length();
-        let translation = Vec3::new(m[0][3], m[1][3], m[2][3]).abs().max_element();
-        translation + axis(0) + axis(1) + axis(2)
+        let [x, y, z, origin] = self.axes();
+        origin.abs().max_element() + x.length() + y.length() + z.length()
     }
 
     /// The world axes of the object's x, y and z, and its origin.
@@ -267,14 +268,55 @@ impl Quadric {
     }
 
     /// A point uniform over the area for `uv` uniform in the unit square
-    /// (for a cylinder, when [`Quadric::round`]).
-    pub fn sample(&self, [s, t]: [f32; 2]) -> QuadricHit {
+    /// (for a cylinder, when [`Quadric::round`]): the point, its outward
+    /// normal and its texture coordinates (a light sample needs no
+    /// derivatives).
+    pub fn sample(&self, [s, t]: [f32; 2]) -> (Point3, Vec3, [f32; 2]) {
         let (s, t) = (f64::from(s), f64::from(t));
-        match self.form {
-            QuadricForm::Disk => self.at([s.sqrt(), t]),
-            QuadricForm::Cylinder => self.at([s, t]),
-        }
+        let uv = match self.form {
+            QuadricForm::Disk => [s.sqrt(), t],
+            QuadricForm::Cylinder => [s, t],
+        };
+        let (point, normal, ..) = self.local(uv);
+        (
+            Vec3::from(self.world_point(point).as_vec3()),
+            self.outward(normal),
+            uv.map(|x| x as f32),
+        )
     }
+}
+
+/// The placement of the unit disk that makes the disk of `radius` about
+/// `center` facing unit `normal`, its φ measured from the first axis of
+/// [`crate::math::frame`] of the normal: a 4 × 4 matrix row by row (as
+/// `TransformStep::Matrix` takes it).
+pub fn disk_placement(center: [f64; 3], normal: DVec3, radius: f64) -> [[f64; 4]; 4] {
+    let [s, t, n] = crate::math::frame(normal);
+    columns([s * radius, t * radius, n * radius, DVec3::from(center)])
+}
+
+/// The placement of the unit cylinder that makes the cylinder of `radius`
+/// from `p0` to `p1`, turned about its axis as Mitsuba and pbrt turn it
+/// (by [`crate::math::frame`] of the axis), row by row; `None` when `p0`
+/// is `p1`.
+pub fn cylinder_placement(p0: [f64; 3], p1: [f64; 3], radius: f64) -> Option<[[f64; 4]; 4]> {
+    let (p0, axis) = (DVec3::from(p0), DVec3::from(p1) - DVec3::from(p0));
+    if !(axis.length() > 0.0) {
+        return None;
+    }
+    let [s, t, _] = crate::math::frame(axis.normalize());
+    Some(columns([s * radius, t * radius, axis, p0]))
+}
+
+/// The affine matrix, row by row, whose columns are the axes `x`, `y`,
+/// `z` and the origin `o`.
+fn columns([x, y, z, o]: [DVec3; 4]) -> [[f64; 4]; 4] {
+    [
+        [x.x, y.x, z.x, o.x],
+        [x.y, y.y, z.y, o.y],
+        [x.z, y.z, z.z, o.z],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
 }
 
 /// Row-major 3 × 4 matrix `m` times (p, w).
@@ -373,7 +415,7 @@ mod tests {
                     rng.next_f32() * 8.0 - 5.0,
                     rng.next_f32() * 8.0 - 2.0,
                 );
-                let target = q.sample([rng.next_f32(), rng.next_f32()]).point
+                let target = q.sample([rng.next_f32(), rng.next_f32()]).0
                     + 0.3 * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
                 let ray = Ray::new(origin, (target - origin).normalize());
                 let inside = |t: f32| {
@@ -418,14 +460,7 @@ mod tests {
         assert!((ellipse.area() - 3.0 * std::f32::consts::PI).abs() < 1e-5);
         let n = 200_000;
         let far = (0..n)
-            .filter(|_| {
-                ellipse
-                    .sample([rng.next_f32(), rng.next_f32()])
-                    .point
-                    .x
-                    .abs()
-                    > 1.5
-            })
+            .filter(|_| ellipse.sample([rng.next_f32(), rng.next_f32()]).0.x.abs() > 1.5)
             .count() as f64
             / n as f64;
         // The caps |x| > a/2 of a circle: 1 − (2/π)(asin(1/2) + (1/2)√(3/4)).

@@ -23,7 +23,7 @@ pub use environment::{Environment, EnvironmentMap};
 pub use source::{LightDesc, LightSource};
 
 use crate::distribution::Distribution1D;
-use crate::geometry::{Quadric, Sphere};
+use crate::geometry::{Quadric, QuadricForm, Sphere};
 use crate::material::Emissive;
 use crate::math::{Color, Point3, Vec3};
 use crate::sampler::{Dim, Sampler};
@@ -518,8 +518,8 @@ impl Surface {
             // A disk's normal is everywhere the same; a cylinder's is its
             // sample's.
             Shape::Quadric(q) => match q.form {
-                crate::geometry::QuadricForm::Disk => q.at([0.0, 0.0]).outward,
-                crate::geometry::QuadricForm::Cylinder => Vec3::ZERO,
+                QuadricForm::Disk => q.at([0.0, 0.0]).outward,
+                QuadricForm::Cylinder => Vec3::ZERO,
             },
             Shape::Quad { u, v, .. } => u.cross(v).normalize(),
             Shape::Triangle {
@@ -584,10 +584,7 @@ fn sample_area(shape: &Shape, normal: Vec3, [s, t]: [f32; 2]) -> (Point3, Vec3, 
             };
             (a + s * (b - a) + t * (c - a), normal, [s, t])
         }
-        Shape::Quadric(q) => {
-            let hit = q.sample([s, t]);
-            (hit.point, hit.outward, hit.uv)
-        }
+        Shape::Quadric(q) => q.sample([s, t]),
     }
 }
 

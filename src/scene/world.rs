@@ -3,10 +3,10 @@
 //! a hit found by the tree becomes a [`HitRecord`].
 //!
 //! The tree's items are numbered spheres first, then quads, then disks and
-//! cylinders, then the triangles of each mesh placed once (stored in world space), then the
-//! instances of meshes placed several times (stored once, in object space,
-//! with a tree of their own). A shape's number is its place in the order of
-//! hits at exactly the same distance.
+//! cylinders, then the triangles of each mesh placed once (stored in world
+//! space), then the instances of meshes placed several times (stored once,
+//! in object space, with a tree of their own). A shape's number is its
+//! place in the order of hits at exactly the same distance.
 
 use crate::geometry::bvh::Hit;
 use crate::geometry::hit::face_normal;

@@ -14,6 +14,7 @@ use super::{
 use crate::camera::{Camera, CameraError, CameraSettings};
 use crate::filter::PixelFilter;
 use crate::geometry::bvh_build::Aabb;
+use crate::geometry::quadric;
 use crate::geometry::transform::{Transform, TransformStep};
 use crate::geometry::{Quad, Quadric, QuadricForm, Sphere};
 use crate::light::{Environment, EnvironmentMap, Lights};
@@ -497,13 +498,7 @@ impl<'a> Objects<'a> {
                 ..
             } => {
                 finite(format_args!("objects[{i}].center"), center)?;
-                finite(format_args!("objects[{i}].radius"), &[*radius])?;
-                if !(*radius as f32 > 0.0) {
-                    return Err(invalid(
-                        format!("objects[{i}].radius"),
-                        format!("must be greater than 0, got {radius}"),
-                    ));
-                }
+                positive(format_args!("objects[{i}].radius"), *radius)?;
                 // The intersection squares the radius and distances of the
                 // order of the centre's coordinates, in f32.
                 let extent = center.iter().fold(*radius, |m, c| m.max(c.abs()));
@@ -604,18 +599,12 @@ impl<'a> Objects<'a> {
                 let field = |name: &str| format!("objects[{i}].{name}");
                 finite(field("center"), center)?;
                 finite(field("normal"), normal)?;
-                let radius = positive(&field("radius"), *radius)?;
+                let radius = positive(field("radius"), *radius)?;
                 let n = glam::DVec3::from(*normal);
                 if n == glam::DVec3::ZERO {
                     return Err(invalid(field("normal"), "must not be zero"));
                 }
-                let [s, t, n] = crate::math::frame(n.normalize());
-                let unit = [
-                    s * radius,
-                    t * radius,
-                    n * radius,
-                    glam::DVec3::from(*center),
-                ];
+                let unit = quadric::disk_placement(*center, n.normalize(), radius);
                 let m = self.material(i, material)?;
                 self.place_quadric(i, QuadricForm::Disk, unit, &transform, m)?;
             }
@@ -629,19 +618,10 @@ impl<'a> Objects<'a> {
                 let field = |name: &str| format!("objects[{i}].{name}");
                 finite(field("p0"), p0)?;
                 finite(field("p1"), p1)?;
-                let radius = positive(&field("radius"), *radius)?;
-                let (p0, axis) = (
-                    glam::DVec3::from(*p0),
-                    glam::DVec3::from(*p1) - glam::DVec3::from(*p0),
-                );
-                if !(axis.length() > 0.0) {
-                    return Err(invalid(
-                        field("p1"),
-                        "must not be p0: the cylinder has no length",
-                    ));
-                }
-                let [s, t, _] = crate::math::frame(axis.normalize());
-                let unit = [s * radius, t * radius, axis, p0];
+                let radius = positive(field("radius"), *radius)?;
+                let unit = quadric::cylinder_placement(*p0, *p1, radius).ok_or_else(|| {
+                    invalid(field("p1"), "must not be p0: the cylinder has no length")
+                })?;
                 let m = self.material(i, material)?;
                 self.place_quadric(i, QuadricForm::Cylinder, unit, &transform, m)?;
             }
@@ -677,24 +657,12 @@ impl<'a> Objects<'a> {
                 ..
             } => {
                 let field = |name: &str| format!("objects[{i}].{name}");
-                finite(field("density"), &[*density])?;
-                if !(*density as f32 > 0.0) {
-                    return Err(invalid(
-                        field("density"),
-                        format!("must be greater than 0, got {density}"),
-                    ));
-                }
+                positive(field("density"), *density)?;
                 let albedo = albedo(&field("albedo"), *colour)?;
                 let shape = match boundary {
                     BoundaryDesc::Sphere { center, radius } => {
                         finite(field("boundary.center"), center)?;
-                        finite(field("boundary.radius"), &[*radius])?;
-                        if !(*radius as f32 > 0.0) {
-                            return Err(invalid(
-                                field("boundary.radius"),
-                                format!("must be greater than 0, got {radius}"),
-                            ));
-                        }
+                        positive(field("boundary.radius"), *radius)?;
                         Boundary::Sphere {
                             center: vec3(*center),
                             radius: *radius as f32,
@@ -791,19 +759,17 @@ impl<'a> Objects<'a> {
         Ok(())
     }
 
-    /// Adds the unit `form` placed by the axes and origin `unit` (columns
-    /// of its matrix) and then by `transform`, in material `m`: for object
-    /// `i`.
+    /// Adds the unit `form` placed by `unit` (a matrix, row by row) and
+    /// then by `transform`, in material `m`: for object `i`.
     fn place_quadric(
         &mut self,
         i: usize,
         form: QuadricForm,
-        [x, y, z, origin]: [glam::DVec3; 4],
+        unit: [[f64; 4]; 4],
         transform: &Transform,
         m: u32,
     ) -> Result<(), SceneError> {
-        let rows = [0, 1, 2].map(|r| [x[r], y[r], z[r], origin[r]]);
-        let matrix = TransformStep::Matrix([rows[0], rows[1], rows[2], [0.0, 0.0, 0.0, 1.0]]);
+        let matrix = TransformStep::Matrix(unit);
         let what = match form {
             QuadricForm::Disk => "the disk",
             QuadricForm::Cylinder => "the cylinder",
@@ -1160,11 +1126,13 @@ fn model_path(base: &Path, file: &str) -> PathBuf {
 }
 
 /// `value` of `field` when it is finite and above 0 once in `f32`.
-fn positive(field: &str, value: f64) -> Result<f64, SceneError> {
-    finite(field, &[value])?;
+/// `field` is only formatted when the value is refused (as for
+/// [`finite`]).
+fn positive(field: impl std::fmt::Display, value: f64) -> Result<f64, SceneError> {
+    finite(&field, &[value])?;
     if !(value as f32 > 0.0) {
         return Err(invalid(
-            field,
+            field.to_string(),
             format!("must be greater than 0, got {value}"),
         ));
     }

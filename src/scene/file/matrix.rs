@@ -28,33 +28,6 @@ pub fn z_up_sphere([cx, cy, cz]: [f64; 3]) -> Mat4 {
     ]
 }
 
-/// The matrix whose columns are the axes `x`, `y`, `z` and the origin
-/// `o`.
-pub fn columns(x: [f64; 3], y: [f64; 3], z: [f64; 3], o: [f64; 3]) -> Mat4 {
-    [
-        [x[0], y[0], z[0], o[0]],
-        [x[1], y[1], z[1], o[1]],
-        [x[2], y[2], z[2], o[2]],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// The placement of lumen's unit cylinder (radius 1, z from 0 to 1) that
-/// makes the cylinder of `radius` from `p0` to `p1` as Mitsuba and pbrt
-/// turn it about its axis (their frame of the axis, which lumen's
-/// cylinders share), or `None` when `p0` is `p1`.
-pub fn cylinder(p0: [f64; 3], p1: [f64; 3], radius: f64) -> Option<Mat4> {
-    let d = sub(p1, p0);
-    let axis = glam::DVec3::from(normalize(d)?);
-    let [s, t, _] = crate::math::frame(axis);
-    Some(columns(
-        (s * radius).to_array(),
-        (t * radius).to_array(),
-        d,
-        p0,
-    ))
-}
-
 /// a · b.
 pub fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut m = [[0.0; 4]; 4];

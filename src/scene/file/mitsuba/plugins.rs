@@ -1023,18 +1023,14 @@ impl<'d> Convert<'d> {
                         format!("a cylinder's radius must be above 0, got {radius}"),
                     ));
                 }
-                let Some(unit) = crate::scene::file::matrix::cylinder(p0, p1, radius) else {
+                let Some(unit) = crate::geometry::quadric::cylinder_placement(p0, p1, radius)
+                else {
                     return Err(self.fail(e, "a cylinder's p0 and p1 must differ".into()));
                 };
                 // Mitsuba's v (along the axis) runs down the image, lumen's
                 // up: z becomes 1 − z.
-                let along = [
-                    [1.0, 0.0, 0.0, 0.0],
-                    [0.0, 1.0, 0.0, 0.0],
-                    [0.0, 0.0, -1.0, 1.0],
-                    [0.0, 0.0, 0.0, 1.0],
-                ];
-                use crate::scene::file::matrix::mul;
+                use crate::scene::file::matrix::{mul, scaling, translation};
+                let along = mul(&translation([0.0, 0.0, 1.0]), &scaling([1.0, 1.0, -1.0]));
                 ObjectDesc::Cylinder {
                     p0: [0.0; 3],
                     p1: [0.0, 0.0, 1.0],

@@ -99,6 +99,7 @@ impl Builder {
                     p,
                     at,
                     "a trianglemesh",
+                    Lights::Each(1),
                 )?;
             }
             "bilinearmesh" => {
@@ -171,6 +172,7 @@ impl Builder {
                     p,
                     at,
                     "a bilinearmesh",
+                    Lights::Each(2),
                 )?;
             }
             "plymesh" => {
@@ -246,6 +248,7 @@ impl Builder {
                     p,
                     at,
                     "a loopsubdiv",
+                    Lights::Each(1),
                 )?;
             }
             "disk" | "cylinder" => {
@@ -274,7 +277,10 @@ impl Builder {
                         "a polygon of 128 sides of its area",
                     )?;
                     let height = p.float("height")?.unwrap_or(0.0);
-                    let mesh = tessellate::disk(radius, inner.min(radius), height);
+                    let inner = inner.min(radius);
+                    // pbrt's area of a ring: in its own space.
+                    let area = std::f64::consts::PI * (radius * radius - inner * inner);
+                    let mesh = tessellate::disk(radius, inner, height);
                     let (positions, triangles, normals) = mesh;
                     return self.triangles(
                         positions,
@@ -285,6 +291,7 @@ impl Builder {
                         p,
                         at,
                         "a disk",
+                        Lights::Whole(area),
                     );
                 }
                 // pbrt turns a shape's outside over for ReverseOrientation
@@ -369,7 +376,7 @@ impl Builder {
     }
 
     /// Adds a triangle mesh of `triangles` (indices in range) over
-    /// `positions`.
+    /// `positions`, made into lights by an area light as `lights` says.
     #[allow(clippy::too_many_arguments)]
     fn triangles(
         &mut self,
@@ -381,6 +388,7 @@ impl Builder {
         p: &Params,
         at: At,
         what: &str,
+        lights: Lights,
     ) -> Result<(), Problem> {
         let n = positions.len();
         for (name, len) in [
@@ -396,19 +404,13 @@ impl Builder {
             }
         }
         p.ignore(&["S", "faceIndices"]);
-        // pbrt makes a light of each triangle and each patch of a bilinear
-        // mesh (two triangles here), of its area as placed (known to lumen
-        // when all are alike), and one of a ring, of its area in its own
-        // space (which its triangles keep).
-        let (per_light, space) = match what {
-            "a bilinearmesh" => (2, self.state.ctm),
-            "a disk" => (triangles.len().max(1), matrix::IDENTITY),
-            _ => (1, self.state.ctm),
+        let area = match lights {
+            _ if self.state.area_power.is_none() => None,
+            Lights::Each(per_light) => {
+                light_area(&positions, &triangles, per_light, &self.state.ctm)
+            }
+            Lights::Whole(area) => Some(area),
         };
-        let area = self
-            .state
-            .area_power
-            .and_then(|_| light_area(&positions, &triangles, per_light, &space));
         let material = self.surface(p, at, area)?;
         p.finish(
             what,
@@ -480,6 +482,17 @@ fn triples(indices: &[u32], n: usize, at: At) -> Result<Vec<[u32; 3]>, Problem> 
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect())
+}
+
+/// How pbrt divides a shape's triangles into lights (for an area light
+/// given by its `power`, which each light gives off).
+#[derive(Clone, Copy)]
+enum Lights {
+    /// Each run of this many triangles (a triangle, a bilinear patch), of
+    /// its area as placed.
+    Each(usize),
+    /// The whole shape, of this area (a ring's, in its own space).
+    Whole(f64),
 }
 
 /// The area each light of `triangles` over `positions`, placed by `ctm`,
