@@ -30,6 +30,10 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
         "bsdf_spheres/test_textured_diffuse_path.xml",
         "instancing/test_instancing_path.xml",
         "floating_sphere/test_directional_direct.xml",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scripts/peers/flip_normals/flip_normals.xml"
+        ),
     ] {
         let path = data().join(scene);
         let direct = SceneFile::read_with(&path, &spp(4)).unwrap_or_else(|e| panic!("{e}"));
@@ -47,6 +51,45 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
         assert!(a.iter().any(|c| c.max_element() > 0.0), "{scene}: black");
         assert!(a == b, "{scene}: the exported scene renders differently");
     }
+}
+
+#[test]
+fn flip_normals_turns_every_kind_of_shape_inside_out() {
+    // The scene compared with Mitsuba: its floor as it is; a rectangle
+    // light, a sphere, a cylinder, a cube and an OBJ flipped; a rectangle
+    // flipped and mirrored, whose mirror turns its triangles' winding over
+    // where Mitsuba keeps its normal on to_world's image of +z: the two
+    // cancel.
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peers/flip_normals/flip_normals.xml");
+    let file = SceneFile::read_with(&path, &spp(4)).unwrap_or_else(|e| panic!("{e}"));
+    use lumen::scene::desc::ObjectDesc as O;
+    let flips: Vec<(&str, bool)> = file
+        .desc
+        .objects
+        .iter()
+        .map(|o| match o {
+            O::Sphere { flip_normals, .. } => ("sphere", *flip_normals),
+            O::Quad { flip_normals, .. } => ("quad", *flip_normals),
+            O::Cylinder { flip_normals, .. } => ("cylinder", *flip_normals),
+            O::Box { flip_normals, .. } => ("box", *flip_normals),
+            O::Mesh { flip_normals, .. } => ("mesh", *flip_normals),
+            O::Triangles { flip_normals, .. } => ("triangles", *flip_normals),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        flips,
+        [
+            ("triangles", false),
+            ("quad", true),
+            ("sphere", true),
+            ("cylinder", true),
+            ("box", true),
+            ("mesh", true),
+            ("triangles", false),
+        ]
+    );
 }
 
 /// The message reading `text` (as `dir/name`, with `files` beside it)
@@ -155,8 +198,8 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
             vec!["bad.xml:2:", "unknown index of refraction `glas`", "bk7"],
         ),
         (
-            scene("  <shape type=\"cylinder\"><boolean name=\"flip_normals\" value=\"true\"/></shape>"),
-            vec!["bad.xml:2:3", "flip_normals", "--approximate"],
+            scene("  <shape type=\"sphere\"><bsdf type=\"twosided\"><bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf></shape>"),
+            vec!["bad.xml:2:", "two BSDFs", "--approximate"],
         ),
         (
             scene("  <shape type=\"cylinder\"><point name=\"p1\" value=\"0, 0, 0\"/></shape>"),
@@ -233,9 +276,9 @@ fn includes_that_loop_or_leave_the_folder_and_unused_parameters_are_refused() {
 #[test]
 fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     let dir = scratch_dir("mitsuba_scenes_approximate");
-    let flipped = "<boolean name=\"flip_normals\" value=\"true\"/>";
+    let two = "<bsdf type=\"twosided\"><bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf>";
     let text = scene(&format!(
-        "  <shape type=\"sphere\">{flipped}</shape>\n  <shape type=\"cylinder\">{flipped}</shape>"
+        "  <shape type=\"sphere\">{two}</shape>\n  <shape type=\"cylinder\">{two}</shape>"
     ));
     let path = dir.join("s.xml");
     std::fs::write(&path, &text).unwrap();
@@ -248,11 +291,11 @@ fn approximate_renders_what_lumen_lacks_with_a_warning_each() {
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("s.xml:2:3: flip_normals")));
+        .any(|w| w.contains("s.xml:2:") && w.contains("two BSDFs")));
     assert!(file
         .import_warnings
         .iter()
-        .any(|w| w.contains("s.xml:3:3: flip_normals")));
+        .any(|w| w.contains("s.xml:3:") && w.contains("two BSDFs")));
     file.compile(&Overrides::default()).unwrap();
 }
 

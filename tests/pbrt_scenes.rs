@@ -516,27 +516,58 @@ fn a_render_of_a_bad_scene_writes_nothing_and_fails() {
 
 #[test]
 fn a_light_shines_from_the_side_pbrt_gives_it_whatever_the_transform() {
-    // A square facing +z (counter-clockwise seen from +z) shines towards
-    // the camera at +z; mirrored by Scale -1 1 1, it still does in pbrt;
-    // ReverseOrientation turns it away.
+    // A square facing +z (counter-clockwise seen from +z), written out or
+    // in a PLY file, shines towards the camera at +z; mirrored by Scale -1
+    // 1 1, it still does in pbrt; ReverseOrientation turns it away.
     let dir = scratch_dir("pbrt_scenes_sides");
-    let brightness = |before: &str| {
+    std::fs::write(
+        dir.join("square.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n\
+         -1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    let shine = |before: &str, shape: &str| {
         let text = format!(
             "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
              Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
              Sampler \"independent\" \"integer pixelsamples\" 2\nWorldBegin\n{before}\n\
              AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\nMaterial \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n\
-             Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]\n"
+             {shape}\n"
         );
         let file = read_in(&dir, &text, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
         let scene = file.compile(&Overrides::default()).unwrap();
         let image = lumen::render::render(&scene, &|_| {}).0.linear();
         image.iter().map(|c| f64::from(c.x)).sum::<f64>() / image.len() as f64
     };
-    assert!((brightness("") - 1.0).abs() < 1e-6);
-    assert!((brightness("Scale -1 1 1") - 1.0).abs() < 1e-6);
-    assert_eq!(brightness("ReverseOrientation"), 0.0);
-    assert_eq!(brightness("Scale -1 1 1\nReverseOrientation"), 0.0);
+    let mesh = "Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"integer indices\" [ 0 1 2  0 2 3 ]";
+    for shape in [mesh, "Shape \"plymesh\" \"string filename\" \"square.ply\""] {
+        let brightness = |before: &str| shine(before, shape);
+        assert!((brightness("") - 1.0).abs() < 1e-6, "{shape}");
+        assert!((brightness("Scale -1 1 1") - 1.0).abs() < 1e-6, "{shape}");
+        assert_eq!(brightness("ReverseOrientation"), 0.0, "{shape}");
+        assert_eq!(
+            brightness("Scale -1 1 1\nReverseOrientation"),
+            0.0,
+            "{shape}"
+        );
+    }
+    // pbrt's spheres and cylinders (seen from outside, filling the view)
+    // are turned inside out by ReverseOrientation and, as pbrt finds them,
+    // by a transform that mirrors.
+    for shape in [
+        "Shape \"sphere\" \"float radius\" 2",
+        "Rotate 90 1 0 0\nShape \"cylinder\" \"float radius\" 2 \"float zmin\" -2 \"float zmax\" 2",
+    ] {
+        let brightness = |before: &str| shine(before, shape);
+        assert!((brightness("") - 1.0).abs() < 1e-6, "{shape}");
+        assert_eq!(brightness("Scale -1 1 1"), 0.0, "{shape}");
+        assert_eq!(brightness("ReverseOrientation"), 0.0, "{shape}");
+        assert!(
+            (brightness("Scale -1 1 1\nReverseOrientation") - 1.0).abs() < 1e-6,
+            "{shape}"
+        );
+    }
 }
 
 #[test]

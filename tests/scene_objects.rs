@@ -157,6 +157,7 @@ fn expected() -> SceneDesc {
     );
     desc.objects = vec![
         ObjectDesc::Sphere {
+            flip_normals: false,
             center: [0.0; 3],
             radius: 1.0,
             material: "gold".into(),
@@ -185,6 +186,7 @@ fn expected() -> SceneDesc {
             transform: vec![],
         },
         ObjectDesc::Quad {
+            flip_normals: false,
             corner: [-5.0, -1.0, -5.0],
             u: [10.0, 0.0, 0.0],
             v: [0.0, 0.0, 10.0],
@@ -192,6 +194,7 @@ fn expected() -> SceneDesc {
             transform: vec![],
         },
         ObjectDesc::Box {
+            flip_normals: false,
             min: [-0.5; 3],
             max: [0.5; 3],
             material: "grey".into(),
@@ -205,6 +208,7 @@ fn expected() -> SceneDesc {
             ],
         },
         ObjectDesc::Mesh {
+            flip_normals: false,
             file: "tetra.obj".into(),
             material: None,
             smooth: true,
@@ -219,6 +223,7 @@ fn expected() -> SceneDesc {
             ])],
         },
         ObjectDesc::Mesh {
+            flip_normals: false,
             file: "tetra.obj".into(),
             material: Some("gold".into()),
             smooth: false,
@@ -323,6 +328,7 @@ fn every_step_form_reads_alone() {
                 "type = \"sphere\"\ncenter = [0, 0, -2]\nradius = 1\nmaterial = \"m\"".into(),
                 r#""type": "sphere", "center": [0, 0, -2], "radius": 1, "material": "m""#.into(),
                 ObjectDesc::Sphere {
+                    flip_normals: false,
                     center: [0.0, 0.0, -2.0],
                     radius: 1.0,
                     material: "m".into(),
@@ -333,6 +339,7 @@ fn every_step_form_reads_alone() {
                 "type = \"quad\"\ncorner = [0, 0, -2]\nu = [1, 0, 0]\nv = [0, 1, 0]\nmaterial = \"m\"".into(),
                 r#""type": "quad", "corner": [0, 0, -2], "u": [1, 0, 0], "v": [0, 1, 0], "material": "m""#.into(),
                 ObjectDesc::Quad {
+                    flip_normals: false,
                     corner: [0.0, 0.0, -2.0],
                     u: [1.0, 0.0, 0.0],
                     v: [0.0, 1.0, 0.0],
@@ -344,6 +351,7 @@ fn every_step_form_reads_alone() {
                 "type = \"box\"\nmin = [0, 0, -3]\nmax = [1, 1, -2]\nmaterial = \"m\"".into(),
                 r#""type": "box", "min": [0, 0, -3], "max": [1, 1, -2], "material": "m""#.into(),
                 ObjectDesc::Box {
+                    flip_normals: false,
                     min: [0.0, 0.0, -3.0],
                     max: [1.0, 1.0, -2.0],
                     material: "m".into(),
@@ -354,6 +362,7 @@ fn every_step_form_reads_alone() {
                 "type = \"mesh\"\nfile = \"t.obj\"".into(),
                 r#""type": "mesh", "file": "t.obj""#.into(),
                 ObjectDesc::Mesh {
+                    flip_normals: false,
                     file: "t.obj".into(),
                     material: None,
                     smooth: true,

@@ -85,6 +85,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
     desc.materials.insert("bunny".into(), diffuse(0.7));
     desc.materials.insert("floor".into(), diffuse(0.5));
     desc.objects.push(ObjectDesc::Quad {
+        flip_normals: false,
         corner: [-30.0, 0.0, -30.0],
         u: [0.0, 0.0, 60.0],
         v: [60.0, 0.0, 0.0],
@@ -92,6 +93,7 @@ pub fn bunny_scene(file: &str) -> SceneDesc {
         transform: Vec::new(),
     });
     desc.objects.push(ObjectDesc::Mesh {
+        flip_normals: false,
         file: file.into(),
         material: Some("bunny".into()),
         smooth: false,
@@ -127,6 +129,7 @@ pub fn bunny_field(file: &str, n: usize) -> SceneDesc {
     for k in 0..n {
         let (i, j) = ((k % side) as f64, (k / side) as f64);
         desc.objects.push(ObjectDesc::Mesh {
+            flip_normals: false,
             file: file.into(),
             material: Some("bunny".into()),
             smooth: false,
@@ -339,6 +342,7 @@ pub fn sphere_field(n: usize) -> SceneDesc {
                 15
             };
             desc.objects.push(ObjectDesc::Sphere {
+                flip_normals: false,
                 center,
                 radius: 0.2,
                 material: palette[k.min(15)].0.clone(),
@@ -455,6 +459,7 @@ mod tests {
         assert!((film.pixel(8, 4) - sky).abs().max_element() < 0.02);
 
         desc.objects.push(ObjectDesc::Sphere {
+            flip_normals: false,
             center: [0.0, 0.0, 0.0],
             radius: 2.0,
             material: "big-diffuse".to_string(),

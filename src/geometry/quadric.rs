@@ -40,6 +40,8 @@ pub struct Quadric {
     to_world: [[f32; 4]; 3],
     /// The world box.
     bounds: Aabb,
+    /// Whether its outside is turned in ([`Quadric::turned`]).
+    inward: bool,
 }
 
 /// What a hit on a quadric gives its record, in the world.
@@ -87,6 +89,16 @@ impl Quadric {
             to_object: rows(transform.to_object_matrix()),
             to_world: rows(transform.to_world_matrix()),
             bounds,
+            inward: false,
+        }
+    }
+
+    /// The same surface with its outside turned in: a cylinder facing its
+    /// axis, a disk facing the other way.
+    pub fn turned(self) -> Quadric {
+        Quadric {
+            inward: !self.inward,
+            ..self
         }
     }
 
@@ -213,13 +225,15 @@ impl Quadric {
     }
 
     /// The world unit normal of object normal `n`: the inverse transpose,
-    /// which keeps the outside outside under a mirroring transform.
+    /// which keeps the outside outside under a mirroring transform, turned
+    /// in if the shape is.
     fn outward(&self, n: DVec3) -> Vec3 {
         let row = |j: usize| {
             let r = self.to_object[j].map(f64::from);
             DVec3::new(r[0], r[1], r[2])
         };
         let w = row(0) * n.x + row(1) * n.y + row(2) * n.z;
+        let w = if self.inward { -w } else { w };
         Vec3::from(w.normalize().as_vec3())
     }
 

@@ -34,6 +34,8 @@ pub(crate) struct Surface {
     /// Whether hit records on it carry their (u, v) (the inverse
     /// trigonometry is worth paying only for a texture that uses them).
     pub(crate) uv: bool,
+    /// Whether its outside is turned in, towards the centre.
+    pub(crate) inward: bool,
 }
 
 impl Surface {
@@ -44,6 +46,15 @@ impl Surface {
             radius: sphere.radius,
             material,
             uv,
+            inward: false,
+        }
+    }
+
+    /// The same sphere with its outside turned in.
+    pub(crate) fn turned(self) -> Self {
+        Surface {
+            inward: !self.inward,
+            ..self
         }
     }
 }
@@ -52,6 +63,9 @@ impl Surface {
 #[derive(Clone, Debug)]
 pub(crate) struct Mesh {
     pub(crate) data: TriangleMesh,
+    /// Whether its outside is the side from which its triangles run
+    /// clockwise, against the file's winding.
+    pub(crate) flipped: bool,
 }
 
 impl Mesh {
@@ -196,7 +210,11 @@ impl Shapes {
                     point = surface.center + off * (surface.radius / off.length());
                 }
                 let outward = (point - surface.center) * surface.inverse_radius;
-                let (normal, front_face) = face_normal(ray, outward);
+                let (normal, front_face) = if surface.inward {
+                    face_normal(ray, -outward)
+                } else {
+                    face_normal(ray, outward)
+                };
                 // Along u = φ/2π about +y (see `Sphere::uv`).
                 let along_u = Vec3::new(outward.z, 0.0, -outward.x);
                 // Only for textures that use them: the inverse
@@ -384,6 +402,7 @@ fn triangle_record(
         } else {
             large_hit(&tri, ray, t, error_scale, margin)
         };
+    let geometric = if mesh.flipped { -geometric } else { geometric };
     let (normal, front_face) = face_normal(ray, geometric);
     let idx = mesh.data.triangles[k].map(|i| i as usize);
     let shading_normal = match &mesh.data.normals {
@@ -942,7 +961,9 @@ impl World {
             };
         let top = &self.top;
         for s in &top.spheres {
-            ids.top.push(emitter(s.material).map_or(NO_LIGHT, |e| {
+            // A sphere that shines inwards is found by the bounces only.
+            let sampled = emitter(s.material).filter(|_| !s.inward);
+            ids.top.push(sampled.map_or(NO_LIGHT, |e| {
                 let shape = LightShape::Sphere {
                     center: s.center,
                     radius: s.radius,
@@ -986,8 +1007,15 @@ impl World {
             for k in 0..mesh.data.triangles.len() {
                 ids.top
                     .push(emitter(mesh.material(k)).map_or(NO_LIGHT, |e| {
-                        let vertices = mesh.triangle(k).vertices;
-                        let uvs = corner_uvs(mesh, k);
+                        let [a, b, c] = mesh.triangle(k).vertices;
+                        let [p, q, r] = corner_uvs(mesh, k);
+                        // A light's outside is the side from which its
+                        // corners run counter-clockwise.
+                        let (vertices, uvs) = if mesh.flipped {
+                            ([a, c, b], [p, r, q])
+                        } else {
+                            ([a, b, c], [p, q, r])
+                        };
                         add(LightShape::Triangle { vertices }, e, uvs, &mut lights)
                     }));
             }
@@ -1018,7 +1046,12 @@ impl World {
                     let [p, q, r] = corner_uvs(mesh, k);
                     // Keep the outward side the hit record's: a mirroring
                     // transform reverses the corners' order.
-                    let outward = transform.normal(tri.area_normal());
+                    let area_normal = if mesh.flipped {
+                        -tri.area_normal()
+                    } else {
+                        tri.area_normal()
+                    };
+                    let outward = transform.normal(area_normal);
                     let (vertices, uvs) = if (b - a).cross(c - a).dot(outward) < 0.0 {
                         ([a, c, b], [p, r, q])
                     } else {

@@ -71,6 +71,7 @@ pub fn furnace_desc(
         textures: Default::default(),
         materials: [("m".to_string(), material)].into_iter().collect(),
         objects: vec![ObjectDesc::Sphere {
+            flip_normals: false,
             center: FURNACE_CENTER,
             radius: FURNACE_RADIUS,
             material: "m".into(),

@@ -167,6 +167,7 @@ impl Builder {
 
     fn sphere(mut self, center: Triple, radius: f64, material: &str) -> Self {
         self.desc.objects.push(ObjectDesc::Sphere {
+            flip_normals: false,
             center,
             radius,
             material: material.to_string(),
@@ -184,6 +185,7 @@ impl Builder {
         motion: Triple,
     ) -> Self {
         self.desc.objects.push(ObjectDesc::Sphere {
+            flip_normals: false,
             center,
             radius,
             material: material.to_string(),
@@ -194,6 +196,7 @@ impl Builder {
 
     fn quad(mut self, corner: Triple, u: Triple, v: Triple, material: &str) -> Self {
         self.desc.objects.push(ObjectDesc::Quad {
+            flip_normals: false,
             corner,
             u,
             v,
@@ -207,6 +210,7 @@ impl Builder {
     /// and then moved by `offset` (the books' `rotate_y` and `translate`).
     fn turned_box(mut self, size: Triple, degrees: f64, offset: Triple, material: &str) -> Self {
         self.desc.objects.push(ObjectDesc::Box {
+            flip_normals: false,
             min: [0.0; 3],
             max: size,
             material: material.to_string(),
@@ -877,6 +881,7 @@ fn next_week_final() -> SceneDesc {
             );
             let y1 = 1.0 + 100.0 * rng.next_f64();
             b.desc.objects.push(ObjectDesc::Box {
+                flip_normals: false,
                 min: [x0, 0.0, z0],
                 max: [x0 + 100.0, y1, z0 + 100.0],
                 material: "ground".to_string(),
@@ -925,6 +930,7 @@ fn next_week_final() -> SceneDesc {
     for _ in 0..1000 {
         let center = [0; 3].map(|_| 165.0 * rng.next_f64());
         b.desc.objects.push(ObjectDesc::Sphere {
+            flip_normals: false,
             center,
             radius: 10.0,
             material: "white".to_string(),

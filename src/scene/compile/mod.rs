@@ -387,8 +387,17 @@ pub const MAX_INSTANCES: u64 = 1 << 24;
 /// instances (about 420 bytes measured, with room).
 const BYTES_PER_PLACEMENT: u64 = 512;
 
-/// Which mesh: (file, mesh of the file, smooth).
-type MeshKey = (PathBuf, usize, bool);
+/// How a mesh's surface is taken from its file.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct MeshSurface {
+    /// Its vertex normals interpolated (or every triangle flat).
+    smooth: bool,
+    /// Its outside turned in, against the file's winding.
+    flipped: bool,
+}
+
+/// Which mesh: (file, mesh of the file, how its surface is taken).
+type MeshKey = (PathBuf, usize, MeshSurface);
 
 /// One placement of one mesh of a file.
 struct Placement {
@@ -495,6 +504,7 @@ impl<'a> Objects<'a> {
                 center,
                 radius,
                 material,
+                flip_normals,
                 ..
             } => {
                 finite(format_args!("objects[{i}].center"), center)?;
@@ -529,7 +539,12 @@ impl<'a> Objects<'a> {
                         }
                         let extent = placed.center.abs().max_element().max(placed.radius);
                         placed_within(i, "the sphere", extent)?;
-                        self.top.spheres.push(Surface::new(&placed, m, uv));
+                        let surface = Surface::new(&placed, m, uv);
+                        self.top.spheres.push(if *flip_normals {
+                            surface.turned()
+                        } else {
+                            surface
+                        });
                         self.spheres.push(placed);
                     }
                     None => {
@@ -546,7 +561,12 @@ impl<'a> Objects<'a> {
                         let mut shapes = Shapes::default();
                         // Placed by an instance, whose material may be
                         // another: (u, v) always.
-                        shapes.spheres.push(Surface::new(&sphere, m, true));
+                        let surface = Surface::new(&sphere, m, true);
+                        shapes.spheres.push(if *flip_normals {
+                            surface.turned()
+                        } else {
+                            surface
+                        });
                         let group = Group::new(shapes)
                             .map_err(|e| invalid(format!("objects[{i}]"), e.to_string()))?;
                         self.groups.push(group);
@@ -564,6 +584,7 @@ impl<'a> Objects<'a> {
                 u,
                 v,
                 material,
+                flip_normals,
                 ..
             } => {
                 for (name, value) in [("corner", corner), ("u", u), ("v", v)] {
@@ -587,13 +608,14 @@ impl<'a> Objects<'a> {
                 let m = self.material(i, material)?;
                 let quad =
                     place_quad(i, "the quad", &transform, vec3(*corner), vec3(*u), vec3(*v))?;
-                self.top.quads.push((quad, m));
+                self.top.quads.push((turned(quad, *flip_normals), m));
             }
             ObjectDesc::Disk {
                 center,
                 normal,
                 radius,
                 material,
+                flip_normals,
                 ..
             } => {
                 let field = |name: &str| format!("objects[{i}].{name}");
@@ -606,13 +628,15 @@ impl<'a> Objects<'a> {
                 }
                 let unit = quadric::disk_placement(*center, n.normalize(), radius);
                 let m = self.material(i, material)?;
-                self.place_quadric(i, QuadricForm::Disk, unit, &transform, m)?;
+                let form = (QuadricForm::Disk, *flip_normals);
+                self.place_quadric(i, form, unit, &transform, m)?;
             }
             ObjectDesc::Cylinder {
                 p0,
                 p1,
                 radius,
                 material,
+                flip_normals,
                 ..
             } => {
                 let field = |name: &str| format!("objects[{i}].{name}");
@@ -623,10 +647,15 @@ impl<'a> Objects<'a> {
                     invalid(field("p1"), "must not be p0: the cylinder has no length")
                 })?;
                 let m = self.material(i, material)?;
-                self.place_quadric(i, QuadricForm::Cylinder, unit, &transform, m)?;
+                let form = (QuadricForm::Cylinder, *flip_normals);
+                self.place_quadric(i, form, unit, &transform, m)?;
             }
             ObjectDesc::Box {
-                min, max, material, ..
+                min,
+                max,
+                material,
+                flip_normals,
+                ..
             } => {
                 finite(format_args!("objects[{i}].min"), min)?;
                 finite(format_args!("objects[{i}].max"), max)?;
@@ -647,7 +676,7 @@ impl<'a> Objects<'a> {
                 let m = self.material(i, material)?;
                 for (q, u, v) in box_faces(vec3(*min), vec3(*max)) {
                     let quad = place_quad(i, "the box", &transform, q, u, v)?;
-                    self.top.quads.push((quad, m));
+                    self.top.quads.push((turned(quad, *flip_normals), m));
                 }
             }
             ObjectDesc::Medium {
@@ -693,6 +722,7 @@ impl<'a> Objects<'a> {
                 allow_outside,
                 part,
                 flip_v,
+                flip_normals,
                 ..
             } => {
                 let override_material = material
@@ -709,7 +739,10 @@ impl<'a> Objects<'a> {
                     file,
                     (path, *part),
                     override_material,
-                    *smooth,
+                    MeshSurface {
+                        smooth: *smooth,
+                        flipped: *flip_normals,
+                    },
                     &transform,
                     motion,
                 )?;
@@ -720,6 +753,7 @@ impl<'a> Objects<'a> {
                 normals,
                 uvs,
                 material,
+                flip_normals,
                 ..
             } => {
                 let material = self.material(i, material)?;
@@ -744,13 +778,16 @@ impl<'a> Objects<'a> {
                     },
                 );
                 let label = format!("the triangles of objects[{i}]");
-                let smooth = normals.is_some();
+                let surface = MeshSurface {
+                    smooth: normals.is_some(),
+                    flipped: *flip_normals,
+                };
                 self.place(
                     i,
                     &label,
                     (path, None),
                     Some(material),
-                    smooth,
+                    surface,
                     &transform,
                     motion,
                 )?;
@@ -760,11 +797,12 @@ impl<'a> Objects<'a> {
     }
 
     /// Adds the unit `form` placed by `unit` (a matrix, row by row) and
-    /// then by `transform`, in material `m`: for object `i`.
+    /// then by `transform`, its outside turned in if `inward`, in material
+    /// `m`: for object `i`.
     fn place_quadric(
         &mut self,
         i: usize,
-        form: QuadricForm,
+        (form, inward): (QuadricForm, bool),
         unit: [[f64; 4]; 4],
         transform: &Transform,
         m: u32,
@@ -787,6 +825,7 @@ impl<'a> Objects<'a> {
             )
         })?;
         let quadric = Quadric::new(form, &placed);
+        let quadric = if inward { quadric.turned() } else { quadric };
         let b = quadric.bounds();
         if !(b.min.is_finite() && b.max.is_finite()) {
             return Err(out_of_range(i));
@@ -806,7 +845,7 @@ impl<'a> Objects<'a> {
         file: &str,
         (path, part): (PathBuf, Option<u32>),
         override_material: Option<u32>,
-        smooth: bool,
+        surface: MeshSurface,
         transform: &Transform,
         motion: Vec3,
     ) -> Result<(), SceneError> {
@@ -864,7 +903,7 @@ impl<'a> Objects<'a> {
                         )
                     })?;
             self.placements.push(Placement {
-                key: (path.clone(), *mesh, smooth),
+                key: (path.clone(), *mesh, surface),
                 transform: placed,
                 material: override_material,
                 motion,
@@ -955,7 +994,7 @@ impl<'a> Objects<'a> {
         }
         for key in order {
             let placed = &by_key[key];
-            let (path, mesh_index, smooth) = key;
+            let (path, mesh_index, surface) = key;
             let left = uses
                 .get_mut(&(path.as_path(), *mesh_index))
                 .expect("counted");
@@ -965,7 +1004,7 @@ impl<'a> Objects<'a> {
             // moving one is carried by an instance.
             let still = placed.len() == 1 && placed[0].motion == Vec3::ZERO;
             if let (true, [only]) = (still, placed.as_slice()) {
-                let mesh = self.scene_mesh(path, *mesh_index, only.material, *smooth, last);
+                let mesh = self.scene_mesh(path, *mesh_index, only.material, *surface, last);
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n;
@@ -974,7 +1013,7 @@ impl<'a> Objects<'a> {
             } else {
                 // Stored once with the file's materials; an instance whose
                 // object names a material uses it instead.
-                let mesh = self.scene_mesh(path, *mesh_index, None, *smooth, last);
+                let mesh = self.scene_mesh(path, *mesh_index, None, *surface, last);
                 let n = mesh.data.triangles.len() as u64;
                 self.stats.triangles += n;
                 self.stats.placed_triangles += n * placed.len() as u64;
@@ -1018,9 +1057,10 @@ impl<'a> Objects<'a> {
         path: &Path,
         mesh_index: usize,
         override_material: Option<u32>,
-        smooth: bool,
+        surface: MeshSurface,
         last: bool,
     ) -> Mesh {
+        let smooth = surface.smooth;
         let loaded = self.models.get_mut(path).expect("loaded");
         let source = &mut loaded.model.meshes[mesh_index];
         let source = if last {
@@ -1052,7 +1092,10 @@ impl<'a> Objects<'a> {
             }
         };
         data.material.shrink_to_fit();
-        Mesh { data }
+        Mesh {
+            data,
+            flipped: surface.flipped,
+        }
     }
 }
 
@@ -1252,6 +1295,15 @@ fn place_quad(
     } else {
         quad
     })
+}
+
+/// `quad`, with its outside turned in if `inward`.
+fn turned(quad: Quad, inward: bool) -> Quad {
+    if inward {
+        quad.flipped()
+    } else {
+        quad
+    }
 }
 
 /// The six faces (corner, u, v) of the box from `min` to `max`, each with

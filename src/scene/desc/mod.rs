@@ -646,6 +646,10 @@ pub enum ObjectDesc {
         radius: f64,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -660,6 +664,10 @@ pub enum ObjectDesc {
         v: Triple,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -678,6 +686,10 @@ pub enum ObjectDesc {
         radius: f64,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -695,6 +707,10 @@ pub enum ObjectDesc {
         radius: f64,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -708,6 +724,10 @@ pub enum ObjectDesc {
         max: Triple,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -741,6 +761,10 @@ pub enum ObjectDesc {
         /// where lumen's v runs up it.
         #[serde(default, skip_serializing_if = "is_false")]
         flip_v: bool,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,
@@ -762,6 +786,10 @@ pub enum ObjectDesc {
         uvs: Option<Vec<[f64; 2]>>,
         /// Name of a material in `materials`.
         material: String,
+        /// Turn the outside in: one-sided materials and lights face the
+        /// other way, and a glass's inside becomes its outside.
+        #[serde(default, skip_serializing_if = "is_false")]
+        flip_normals: bool,
         /// Placement, applied to the object in the order written.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         transform: Vec<TransformDesc>,

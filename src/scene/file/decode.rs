@@ -1036,7 +1036,14 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
         name: "sphere",
         kind: ObjectKind::Sphere,
         what: "a sphere",
-        fields: &["type", "center", "radius", "material", "transform"],
+        fields: &[
+            "type",
+            "center",
+            "radius",
+            "material",
+            "flip_normals",
+            "transform",
+        ],
         elsewhere: &[
             ("corner", "quads"),
             ("u", "quads"),
@@ -1051,7 +1058,15 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
         name: "quad",
         kind: ObjectKind::Quad,
         what: "a quad",
-        fields: &["type", "corner", "u", "v", "material", "transform"],
+        fields: &[
+            "type",
+            "corner",
+            "u",
+            "v",
+            "material",
+            "flip_normals",
+            "transform",
+        ],
         elsewhere: &[
             ("center", "spheres"),
             ("radius", "spheres"),
@@ -1071,6 +1086,7 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             "normal",
             "radius",
             "material",
+            "flip_normals",
             "transform",
         ],
         elsewhere: &[
@@ -1086,7 +1102,15 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
         name: "cylinder",
         kind: ObjectKind::Cylinder,
         what: "a cylinder",
-        fields: &["type", "p0", "p1", "radius", "material", "transform"],
+        fields: &[
+            "type",
+            "p0",
+            "p1",
+            "radius",
+            "material",
+            "flip_normals",
+            "transform",
+        ],
         elsewhere: &[
             ("center", "spheres and disks"),
             ("normal", "disks"),
@@ -1100,7 +1124,14 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
         name: "box",
         kind: ObjectKind::Box,
         what: "a box",
-        fields: &["type", "min", "max", "material", "transform"],
+        fields: &[
+            "type",
+            "min",
+            "max",
+            "material",
+            "flip_normals",
+            "transform",
+        ],
         elsewhere: &[
             ("center", "spheres"),
             ("radius", "spheres"),
@@ -1123,6 +1154,7 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             "allow_outside",
             "part",
             "flip_v",
+            "flip_normals",
             "transform",
         ],
         elsewhere: &[
@@ -1146,6 +1178,7 @@ const OBJECTS: &[Kind<ObjectKind>] = &[
             "normals",
             "uvs",
             "material",
+            "flip_normals",
             "transform",
         ],
         elsewhere: &[
@@ -1207,11 +1240,13 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
     let (kind, what, t) = tagged(node, path, "an object", OBJECTS)?;
     let material = || -> Result<String> { Ok(t.require("material", what, string)?.to_string()) };
     let transform = t.optional("transform", transforms)?.unwrap_or_default();
+    let flip_normals = t.optional("flip_normals", boolean)?.unwrap_or(false);
     Ok(match kind {
         ObjectKind::Sphere => ObjectDesc::Sphere {
             center: t.require("center", what, triple)?,
             radius: t.require("radius", what, float)?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Quad => ObjectDesc::Quad {
@@ -1219,6 +1254,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             u: t.require("u", what, triple)?,
             v: t.require("v", what, triple)?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Disk => ObjectDesc::Disk {
@@ -1226,6 +1262,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             normal: t.require("normal", what, triple)?,
             radius: t.require("radius", what, float)?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Cylinder => ObjectDesc::Cylinder {
@@ -1233,12 +1270,14 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
             p1: t.require("p1", what, triple)?,
             radius: t.require("radius", what, float)?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Box => ObjectDesc::Box {
             min: t.require("min", what, triple)?,
             max: t.require("max", what, triple)?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Mesh => ObjectDesc::Mesh {
@@ -1250,6 +1289,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
                 .optional("part", |n, p| integer(n, p, 0, u64::from(u32::MAX)))?
                 .map(|n| n as u32),
             flip_v: t.optional("flip_v", boolean)?.unwrap_or(false),
+            flip_normals,
             transform,
         },
         ObjectKind::Triangles => ObjectDesc::Triangles {
@@ -1260,6 +1300,7 @@ fn object(node: &Node, path: &str) -> Result<ObjectDesc> {
                 list(n, p, |n, p| numbers(n, p, "an array of 2 numbers [u, v]"))
             })?,
             material: material()?,
+            flip_normals,
             transform,
         },
         ObjectKind::Medium => ObjectDesc::Medium {

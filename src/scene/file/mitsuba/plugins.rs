@@ -880,9 +880,6 @@ impl<'d> Convert<'d> {
             "id",
         ];
         let flip = p.boolean("flip_normals", self)? == Some(true);
-        if flip && t != "disk" {
-            self.lacks(e, "flip_normals", "the normals as they are")?;
-        }
         if p.has("interior") || p.has("exterior") {
             return Err(self.fail(e, "media inside or outside shapes are not read yet".into()));
         }
@@ -926,6 +923,7 @@ impl<'d> Convert<'d> {
                     None
                 };
                 ObjectDesc::Mesh {
+                    flip_normals: flip,
                     file,
                     material: Some(material),
                     smooth: !flat,
@@ -942,6 +940,7 @@ impl<'d> Convert<'d> {
                 // Turned so that its (u, v) are Mitsuba's.
                 let turn = crate::scene::file::matrix::z_up_sphere(center);
                 ObjectDesc::Sphere {
+                    flip_normals: flip,
                     center,
                     radius,
                     material,
@@ -959,6 +958,7 @@ impl<'d> Convert<'d> {
                     // keeps a quad's side).
                     let mirror = crate::scene::file::matrix::scaling([1.0, -1.0, 1.0]);
                     ObjectDesc::Quad {
+                        flip_normals: flip,
                         corner: [-1.0, -1.0, 0.0],
                         u: [2.0, 0.0, 0.0],
                         v: [0.0, 2.0, 0.0],
@@ -968,8 +968,11 @@ impl<'d> Convert<'d> {
                 } else {
                     // Two triangles, so that the texture coordinates are
                     // Mitsuba's: (0, 0) at (−1, −1), v down the image
-                    // (lumen's runs up it: 1 − v).
+                    // (lumen's runs up it: 1 − v). Mitsuba's normal is
+                    // to_world's image of +z, which a mirror keeps on its
+                    // side, where it turns the triangles' winding over.
                     ObjectDesc::Triangles {
+                        flip_normals: flip != (transform::det3(&m) < 0.0),
                         positions: vec![
                             [-1.0, -1.0, 0.0],
                             [1.0, -1.0, 0.0],
@@ -985,6 +988,7 @@ impl<'d> Convert<'d> {
                 }
             }
             "cube" => ObjectDesc::Box {
+                flip_normals: flip,
                 min: [-1.0; 3],
                 max: [1.0; 3],
                 material,
@@ -993,18 +997,13 @@ impl<'d> Convert<'d> {
             "disk" => {
                 // Mitsuba's v runs down the image, lumen's up: the disk
                 // turned over in y (v = φ/2π becomes 1 − φ/2π), which
-                // keeps its side; turned over in z as well to flip it,
-                // which together is half a turn about x.
-                let mirror = if flip {
-                    [1.0, -1.0, -1.0]
-                } else {
-                    [1.0, -1.0, 1.0]
-                };
+                // keeps its side.
                 let m = crate::scene::file::matrix::mul(
                     &m,
-                    &crate::scene::file::matrix::scaling(mirror),
+                    &crate::scene::file::matrix::scaling([1.0, -1.0, 1.0]),
                 );
                 ObjectDesc::Disk {
+                    flip_normals: flip,
                     center: [0.0; 3],
                     normal: [0.0, 0.0, 1.0],
                     radius: 1.0,
@@ -1032,6 +1031,7 @@ impl<'d> Convert<'d> {
                 use crate::scene::file::matrix::{mul, scaling, translation};
                 let along = mul(&translation([0.0, 0.0, 1.0]), &scaling([1.0, 1.0, -1.0]));
                 ObjectDesc::Cylinder {
+                    flip_normals: flip,
                     p0: [0.0; 3],
                     p1: [0.0, 0.0, 1.0],
                     radius: 1.0,

@@ -53,17 +53,14 @@ impl Builder {
                 let area = 4.0 * std::f64::consts::PI * radius * radius;
                 let material = self.surface(p, at, Some(area))?;
                 p.finish("a sphere", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
-                if self.state.reverse && self.state.area.is_some() {
-                    self.lacks(
-                        at,
-                        "sphere that shines inwards (ReverseOrientation)",
-                        "one that shines outwards",
-                    )?;
-                }
+                // pbrt turns a sphere's outside in for ReverseOrientation
+                // and for a transform that mirrors; a mirror keeps lumen's.
+                let turned = self.state.reverse != (matrix::det3(&self.state.ctm) < 0.0);
                 // Turned so that its (u, v) are pbrt's.
                 let turn = matrix::z_up_sphere([0.0; 3]);
                 let transform = vec![TransformDesc::Matrix(matrix::mul(&self.state.ctm, &turn))];
                 self.add(ObjectDesc::Sphere {
+                    flip_normals: turned,
                     center: [0.0; 3],
                     radius,
                     material,
@@ -196,17 +193,13 @@ impl Builder {
                     "a plymesh",
                     &["filename", "displacement", "edgelength", "alpha"],
                 )?;
-                // Only a light's side depends on the winding.
+                // pbrt's outside is the file's winding's as written, turned
+                // by ReverseOrientation; lumen's is the winding's as placed,
+                // which a mirroring transform turns.
                 let mirrored = matrix::det3(&self.state.ctm) < 0.0;
-                if self.state.area.is_some() && (self.state.reverse != mirrored) {
-                    self.lacks(
-                        at,
-                        "PLY mesh light turned to its other side (by ReverseOrientation or a mirroring transform)",
-                        "the side its file's winding gives",
-                    )?;
-                }
                 let transform = self.placement();
                 self.add(ObjectDesc::Mesh {
+                    flip_normals: self.state.reverse != mirrored,
                     file,
                     material: Some(material),
                     smooth: true,
@@ -315,6 +308,7 @@ impl Builder {
                         &matrix::scaling([1.0, 1.0, side]),
                     );
                     ObjectDesc::Disk {
+                        flip_normals: false,
                         center: [0.0; 3],
                         normal: [0.0, 0.0, 1.0],
                         radius,
@@ -331,17 +325,11 @@ impl Builder {
                             None,
                         ));
                     }
-                    if turned && self.state.area.is_some() {
-                        self.lacks(
-                            at,
-                            "cylinder light that shines inwards (ReverseOrientation or a mirroring transform)",
-                            "one that shines outwards",
-                        )?;
-                    }
                     let area = 2.0 * std::f64::consts::PI * radius * (z1 - z0).abs();
                     let material = self.surface(p, at, Some(area))?;
                     p.finish("a cylinder", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
                     ObjectDesc::Cylinder {
+                        flip_normals: turned,
                         p0: [0.0, 0.0, z0.min(z1)],
                         p1: [0.0, 0.0, z0.max(z1)],
                         radius,
@@ -451,6 +439,7 @@ impl Builder {
         }
         let transform = self.placement();
         self.add(ObjectDesc::Triangles {
+            flip_normals: false,
             positions,
             indices: triangles,
             normals,
