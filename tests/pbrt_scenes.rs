@@ -675,6 +675,12 @@ fn a_scaled_texture_scales_what_it_shows() {
     let half = render(
         "Texture \"shown\" \"spectrum\" \"scale\" \"texture tex\" \"image\" \"float scale\" 0.5",
     );
+    // Times a float texture: a checkerboard whose one square covers the
+    // floor's (u, v), 0.5 there.
+    let product = render(
+        "Texture \"m\" \"float\" \"checkerboard\" \"float tex1\" 0.5 \"float tex2\" 0.25\n\
+         Texture \"shown\" \"spectrum\" \"scale\" \"texture tex\" \"image\" \"texture scale\" \"m\"",
+    );
     // Pixels wholly on the floor (it fills the middle 14 × 14).
     let inside: Vec<usize> = (0..plain.len())
         .filter(|&i| (2..14).contains(&(i % 16)) && (2..14).contains(&(i / 16)))
@@ -684,12 +690,63 @@ fn a_scaled_texture_scales_what_it_shows() {
         "the floor is seen"
     );
     for i in inside {
-        let (a, b) = (plain[i], half[i]);
+        let (a, b, c) = (plain[i], half[i], product[i]);
         assert!(
             (b * 2.0 - a).abs().max_element() < 1e-5 * a.max_element().max(1.0),
             "{a:?} vs {b:?}"
         );
+        assert!(
+            (c * 2.0 - a).abs().max_element() < 1e-5 * a.max_element().max(1.0),
+            "{a:?} vs {c:?}"
+        );
     }
+}
+
+/// A three-dimensional checkerboard is lumen's checker of cubes in the
+/// world, of the side the transform at its definition scales it to; one
+/// moved or turned is refused (`--approximate`: not moved).
+#[test]
+fn three_dimensional_checkerboards_are_checkers_in_space() {
+    let text = |before: &str| {
+        format!(
+            "WorldBegin\n{before}\nTexture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3 \
+             \"rgb tex1\" [ 0.9 0.1 0.1 ] \"rgb tex2\" [ 0.1 0.1 0.9 ]\n\
+             Material \"diffuse\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n"
+        )
+    };
+    for (before, side) in [("", 1.0), ("Scale 0.25 0.25 0.25", 0.25)] {
+        let d = read("checker3d", &text(before));
+        let ObjectDesc::Sphere { material, .. } = &d.objects[0] else {
+            panic!("{:?}", d.objects[0]);
+        };
+        let MaterialDesc::Diffuse(diffuse) = &d.materials[material] else {
+            panic!("{:?}", d.materials[material]);
+        };
+        let ColorDesc::Texture(name) = &diffuse.albedo else {
+            panic!("{:?}", diffuse.albedo);
+        };
+        assert_eq!(
+            d.textures[name],
+            TextureDesc::Checker {
+                scale: side,
+                even: ColorDesc::Rgb([0.9, 0.1, 0.1]),
+                odd: ColorDesc::Rgb([0.1, 0.1, 0.9]),
+            }
+        );
+    }
+    let dir = scratch_dir("pbrt_scenes_checker3d_moved");
+    let e = read_in(&dir, &text("Translate 0.5 0 0"), &Options::default()).unwrap_err();
+    assert!(
+        e.contains("s.pbrt:3:") && e.contains("moves or turns"),
+        "{e}"
+    );
+    let e = read_in(
+        &dir,
+        &text("").replace("dimension\" 3", "dimension\" 4"),
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.contains("`dimension` is 2 or 3, got 4"), "{e}");
 }
 
 /// A thin dielectric is lumen's thin sheet of its index (pbrt's takes no

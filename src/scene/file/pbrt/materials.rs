@@ -13,6 +13,7 @@ use crate::scene::desc::{
     ColorDesc, DielectricDesc, DiffuseDesc, EncodingDesc, FilterDesc, MaterialDesc, RoughnessDesc,
     ScalarDesc, TextureDesc, WrapDesc,
 };
+use crate::scene::file::matrix;
 
 /// A texture as lumen has it.
 #[derive(Clone, Debug, PartialEq)]
@@ -727,9 +728,19 @@ impl Builder {
                     (Tex::Named(t), Tex::Constant(c)) | (Tex::Constant(c), Tex::Named(t)) => {
                         self.scaled(t, c)
                     }
-                    (t, _) => {
-                        self.lacks(at, "product of a texture and another", "the first texture")?;
-                        t
+                    // s·t as a blend from black to t by s (which lumen does
+                    // not clamp).
+                    (t, Tex::Named(s)) => {
+                        let lumen = self.name("product");
+                        self.desc.textures.insert(
+                            lumen.clone(),
+                            TextureDesc::Mix {
+                                first: ColorDesc::Rgb([0.0; 3]),
+                                second: t.into(),
+                                amount: ScalarDesc::Texture(s),
+                            },
+                        );
+                        Tex::Named(lumen)
                     }
                 }
             }
@@ -798,11 +809,32 @@ impl Builder {
                     }
                 }
             }
+            // In three dimensions: cubes of side 1 in the space the
+            // transform of the texture's definition places, which lumen's
+            // checker draws in the world, scaled.
+            "checkerboard" if p.int("dimension")? == Some(3) => {
+                let even = value(self, "tex1", 1.0)?.into();
+                let odd = value(self, "tex2", 0.0)?.into();
+                p.finish("a checkerboard texture", &["tex1", "tex2", "dimension"])?;
+                let Some(side) = uniform_scale(&self.state.ctm) else {
+                    self.lacks(
+                        at,
+                        "three-dimensional `checkerboard` placed by a transform that moves or turns it",
+                        "its cubes in the world, of the transform's size",
+                    )?;
+                    let side = matrix::det3(&self.state.ctm).abs().cbrt();
+                    let side = if side.is_normal() { side } else { 1.0 };
+                    return self.checker(name, float, side, even, odd);
+                };
+                return self.checker(name, float, side, even, odd);
+            }
             "checkerboard" => {
-                let first = value(self, "tex1", 1.0)?;
-                p.ignore_all();
-                self.lacks(at, "three-dimensional `checkerboard` texture", "its `tex1`")?;
-                first
+                let d = p.int("dimension")?.unwrap_or(2);
+                return Err((
+                    at,
+                    format!("a checkerboard's `dimension` is 2 or 3, got {d}"),
+                    None,
+                ));
             }
             other => {
                 p.ignore_all();
@@ -834,6 +866,31 @@ impl Builder {
             }
         };
         self.textures.insert((name.to_string(), float), tex);
+        Ok(())
+    }
+
+    /// Texture `name` (a float texture if `float`): lumen's checker of
+    /// cubes of side `side` in the world, `even` where the sum of the
+    /// cubes' integer coordinates is even.
+    fn checker(
+        &mut self,
+        name: &str,
+        float: bool,
+        side: f64,
+        even: ColorDesc,
+        odd: ColorDesc,
+    ) -> Result<(), Problem> {
+        let lumen = self.name("checker");
+        self.desc.textures.insert(
+            lumen.clone(),
+            TextureDesc::Checker {
+                scale: side,
+                even,
+                odd,
+            },
+        );
+        self.textures
+            .insert((name.to_string(), float), Tex::Named(lumen));
         Ok(())
     }
 
@@ -898,4 +955,12 @@ pub(super) fn image(
         uv_rotation: None,
         uv_scale: (!identity).then_some([su, sv]),
     }
+}
+
+/// The factor s of a transform that is s times the identity (no turn, no
+/// move), if it is one.
+fn uniform_scale(m: &matrix::Mat4) -> Option<f64> {
+    let s = m[0][0];
+    let uniform = (0..3).all(|r| (0..4).all(|c| m[r][c] == if r == c { s } else { 0.0 }));
+    (uniform && s > 0.0 && s.is_finite()).then_some(s)
 }
