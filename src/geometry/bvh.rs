@@ -808,6 +808,7 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
                 self.closest = nearest.min_lane();
                 let at = R::bits(hit & nearest.eq(R::splat(self.closest)));
                 self.best = index[at.trailing_zeros() as usize];
+                self.sub = 0;
                 return true;
             }
             return false;
@@ -820,8 +821,9 @@ impl<Q: Query, const SPHERES: bool> SingleRay<Q, SPHERES> {
         let t_best = t.min_lane();
         let equal = R::bits(t.eq(R::splat(t_best)));
         if let Some((t, index)) = finish(t_best, equal, index, self.closest, self.best) {
-            self.closest = t;
-            self.best = index;
+            // A packet's primitive has no sub-item: what a farther
+            // instance left there goes.
+            (self.closest, self.best, self.sub) = (t, index, 0);
         }
         false
     }
@@ -1364,7 +1366,7 @@ impl<P: PrimitiveSet + ?Sized> Collapse<'_, P> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::{Quad, Sphere, Triangle};
     use crate::math::Vec3;
@@ -1573,6 +1575,63 @@ mod tests {
         assert!(
             hits > 15_000,
             "only {hits} hits: the test exercises too little"
+        );
+    }
+
+    /// 600 shapes of every kind among 30 instances of a tree of 40
+    /// triangles, and the index of the first instance among its items.
+    pub(in crate::geometry) fn shapes_among_instances(rng: &mut Rng) -> (Bvh, usize) {
+        let mut prims = random_mixed(rng, 600, 20.0);
+        let triangles: Vec<Primitive> = (0..40)
+            .map(|_| {
+                let c = point(rng, 3.0);
+                Primitive::Triangle(Triangle::new(c, c + point(rng, 2.0), c + point(rng, 2.0)))
+            })
+            .collect();
+        let group = std::sync::Arc::new(Bvh::new(&triangles));
+        let instances: Vec<Instance> = (0..30)
+            .map(|_| {
+                let at = point(rng, 20.0).to_array().map(f64::from);
+                let steps = [crate::geometry::transform::TransformStep::Translate(at)];
+                let placed =
+                    crate::geometry::transform::Transform::from_steps(&steps).expect("a move");
+                Instance::new(placed, group.clone())
+            })
+            .collect();
+        let first_instance = prims.len();
+        for (index, instance) in instances.iter().enumerate() {
+            prims.push(Primitive::Instance {
+                bounds: instance.bounds(),
+                index: index as u32,
+            });
+        }
+        (Bvh::with_instances(&prims, instances), first_instance)
+    }
+
+    #[test]
+    fn a_hit_outside_instances_has_no_sub_item() {
+        // A nearer shape found after a farther instance (whose box the ray
+        // entered first) must not keep the instance's sub-item.
+        let mut rng = Rng::new(41);
+        let (bvh, first_instance) = shapes_among_instances(&mut rng);
+        let (mut in_instances, mut outside) = (0, 0);
+        for _ in 0..20_000 {
+            let origin = point(&mut rng, 30.0);
+            let ray = Ray::new(origin, (point(&mut rng, 10.0) - origin).normalize());
+            let interval = Interval::new(0.001, f32::INFINITY);
+            let hits = [bvh.hit(&ray, interval), bvh.any_hit(&ray, interval)];
+            for hit in hits.into_iter().flatten() {
+                if (hit.index as usize) < first_instance {
+                    assert_eq!(hit.sub, 0, "a shape's hit with a sub-item: {hit:?}");
+                    outside += 1;
+                } else {
+                    in_instances += usize::from(hit.sub != 0);
+                }
+            }
+        }
+        assert!(
+            outside > 5_000 && in_instances > 500,
+            "{outside} and {in_instances} hits"
         );
     }
 

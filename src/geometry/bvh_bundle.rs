@@ -177,14 +177,14 @@ impl Bvh {
             if let Nodes::Four(nodes) = self.nodes() {
                 self.traverse(nodes, &mut query);
             }
-            (query.closest, query.best, query.sub)
+            (query.closest, query.best, query.sub_of())
         } else {
             let mut query = BundleRays::<false>::new(self, rays, reference, interval);
             match self.nodes() {
                 Nodes::Four(nodes) => self.traverse(nodes, &mut query),
                 Nodes::Eight(nodes) => self.traverse(nodes, &mut query),
             }
-            (query.closest, query.best, query.sub)
+            (query.closest, query.best, query.sub_of())
         };
         let mut hits = [None; LANES];
         for lane in 0..rays.len {
@@ -229,11 +229,27 @@ struct BundleRays<'a, const SPHERES: bool> {
     /// they never enter a box or accept a primitive.
     closest: Lanes,
     best: [u32; LANES],
-    /// Per lane, the primitive inside the instance `best`, if it is one.
+    /// Per lane, the instance the last hit inside an instance was on, and
+    /// the primitive inside it: `best`'s sub-item when `best` is that
+    /// instance, none otherwise (kept apart so that the packets' hot
+    /// loop need not clear it).
+    sub_of: [u32; LANES],
     sub: [u32; LANES],
 }
 
 impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
+    /// Per lane, the sub-item of the best hit (0 for a hit outside
+    /// instances).
+    fn sub_of(&self) -> [u32; LANES] {
+        std::array::from_fn(|l| {
+            if self.sub_of[l] == self.best[l] {
+                self.sub[l]
+            } else {
+                0
+            }
+        })
+    }
+
     #[inline(always)]
     fn new(bvh: &Bvh, rays: &'a RayBundle, reference: &Ray, interval: Interval) -> Self {
         let ref_inv = reference.direction.recip();
@@ -299,6 +315,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             avx2: bvh.avx2(),
             closest,
             best: [0; LANES],
+            sub_of: [NO_CHILD; LANES],
             sub: [0; LANES],
         }
     }
@@ -484,7 +501,8 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
                 let instance = &bvh.instances()[p.instance[s] as usize];
                 if let Some((t, sub)) = instance.hit(&ray, self.t_min, self.closest[l]) {
                     if comes_before((t, index), (self.closest[l], self.best[l])) {
-                        (self.closest[l], self.best[l], self.sub[l]) = (t, index, sub);
+                        (self.closest[l], self.best[l]) = (t, index);
+                        (self.sub_of[l], self.sub[l]) = (index, sub);
                     }
                 }
             }
@@ -501,7 +519,7 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
             let ray = self.rays.ray(l);
             for (t, index) in p.hits(&ray, self.t_min) {
                 if comes_before((t, index), (self.closest[l], self.best[l])) {
-                    (self.closest[l], self.best[l], self.sub[l]) = (t, index, 0);
+                    (self.closest[l], self.best[l]) = (t, index);
                 }
             }
         }
@@ -777,6 +795,36 @@ mod tests {
     #[test]
     fn bundles_over_mixed_kinds_find_exactly_what_single_rays_find() {
         bundles_agree_with_single_rays(true);
+    }
+
+    #[test]
+    fn bundles_among_instances_find_what_single_rays_find_with_their_sub_items() {
+        let mut rng = Rng::new(43);
+        let (bvh, _) = crate::geometry::bvh::tests::shapes_among_instances(&mut rng);
+        let interval = Interval::new(0.001, f32::INFINITY);
+        let key = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.index, h.sub));
+        let mut hits = 0;
+        for case in 0..3000 {
+            let n = 1 + case % LANES;
+            let origin = Vec3::new(
+                rng.range_f32(-30.0, 30.0),
+                rng.range_f32(-30.0, 30.0),
+                rng.range_f32(-30.0, 30.0),
+            );
+            let toward = Vec3::new(rng.range_f32(-5.0, 5.0), 0.0, rng.range_f32(-5.0, 5.0));
+            let reference = Ray::new(origin, (toward - origin).normalize());
+            let rays = bundle_rays(&mut rng, n, origin, toward, case % 2 == 0);
+            let got = bvh.hit_bundle(&RayBundle::new(&rays), &reference, interval);
+            for (lane, ray) in rays.iter().enumerate() {
+                let expected = bvh.hit(ray, interval);
+                assert_eq!(key(got[lane]), key(expected), "case {case}, lane {lane}");
+                hits += usize::from(expected.is_some());
+            }
+        }
+        assert!(
+            hits > 3000,
+            "only {hits} hits: the test exercises too little"
+        );
     }
 
     /// 400 spheres on a ground sphere, or (`mixed`) 200 of them among a
