@@ -702,6 +702,57 @@ fn a_scaled_texture_scales_what_it_shows() {
     }
 }
 
+/// `Attribute` sets default parameters for the directives of its kind
+/// until the scope it was written in ends; a directive's own parameters
+/// win, and a default one does not read is not refused.
+#[test]
+fn attributes_set_default_parameters_within_their_scope() {
+    let d = read(
+        "attributes",
+        "WorldBegin\nAttributeBegin\n\
+         Attribute \"shape\" \"float radius\" 0.25\n\
+         Attribute \"material\" \"rgb reflectance\" [ 0.1 0.2 0.3 ]\n\
+         Attribute \"light\" \"rgb L\" [ 2 3 4 ]\n\
+         Material \"diffuse\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\n\
+         Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ]\n\
+         AreaLightSource \"diffuse\"\nShape \"sphere\"\n\
+         AttributeEnd\nShape \"sphere\"\n",
+    );
+    let radius = |i: usize| match &d.objects[i] {
+        ObjectDesc::Sphere { radius, .. } => *radius,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        [0, 1, 3, 4].map(radius),
+        [0.25, 2.0, 0.25, 1.0],
+        "{:?}",
+        d.objects
+    );
+    let ObjectDesc::Sphere { material, .. } = &d.objects[0] else {
+        unreachable!()
+    };
+    let MaterialDesc::Diffuse(diffuse) = &d.materials[material] else {
+        panic!("{:?}", d.materials[material]);
+    };
+    assert_eq!(diffuse.albedo, ColorDesc::Rgb([0.1, 0.2, 0.3]));
+    let (_, light) = glow(&d, 3);
+    assert!(close(light, [2.0, 3.0, 4.0]), "{light:?}");
+
+    let dir = scratch_dir("pbrt_scenes_attributes_bad");
+    let e = read_in(
+        &dir,
+        "WorldBegin\nAttribute \"shapes\" \"float radius\" 1\n",
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("s.pbrt:2:")
+            && e.contains("not `shapes`")
+            && e.contains("did you mean `shape`?"),
+        "{e}"
+    );
+}
+
 /// A three-dimensional checkerboard is lumen's checker of cubes in the
 /// world, of the side the transform at its definition scales it to; one
 /// moved or turned is refused (`--approximate`: not moved).

@@ -17,7 +17,7 @@ pub enum Values {
 }
 
 /// One parameter as written.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Param {
     /// Its type as written ("float", "rgb", "point3", …).
     pub ty: String,
@@ -331,6 +331,20 @@ impl Params {
             ),
             hint,
         ))
+    }
+
+    /// These parameters followed by `defaults` (pbrt's `Attribute`s) that
+    /// they do not set themselves: a directive's own parameters win, and
+    /// a default it does not read is not refused.
+    pub fn with_defaults<'a>(mut self, defaults: impl Iterator<Item = &'a Param>) -> Params {
+        for d in defaults {
+            if !self.list.iter().any(|p| p.name == d.name) {
+                let mut d = d.clone();
+                d.used = Cell::new(true);
+                self.list.push(d);
+            }
+        }
+        self
     }
 
     /// Marks every parameter as taken.

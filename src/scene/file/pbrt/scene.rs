@@ -3,7 +3,7 @@
 //! `WorldBegin`; shapes, lights and instances after it.
 
 use super::lex::At;
-use super::params::{Params, Problem, Spectral};
+use super::params::{Param, Params, Problem, Spectral};
 use super::{spectra, Input};
 use crate::scene::desc::{
     BackgroundDesc, CameraDesc, ColorDesc, DirectionalLightDesc, EncodingDesc, IntegratorDesc,
@@ -59,6 +59,9 @@ const DIRECTIVES: &[&str] = &[
     "WorldEnd",
 ];
 
+/// The kinds of directive `Attribute` sets default parameters for.
+const ATTRIBUTE_TARGETS: &[&str] = &["shape", "light", "material", "medium", "texture"];
+
 /// What `AttributeBegin` saves and `AttributeEnd` restores.
 #[derive(Clone, Debug)]
 pub(super) struct State {
@@ -80,6 +83,10 @@ pub(super) struct State {
     /// Transforms apply at the shutter's open (`ActiveTransform
     /// StartTime` or `All`).
     pub start: bool,
+    /// Default parameters `Attribute` set, in the order written, each with
+    /// the kind of directive it is for: "shape", "light", "material",
+    /// "medium" or "texture".
+    pub attributes: Vec<(&'static str, Param)>,
 }
 
 /// The camera as the `Camera` directive gave it.
@@ -138,6 +145,13 @@ fn rgb_of(s: &Spectral, at: At) -> Result<[f64; 3], Problem> {
 }
 
 impl Builder {
+    /// A directive's parameters `p`, with the defaults `Attribute` set for
+    /// `target` after them.
+    fn defaults(&self, target: &str, p: Params) -> Params {
+        let set = self.state.attributes.iter().filter(|(t, _)| *t == target);
+        p.with_defaults(set.map(|(_, param)| param))
+    }
+
     pub fn new(approximate: bool) -> Builder {
         let mut desc = SceneDesc::default();
         // pbrt's defaults, where they are not lumen's.
@@ -162,6 +176,7 @@ impl Builder {
                 area: None,
                 area_power: None,
                 start: true,
+                attributes: Vec::new(),
             },
             stack: Vec::new(),
             coordinate_systems: HashMap::new(),
@@ -423,26 +438,35 @@ impl Builder {
                 }
             }
             "Attribute" => {
-                let (_, tat) = input.string(at)?;
-                input.params(at)?.ignore_all();
-                self.lacks(
-                    tat,
-                    "default parameters set by Attribute",
-                    "each entity's own parameters",
-                )?;
+                let (target, tat) = input.string(at)?;
+                let Some(&target) = ATTRIBUTE_TARGETS.iter().find(|&&t| t == target) else {
+                    return Err((
+                        tat,
+                        format!(
+                            "Attribute sets defaults for {}, not `{target}`",
+                            ATTRIBUTE_TARGETS.join(", ")
+                        ),
+                        crate::hint::closest(&target, ATTRIBUTE_TARGETS.iter().copied())
+                            .map(|k| format!("did you mean `{k}`?")),
+                    ));
+                };
+                let p = input.params(at)?;
+                self.state
+                    .attributes
+                    .extend(p.list.into_iter().map(|param| (target, param)));
             }
             "Texture" => {
                 self.world_only(name, at)?;
                 let (n, _) = input.string(at)?;
                 let (class, cat) = input.string(at)?;
                 let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
+                let p = self.defaults("texture", input.params(at)?);
                 self.texture(&n, &class, cat, &ty, tat, &p, input)?;
             }
             "Material" => {
                 self.world_only(name, at)?;
                 let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
+                let p = self.defaults("material", input.params(at)?);
                 let (material, interface) = self.material(&ty, tat, &p, input)?;
                 self.state.material = Some(material);
                 self.state.interface = interface;
@@ -450,7 +474,7 @@ impl Builder {
             "MakeNamedMaterial" => {
                 self.world_only(name, at)?;
                 let (n, nat) = input.string(at)?;
-                let p = input.params(at)?;
+                let p = self.defaults("material", input.params(at)?);
                 let (ty, tat) = p
                     .string_of("type", "string")?
                     .map(|(t, a)| (t.to_string(), a))
@@ -482,7 +506,8 @@ impl Builder {
             "LightSource" | "AreaLightSource" | "Shape" => {
                 self.world_only(name, at)?;
                 let (ty, tat) = input.string(at)?;
-                let p = input.params(at)?;
+                let target = if name == "Shape" { "shape" } else { "light" };
+                let p = self.defaults(target, input.params(at)?);
                 match name {
                     "LightSource" => self.light(&ty, tat, &p, input)?,
                     "AreaLightSource" => self.area_light(&ty, tat, &p, input)?,
