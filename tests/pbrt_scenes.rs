@@ -753,6 +753,69 @@ fn attributes_set_default_parameters_within_their_scope() {
     );
 }
 
+/// A spectrum may be a file of wavelength–value pairs (pbrt's `.spd`):
+/// read as the same pairs written in the scene; a malformed one is refused
+/// with the file and line.
+#[test]
+fn spectrum_files_read_as_their_samples() {
+    let dir = scratch_dir("pbrt_scenes_spd");
+    let pairs = "400 0.2 500 0.6 600 0.4 700 0.3";
+    std::fs::write(
+        dir.join("paint.spd"),
+        "# a paint\n400 0.2\n500 0.6 # peak\n600 0.4\n700 0.3\n",
+    )
+    .unwrap();
+    let scene = |value: &str| {
+        format!(
+            "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" {value}\nShape \"sphere\"\n\
+             AttributeBegin\nAreaLightSource \"diffuse\" \"spectrum L\" {value}\nShape \"sphere\"\nAttributeEnd\n"
+        )
+    };
+    let from_file = read_in(&dir, &scene("\"paint.spd\""), &Options::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .desc;
+    let written = read_in(&dir, &scene(&format!("[ {pairs} ]")), &Options::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .desc;
+    assert_eq!(from_file.materials, written.materials);
+    let ObjectDesc::Sphere { material, .. } = &from_file.objects[0] else {
+        panic!("{:?}", from_file.objects[0]);
+    };
+    let MaterialDesc::Diffuse(paint) = &from_file.materials[material] else {
+        panic!("{:?}", from_file.materials[material]);
+    };
+    let ColorDesc::Rgb(c) = paint.albedo else {
+        panic!("{:?}", paint.albedo)
+    };
+    assert!(c[1] > c[0] && c[1] > c[2], "green-yellow paint: {c:?}");
+
+    for (text, says) in [
+        ("400 0.2\n500\n", "pairs of a wavelength and a value"),
+        (
+            "400 0.2\n500 x\n",
+            "paint.spd:2: `x` is not a finite number",
+        ),
+        ("500 0.2\n400 0.3\n", "its wavelengths must increase"),
+    ] {
+        std::fs::write(dir.join("paint.spd"), text).unwrap();
+        let e = read_in(&dir, &scene("\"paint.spd\""), &Options::default()).unwrap_err();
+        assert!(e.contains("s.pbrt:2:") && e.contains(says), "{e}");
+    }
+    let outside = format!("lumen-outside-{}.spd", std::process::id());
+    std::fs::write(dir.parent().unwrap().join(&outside), pairs).unwrap();
+    let e = read_in(
+        &dir,
+        &scene(&format!("\"../{outside}\"")),
+        &Options::default(),
+    )
+    .unwrap_err();
+    std::fs::remove_file(dir.parent().unwrap().join(&outside)).unwrap();
+    assert!(
+        e.contains("outside the scene's folder") && e.contains("--allow-outside"),
+        "{e}"
+    );
+}
+
 /// A three-dimensional checkerboard is lumen's checker of cubes in the
 /// world, of the side the transform at its definition scales it to; one
 /// moved or turned is refused (`--approximate`: not moved).

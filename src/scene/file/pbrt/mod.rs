@@ -166,6 +166,56 @@ impl Input {
         }
     }
 
+    /// The wavelength–value pairs of spectrum file `name` (written at
+    /// `at`): numbers separated by white space, `#` starting a comment,
+    /// as pbrt reads them.
+    fn spectrum_file(&self, name: &str, at: At) -> Result<Vec<f64>, Problem> {
+        let path = self.dir.join(name);
+        let fail = |message: String| (at, message, None);
+        let canon = canonical(&path).unwrap_or_else(|| path.clone());
+        if !self.options.allow_outside && !canon.starts_with(&self.root) {
+            return Err(fail(format!(
+                "{name}: lies outside the scene's folder ({}); --allow-outside reads it",
+                self.root.display()
+            )));
+        }
+        let bytes = crate::input::read(&path, crate::input::MAX_SCENE_BYTES)
+            .map_err(|e| fail(format!("{name}: {e}")))?;
+        let text =
+            String::from_utf8(bytes).map_err(|_| fail(format!("{name}: is not UTF-8 text")))?;
+        let mut numbers = Vec::new();
+        for (line, content) in text.lines().enumerate() {
+            let content = content.split('#').next().unwrap_or("");
+            for word in content.split_whitespace() {
+                let x: f64 = word
+                    .parse()
+                    .ok()
+                    .filter(|x: &f64| x.is_finite())
+                    .ok_or_else(|| {
+                        fail(format!(
+                            "{name}:{}: `{word}` is not a finite number",
+                            line + 1
+                        ))
+                    })?;
+                numbers.push(x);
+            }
+        }
+        if numbers.len() < 4 || numbers.len() % 2 != 0 {
+            return Err(fail(format!(
+                "{name}: a spectrum file holds pairs of a wavelength and a value, at least two; it holds {} numbers",
+                numbers.len()
+            )));
+        }
+        if numbers
+            .chunks_exact(2)
+            .zip(numbers.chunks_exact(2).skip(1))
+            .any(|(a, b)| b[0] <= a[0])
+        {
+            return Err(fail(format!("{name}: its wavelengths must increase")));
+        }
+        Ok(numbers)
+    }
+
     /// Opens the file at `path` (included at `from`).
     fn open(&mut self, path: &Path, from: Option<At>) -> Result<(), Problem> {
         let name = path.display().to_string();
@@ -344,7 +394,16 @@ impl Input {
                     None,
                 ));
             };
-            let values = self.values(ty, name, dat)?;
+            let mut values = self.values(ty, name, dat)?;
+            // A spectrum named by a file of its samples (pbrt's `.spd`),
+            // where no spectrum of pbrt's has that name.
+            if let ("spectrum", params::Values::Strs(v)) = (ty, &values) {
+                if let [file] = v.as_slice() {
+                    if !spectra::is_named(file) && self.dir.join(file).is_file() {
+                        values = params::Values::Nums(self.spectrum_file(file, dat)?);
+                    }
+                }
+            }
             if params.list.iter().any(|p: &Param| p.name == name) {
                 return Err((dat, format!("`{name}` is given twice"), None));
             }

@@ -41,7 +41,7 @@ pub fn metal(name: &str) -> Result<(&'static str, bool), String> {
         .and_then(|rest| rest.rsplit_once('-'))
         .ok_or_else(|| {
             format!(
-                "`{name}` names no metal: lumen reads pbrt's named metal spectra (metal-Au-eta, metal-Au-k, …), not spectrum files"
+                "`{name}` names no metal and no spectrum file: lumen reads pbrt's named metal spectra (metal-Au-eta, metal-Au-k, …) and files of wavelength–value pairs"
             )
         })?;
     let k = match part {
@@ -122,6 +122,17 @@ pub fn reflectance_samples(pairs: &[f64]) -> Result<[f64; 3], String> {
 /// A named illuminant's colour at luminance 1 (pbrt's D65 is sRGB's white).
 pub fn illuminant(name: &str) -> Option<[f64; 3]> {
     (name == "stdillum-D65").then_some([1.0; 3])
+}
+
+/// Whether `name` is a spectrum pbrt names (rather than a file of one):
+/// a glass, a metal's part, a standard illuminant, or another of pbrt's
+/// named spectra (cameras' responses, `canon_eos_100d_r`).
+pub fn is_named(name: &str) -> bool {
+    glass(name).is_some()
+        || name.starts_with("metal-")
+        || name.starts_with("stdillum-")
+        || name.starts_with("glass-")
+        || !name.contains('.')
 }
 
 #[cfg(test)]
