@@ -141,6 +141,45 @@ fn a_flipped_light_shines_from_its_other_side() {
     }
 }
 
+#[test]
+fn a_mirror_keeps_every_objects_outside() {
+    // Mirrored in x, each kind still shows its light to the camera, and
+    // flipped it does not: a mesh placed once (its triangles moved into
+    // the world, their winding turned over) as a mesh placed twice (one
+    // tree, placed by two instances).
+    let dir = scratch_dir("flip-normals-mirrored");
+    std::fs::write(dir.join("square.obj"), SQUARE_OBJ).unwrap();
+    let centre = |text: &str| {
+        let stats = pixel_stats(&compile_file(&dir, "scene.toml", text));
+        [0, 1, 2].map(|c| stats.region(3..5, 3..5, c).0)
+    };
+    let mirror = "transform = [ { scale = [-1, 1, 1] } ]";
+    let again = "\n[[objects]]\ntype = \"mesh\"\nfile = \"square.obj\"\nmaterial = \"lamp\"\n\
+                 transform = [ { scale = [-1, 1, 1] }, { translate = [0, 0, -50] } ]\n";
+    for (kind, fields, camera) in shapes() {
+        for twice in [false, true] {
+            if twice && kind != "mesh" {
+                continue;
+            }
+            let fields = format!("{fields}\n{mirror}");
+            for flip in [false, true] {
+                let mut text = seen(kind, &fields, flip, camera);
+                if twice {
+                    text += &format!("{again}flip_normals = {flip}\n");
+                    let scene = compile_file(&dir, "scene.toml", &text);
+                    assert_eq!(scene.stats.instances, 2, "instanced");
+                }
+                let want = if flip { [0.0; 3] } else { [3.0, 2.0, 1.0] };
+                assert_eq!(
+                    centre(&text),
+                    want,
+                    "{kind} mirrored, twice {twice}, flipped {flip}"
+                );
+            }
+        }
+    }
+}
+
 /// A floor lit from above by one-sided lights of each flat kind (and a
 /// mesh file placed twice), built facing up and turned down by
 /// `flip_normals` (`flipped`), or built facing down.
@@ -315,6 +354,12 @@ material = "matte"
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 5\nmaterial = \"lamp\"\nflip_normals = true",
     );
     assert!(compile_file(&dir, "scene.toml", &ball).lights.is_empty());
+    // Shining to both sides, it is sampled, as any sphere light.
+    let both = ball.replace(
+        "radiance = [1.5, 1.2, 1]",
+        "radiance = [1.5, 1.2, 1]\ntwo_sided = true",
+    );
+    assert_eq!(compile_file(&dir, "scene.toml", &both).lights.len(), 1);
     let (path, bsdf) = path_and_bsdf(&dir, &ball);
     tiles_agree("inside a flipped sphere of light", &path, &bsdf);
     // Every direction from the (convex) ball sees the sphere of light: a

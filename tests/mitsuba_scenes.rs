@@ -57,9 +57,7 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
 fn flip_normals_turns_every_kind_of_shape_inside_out() {
     // The scene compared with Mitsuba: its floor as it is; a rectangle
     // light, a sphere, a cylinder, a cube and an OBJ flipped; a rectangle
-    // flipped and mirrored, whose mirror turns its triangles' winding over
-    // where Mitsuba keeps its normal on to_world's image of +z: the two
-    // cancel.
+    // flipped and mirrored, whose mirror keeps its side in both.
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peers/flip_normals/flip_normals.xml");
     let file = SceneFile::read_with(&path, &spp(4)).unwrap_or_else(|e| panic!("{e}"));
@@ -87,9 +85,39 @@ fn flip_normals_turns_every_kind_of_shape_inside_out() {
             ("cylinder", true),
             ("box", true),
             ("mesh", true),
-            ("triangles", false),
+            ("triangles", true),
         ]
     );
+}
+
+#[test]
+fn a_mirrored_mesh_turns_over_as_in_mitsuba_but_not_in_an_instance() {
+    // Mitsuba takes a mesh's side from its winding in the world: its own
+    // to_world, mirroring, turns it over (lumen's mirror keeps it, so the
+    // reader flips it), and an instance's does not.
+    let dir = scratch_dir("mitsuba_scenes_mirrored_mesh");
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let mirror = "<transform name=\"to_world\"><scale x=\"-1\"/></transform>";
+    let text = scene(&format!(
+        "  <shape type=\"obj\"><string name=\"filename\" value=\"tri.obj\"/>{mirror}</shape>\n\
+         <shape type=\"obj\"><string name=\"filename\" value=\"tri.obj\"/>{mirror}\
+         <boolean name=\"flip_normals\" value=\"true\"/></shape>\n\
+         <shape type=\"shapegroup\" id=\"g\"><shape type=\"obj\"><string name=\"filename\" value=\"tri.obj\"/></shape></shape>\n\
+         <shape type=\"instance\"><ref id=\"g\"/>{mirror}</shape>"
+    ));
+    std::fs::write(dir.join("m.xml"), &text).unwrap();
+    let file = SceneFile::read_with(&dir.join("m.xml"), &mitsuba::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let flips: Vec<bool> = file
+        .desc
+        .objects
+        .iter()
+        .map(|o| match o {
+            lumen::scene::desc::ObjectDesc::Mesh { flip_normals, .. } => *flip_normals,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(flips, [true, false, false]);
 }
 
 /// The message reading `text` (as `dir/name`, with `files` beside it)

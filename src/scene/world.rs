@@ -961,8 +961,8 @@ impl World {
             };
         let top = &self.top;
         for s in &top.spheres {
-            // A sphere that shines inwards is found by the bounces only.
-            let sampled = emitter(s.material).filter(|_| !s.inward);
+            // A sphere that shines inwards only is found by the bounces.
+            let sampled = emitter(s.material).filter(|(e, _)| !s.inward || e.two_sided);
             ids.top.push(sampled.map_or(NO_LIGHT, |e| {
                 let shape = LightShape::Sphere {
                     center: s.center,

@@ -1289,12 +1289,13 @@ fn place_quad(
         }
     })?;
     // A mirroring transform reverses u × v: the outside stays the outside.
+    Ok(turned(quad, mirrors(transform)))
+}
+
+/// Whether `transform` mirrors (turns a right-handed frame left-handed).
+fn mirrors(transform: &Transform) -> bool {
     let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
-    Ok(if x.cross(y).dot(z) < 0.0 {
-        quad.flipped()
-    } else {
-        quad
-    })
+    x.cross(y).dot(z) < 0.0
 }
 
 /// `quad`, with its outside turned in if `inward`.
@@ -1336,6 +1337,11 @@ fn place_mesh(
         for p in &mut mesh.data.positions {
             *p = transform.point(Vec3::from(*p)).to_array();
         }
+        // A mirror turns the winding over and keeps the outside, as for
+        // every other shape and for an instanced mesh (and as glTF's
+        // nodes of negative determinant do).
+        let mirror = mirrors(transform);
+        mesh.flipped ^= mirror;
         if let Some(normals) = &mut mesh.data.normals {
             for n in normals {
                 *n = transform.normal(Vec3::from(*n)).to_array();
@@ -1343,8 +1349,7 @@ fn place_mesh(
         }
         if let Some(tangents) = &mut mesh.data.tangents {
             // A mirroring transform turns the bitangent (w · n × t) over.
-            let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
-            let side = if x.cross(y).dot(z) < 0.0 { -1.0 } else { 1.0 };
+            let side = if mirror { -1.0 } else { 1.0 };
             for t in tangents {
                 let v = transform.vector(Vec3::new(t[0], t[1], t[2]));
                 *t = [v.x, v.y, v.z, t[3] * side];

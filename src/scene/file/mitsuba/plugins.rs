@@ -880,6 +880,11 @@ impl<'d> Convert<'d> {
             "id",
         ];
         let flip = p.boolean("flip_normals", self)? == Some(true);
+        // A mesh's outside is the side its winding gives in the shape's own
+        // to_world (which a mirror turns, in Mitsuba), where lumen's
+        // meshes keep it under a mirror; an instance's transform keeps it
+        // in both.
+        let winding_turned = flip != (transform::det3(&local) < 0.0);
         if p.has("interior") || p.has("exterior") {
             return Err(self.fail(e, "media inside or outside shapes are not read yet".into()));
         }
@@ -923,7 +928,7 @@ impl<'d> Convert<'d> {
                     None
                 };
                 ObjectDesc::Mesh {
-                    flip_normals: flip,
+                    flip_normals: winding_turned,
                     file,
                     material: Some(material),
                     smooth: !flat,
@@ -970,9 +975,9 @@ impl<'d> Convert<'d> {
                     // Mitsuba's: (0, 0) at (−1, −1), v down the image
                     // (lumen's runs up it: 1 − v). Mitsuba's normal is
                     // to_world's image of +z, which a mirror keeps on its
-                    // side, where it turns the triangles' winding over.
+                    // side, as lumen's winding does.
                     ObjectDesc::Triangles {
-                        flip_normals: flip != (transform::det3(&m) < 0.0),
+                        flip_normals: flip,
                         positions: vec![
                             [-1.0, -1.0, 0.0],
                             [1.0, -1.0, 0.0],
@@ -987,8 +992,9 @@ impl<'d> Convert<'d> {
                     }
                 }
             }
+            // Mitsuba's cube is a mesh.
             "cube" => ObjectDesc::Box {
-                flip_normals: flip,
+                flip_normals: winding_turned,
                 min: [-1.0; 3],
                 max: [1.0; 3],
                 material,

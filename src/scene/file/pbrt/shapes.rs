@@ -194,12 +194,10 @@ impl Builder {
                     &["filename", "displacement", "edgelength", "alpha"],
                 )?;
                 // pbrt's outside is the file's winding's as written, turned
-                // by ReverseOrientation; lumen's is the winding's as placed,
-                // which a mirroring transform turns.
-                let mirrored = matrix::det3(&self.state.ctm) < 0.0;
+                // by ReverseOrientation; a mirror keeps it, as lumen's.
                 let transform = self.placement();
                 self.add(ObjectDesc::Mesh {
-                    flip_normals: self.state.reverse != mirrored,
+                    flip_normals: self.state.reverse,
                     file,
                     material: Some(material),
                     smooth: true,
@@ -407,7 +405,6 @@ impl Builder {
         // The side that shines: with normals, theirs (turned by
         // ReverseOrientation); otherwise the winding's, so turned.
         let reverse = self.state.reverse;
-        let mirrored = matrix::det3(&self.state.ctm) < 0.0;
         let normals = normals.map(|nv| {
             if reverse {
                 nv.iter().map(|v| v.map(|x| -x)).collect::<Vec<_>>()
@@ -431,9 +428,9 @@ impl Builder {
                 }
                 None => reverse,
             };
-            // lumen's side is the winding's as placed, pbrt's as written:
-            // a mirroring transform turns lumen's.
-            if flip != mirrored {
+            // lumen's side is the winding's as written, which a mirror
+            // keeps, as pbrt's.
+            if flip {
                 t.swap(1, 2);
             }
         }

@@ -124,15 +124,11 @@ pub fn illuminant(name: &str) -> Option<[f64; 3]> {
     (name == "stdillum-D65").then_some([1.0; 3])
 }
 
-/// Whether `name` is a spectrum pbrt names (rather than a file of one):
-/// a glass, a metal's part, a standard illuminant, or another of pbrt's
-/// named spectra (cameras' responses, `canon_eos_100d_r`).
+/// Whether `name` is one of the spectra pbrt names that lumen reads (a
+/// glass, a metal's part, a standard illuminant), which a file of the same
+/// name does not replace, as in pbrt.
 pub fn is_named(name: &str) -> bool {
-    glass(name).is_some()
-        || name.starts_with("metal-")
-        || name.starts_with("stdillum-")
-        || name.starts_with("glass-")
-        || !name.contains('.')
+    glass(name).is_some() || metal(name).is_ok() || illuminant(name).is_some()
 }
 
 #[cfg(test)]
