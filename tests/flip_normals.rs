@@ -97,6 +97,13 @@ flip_normals = {flip}
     )
 }
 
+/// The mean colour of the middle 2 × 2 pixels of the 8 × 8 scene `text`
+/// (written to `dir`).
+fn centre(dir: &std::path::Path, text: &str) -> [f64; 3] {
+    let stats = pixel_stats(&compile_file(dir, "scene.toml", text));
+    [0, 1, 2].map(|c| stats.region(3..5, 3..5, c).0)
+}
+
 #[test]
 fn a_flipped_light_shines_from_its_other_side() {
     // Seen from outside at the centre of the image, each kind shows its
@@ -104,10 +111,7 @@ fn a_flipped_light_shines_from_its_other_side() {
     // the cylinder and the box), the other way round, in every pixel.
     let dir = scratch_dir("flip-normals-seen");
     std::fs::write(dir.join("square.obj"), SQUARE_OBJ).unwrap();
-    let centre = |text: &str| {
-        let stats = pixel_stats(&compile_file(&dir, "scene.toml", text));
-        [0, 1, 2].map(|c| stats.region(3..5, 3..5, c).0)
-    };
+    let centre = |text: &str| centre(&dir, text);
     let whole = |text: &str| {
         let stats = pixel_stats(&compile_file(&dir, "scene.toml", text));
         [0, 1, 2].map(|c| stats.image(c).0)
@@ -149,10 +153,7 @@ fn a_mirror_keeps_every_objects_outside() {
     // tree, placed by two instances).
     let dir = scratch_dir("flip-normals-mirrored");
     std::fs::write(dir.join("square.obj"), SQUARE_OBJ).unwrap();
-    let centre = |text: &str| {
-        let stats = pixel_stats(&compile_file(&dir, "scene.toml", text));
-        [0, 1, 2].map(|c| stats.region(3..5, 3..5, c).0)
-    };
+    let centre = |text: &str| centre(&dir, text);
     let mirror = "transform = [ { scale = [-1, 1, 1] } ]";
     let again = "\n[[objects]]\ntype = \"mesh\"\nfile = \"square.obj\"\nmaterial = \"lamp\"\n\
                  transform = [ { scale = [-1, 1, 1] }, { translate = [0, 0, -50] } ]\n";
