@@ -177,14 +177,14 @@ impl Bvh {
             if let Nodes::Four(nodes) = self.nodes() {
                 self.traverse(nodes, &mut query);
             }
-            (query.closest, query.best, query.sub_of())
+            (query.closest, query.best, query.best_subs())
         } else {
             let mut query = BundleRays::<false>::new(self, rays, reference, interval);
             match self.nodes() {
                 Nodes::Four(nodes) => self.traverse(nodes, &mut query),
                 Nodes::Eight(nodes) => self.traverse(nodes, &mut query),
             }
-            (query.closest, query.best, query.sub_of())
+            (query.closest, query.best, query.best_subs())
         };
         let mut hits = [None; LANES];
         for lane in 0..rays.len {
@@ -230,19 +230,19 @@ struct BundleRays<'a, const SPHERES: bool> {
     closest: Lanes,
     best: [u32; LANES],
     /// Per lane, the instance the last hit inside an instance was on, and
-    /// the primitive inside it: `best`'s sub-item when `best` is that
-    /// instance, none otherwise (kept apart so that the packets' hot
+    /// (`sub`) the primitive inside it: `best`'s sub-item when `best` is
+    /// that instance, none otherwise (kept apart so that the packets' hot
     /// loop need not clear it).
-    sub_of: [u32; LANES],
+    sub_owner: [u32; LANES],
     sub: [u32; LANES],
 }
 
 impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
     /// Per lane, the sub-item of the best hit (0 for a hit outside
     /// instances).
-    fn sub_of(&self) -> [u32; LANES] {
+    fn best_subs(&self) -> [u32; LANES] {
         std::array::from_fn(|l| {
-            if self.sub_of[l] == self.best[l] {
+            if self.sub_owner[l] == self.best[l] {
                 self.sub[l]
             } else {
                 0
@@ -315,7 +315,7 @@ impl<'a, const SPHERES: bool> BundleRays<'a, SPHERES> {
             avx2: bvh.avx2(),
             closest,
             best: [0; LANES],
-            sub_of: [NO_CHILD; LANES],
+            sub_owner: [NO_CHILD; LANES],
             sub: [0; LANES],
         }
     }
@@ -502,7 +502,7 @@ impl<const SPHERES: bool> BundleRays<'_, SPHERES> {
                 if let Some((t, sub)) = instance.hit(&ray, self.t_min, self.closest[l]) {
                     if comes_before((t, index), (self.closest[l], self.best[l])) {
                         (self.closest[l], self.best[l]) = (t, index);
-                        (self.sub_of[l], self.sub[l]) = (index, sub);
+                        (self.sub_owner[l], self.sub[l]) = (index, sub);
                     }
                 }
             }
@@ -801,26 +801,7 @@ mod tests {
     fn bundles_among_instances_find_what_single_rays_find_with_their_sub_items() {
         let mut rng = Rng::new(43);
         let (bvh, _) = crate::geometry::bvh::tests::shapes_among_instances(&mut rng);
-        let interval = Interval::new(0.001, f32::INFINITY);
-        let key = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.index, h.sub));
-        let mut hits = 0;
-        for case in 0..3000 {
-            let n = 1 + case % LANES;
-            let origin = Vec3::new(
-                rng.range_f32(-30.0, 30.0),
-                rng.range_f32(-30.0, 30.0),
-                rng.range_f32(-30.0, 30.0),
-            );
-            let toward = Vec3::new(rng.range_f32(-5.0, 5.0), 0.0, rng.range_f32(-5.0, 5.0));
-            let reference = Ray::new(origin, (toward - origin).normalize());
-            let rays = bundle_rays(&mut rng, n, origin, toward, case % 2 == 0);
-            let got = bvh.hit_bundle(&RayBundle::new(&rays), &reference, interval);
-            for (lane, ray) in rays.iter().enumerate() {
-                let expected = bvh.hit(ray, interval);
-                assert_eq!(key(got[lane]), key(expected), "case {case}, lane {lane}");
-                hits += usize::from(expected.is_some());
-            }
-        }
+        let hits = bundles_match_single_rays(&bvh, &mut rng, Vec3::splat(-30.0), Vec3::splat(30.0));
         assert!(
             hits > 3000,
             "only {hits} hits: the test exercises too little"
@@ -994,23 +975,35 @@ mod tests {
         let mut rng = Rng::new(21);
         let prims = primitives(&mut rng, mixed);
         let bvh = Bvh::new(&prims);
+        let (low, high) = (Vec3::new(-15.0, 0.1, -15.0), Vec3::new(15.0, 3.0, 15.0));
+        let hits = bundles_match_single_rays(&bvh, &mut rng, low, high);
+        assert!(
+            hits > 5000,
+            "only {hits} hits: the test exercises too little"
+        );
+    }
+
+    /// 3,000 bundles of 1 to 8 rays from origins in the box `low`–`high`
+    /// (half of them coherent) find in `bvh` what each ray alone finds, to
+    /// the bit and with its sub-item; returns how many rays hit.
+    fn bundles_match_single_rays(bvh: &Bvh, rng: &mut Rng, low: Vec3, high: Vec3) -> usize {
         let interval = Interval::new(0.001, f32::INFINITY);
+        let key = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.index, h.sub));
         let mut hits = 0;
         for case in 0..3000 {
             let n = 1 + case % LANES;
             let origin = Vec3::new(
-                rng.range_f32(-15.0, 15.0),
-                rng.range_f32(0.1, 3.0),
-                rng.range_f32(-15.0, 15.0),
+                rng.range_f32(low.x, high.x),
+                rng.range_f32(low.y, high.y),
+                rng.range_f32(low.z, high.z),
             );
             let toward = Vec3::new(rng.range_f32(-5.0, 5.0), 0.0, rng.range_f32(-5.0, 5.0));
             let reference = Ray::new(origin, (toward - origin).normalize());
-            let rays = bundle_rays(&mut rng, n, origin, toward, case % 2 == 0);
+            let rays = bundle_rays(rng, n, origin, toward, case % 2 == 0);
             let got = bvh.hit_bundle(&RayBundle::new(&rays), &reference, interval);
             for (lane, ray) in rays.iter().enumerate() {
                 let expected = bvh.hit(ray, interval);
-                let bits = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.index));
-                assert_eq!(bits(got[lane]), bits(expected), "case {case}, lane {lane}");
+                assert_eq!(key(got[lane]), key(expected), "case {case}, lane {lane}");
                 hits += usize::from(expected.is_some());
             }
             assert!(
@@ -1018,10 +1011,7 @@ mod tests {
                 "unused lanes report nothing"
             );
         }
-        assert!(
-            hits > 5000,
-            "only {hits} hits: the test exercises too little"
-        );
+        hits
     }
 
     #[test]

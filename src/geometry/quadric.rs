@@ -40,7 +40,7 @@ pub struct Quadric {
     to_world: [[f32; 4]; 3],
     /// The world box.
     bounds: Aabb,
-    /// Whether its outside is turned in ([`Quadric::turned`]).
+    /// Whether its outside is turned in ([`Quadric::facing_in`]).
     inward: bool,
 }
 
@@ -93,13 +93,10 @@ impl Quadric {
         }
     }
 
-    /// The same surface with its outside turned in: a cylinder facing its
-    /// axis, a disk facing the other way.
-    pub fn turned(self) -> Quadric {
-        Quadric {
-            inward: !self.inward,
-            ..self
-        }
+    /// The same surface with its outside turned in if `inward`: a
+    /// cylinder facing its axis, a disk facing the other way.
+    pub fn facing_in(self, inward: bool) -> Quadric {
+        Quadric { inward, ..self }
     }
 
     /// The world box.

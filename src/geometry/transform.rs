@@ -205,6 +205,12 @@ impl Transform {
         self.to_world64 == DAffine3::IDENTITY
     }
 
+    /// Whether it mirrors: turns a right-handed frame left-handed (and a
+    /// triangle's winding over).
+    pub fn mirrors(&self) -> bool {
+        self.to_world64.matrix3.determinant() < 0.0
+    }
+
     /// The transform that applies `self` first and then `next`: matrix
     /// `next · self`. `a.then(&b)` is the transform of the steps of `a`
     /// followed by those of `b`.

@@ -39,22 +39,15 @@ pub(crate) struct Surface {
 }
 
 impl Surface {
-    pub(crate) fn new(sphere: &Sphere, material: u32, uv: bool) -> Self {
+    /// `sphere` in `material`, its outside turned in if `inward`.
+    pub(crate) fn new(sphere: &Sphere, material: u32, uv: bool, inward: bool) -> Self {
         Surface {
             center: sphere.center,
             inverse_radius: 1.0 / sphere.radius,
             radius: sphere.radius,
             material,
             uv,
-            inward: false,
-        }
-    }
-
-    /// The same sphere with its outside turned in.
-    pub(crate) fn turned(self) -> Self {
-        Surface {
-            inward: !self.inward,
-            ..self
+            inward,
         }
     }
 }
@@ -72,6 +65,21 @@ impl Mesh {
     fn triangle(&self, k: usize) -> Triangle {
         let [a, b, c] = self.data.triangles[k].map(|i| Vec3::from(self.data.positions[i as usize]));
         Triangle::new(a, b, c)
+    }
+
+    /// Triangle `k`'s corners and their texture coordinates, in the order
+    /// that runs counter-clockwise seen from its outside (a light's).
+    fn outward_corners(&self, k: usize) -> ([Point3; 3], [[f32; 2]; 3]) {
+        let [a, b, c] = self.triangle(k).vertices;
+        let [p, q, r] = match &self.data.uvs {
+            Some(uvs) => self.data.triangles[k].map(|i| uvs[i as usize]),
+            None => CORNER_UVS,
+        };
+        if self.flipped {
+            ([a, c, b], [p, r, q])
+        } else {
+            ([a, b, c], [p, q, r])
+        }
     }
 
     fn material(&self, k: usize) -> u32 {
@@ -907,14 +915,6 @@ type Emission = (Emissive, Option<u32>);
 /// record's (u, v) are then the barycentrics (b₁, b₂)).
 const CORNER_UVS: [[f32; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 
-/// The texture coordinates at the corners of triangle `k` of `mesh`.
-fn corner_uvs(mesh: &Mesh, k: usize) -> [[f32; 2]; 3] {
-    match &mesh.data.uvs {
-        Some(uvs) => mesh.data.triangles[k].map(|i| uvs[i as usize]),
-        None => CORNER_UVS,
-    }
-}
-
 impl LightIds {
     /// The light that `hit` met, if it met one that can be sampled.
     #[inline]
@@ -1007,15 +1007,7 @@ impl World {
             for k in 0..mesh.data.triangles.len() {
                 ids.top
                     .push(emitter(mesh.material(k)).map_or(NO_LIGHT, |e| {
-                        let [a, b, c] = mesh.triangle(k).vertices;
-                        let [p, q, r] = corner_uvs(mesh, k);
-                        // A light's outside is the side from which its
-                        // corners run counter-clockwise.
-                        let (vertices, uvs) = if mesh.flipped {
-                            ([a, c, b], [p, r, q])
-                        } else {
-                            ([a, b, c], [p, q, r])
-                        };
+                        let (vertices, uvs) = mesh.outward_corners(k);
                         add(LightShape::Triangle { vertices }, e, uvs, &mut lights)
                     }));
             }
@@ -1039,20 +1031,14 @@ impl World {
             }
             ids.instance_first.push(lights.len() as u32);
             let transform = &self.bvh.instances()[i].transform;
+            // Keep the outward side the hit record's: a mirroring transform
+            // reverses the corners' order.
+            let mirrors = transform.mirrors();
             for mesh in meshes {
                 for k in 0..mesh.data.triangles.len() {
-                    let tri = mesh.triangle(k);
-                    let [a, b, c] = tri.vertices.map(|p| transform.point(p));
-                    let [p, q, r] = corner_uvs(mesh, k);
-                    // Keep the outward side the hit record's: a mirroring
-                    // transform reverses the corners' order.
-                    let area_normal = if mesh.flipped {
-                        -tri.area_normal()
-                    } else {
-                        tri.area_normal()
-                    };
-                    let outward = transform.normal(area_normal);
-                    let (vertices, uvs) = if (b - a).cross(c - a).dot(outward) < 0.0 {
+                    let (corners, [p, q, r]) = mesh.outward_corners(k);
+                    let [a, b, c] = corners.map(|p| transform.point(p));
+                    let (vertices, uvs) = if mirrors {
                         ([a, c, b], [p, r, q])
                     } else {
                         ([a, b, c], [p, q, r])

@@ -539,12 +539,9 @@ impl<'a> Objects<'a> {
                         }
                         let extent = placed.center.abs().max_element().max(placed.radius);
                         placed_within(i, "the sphere", extent)?;
-                        let surface = Surface::new(&placed, m, uv);
-                        self.top.spheres.push(if *flip_normals {
-                            surface.turned()
-                        } else {
-                            surface
-                        });
+                        self.top
+                            .spheres
+                            .push(Surface::new(&placed, m, uv, *flip_normals));
                         self.spheres.push(placed);
                     }
                     None => {
@@ -561,12 +558,9 @@ impl<'a> Objects<'a> {
                         let mut shapes = Shapes::default();
                         // Placed by an instance, whose material may be
                         // another: (u, v) always.
-                        let surface = Surface::new(&sphere, m, true);
-                        shapes.spheres.push(if *flip_normals {
-                            surface.turned()
-                        } else {
-                            surface
-                        });
+                        shapes
+                            .spheres
+                            .push(Surface::new(&sphere, m, true, *flip_normals));
                         let group = Group::new(shapes)
                             .map_err(|e| invalid(format!("objects[{i}]"), e.to_string()))?;
                         self.groups.push(group);
@@ -824,8 +818,7 @@ impl<'a> Objects<'a> {
                 format!("flattens {what} or places it beyond the range of f32"),
             )
         })?;
-        let quadric = Quadric::new(form, &placed);
-        let quadric = if inward { quadric.turned() } else { quadric };
+        let quadric = Quadric::new(form, &placed).facing_in(inward);
         let b = quadric.bounds();
         if !(b.min.is_finite() && b.max.is_finite()) {
             return Err(out_of_range(i));
@@ -1289,13 +1282,7 @@ fn place_quad(
         }
     })?;
     // A mirroring transform reverses u × v: the outside stays the outside.
-    Ok(turned(quad, mirrors(transform)))
-}
-
-/// Whether `transform` mirrors (turns a right-handed frame left-handed).
-fn mirrors(transform: &Transform) -> bool {
-    let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| transform.vector(e));
-    x.cross(y).dot(z) < 0.0
+    Ok(turned(quad, transform.mirrors()))
 }
 
 /// `quad`, with its outside turned in if `inward`.
@@ -1340,7 +1327,7 @@ fn place_mesh(
         // A mirror turns the winding over and keeps the outside, as for
         // every other shape and for an instanced mesh (and as glTF's
         // nodes of negative determinant do).
-        let mirror = mirrors(transform);
+        let mirror = transform.mirrors();
         mesh.flipped ^= mirror;
         if let Some(normals) = &mut mesh.data.normals {
             for n in normals {

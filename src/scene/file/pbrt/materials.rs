@@ -816,17 +816,32 @@ impl Builder {
                 let even = value(self, "tex1", 1.0)?.into();
                 let odd = value(self, "tex2", 0.0)?.into();
                 p.finish("a checkerboard texture", &["tex1", "tex2", "dimension"])?;
-                let Some(side) = uniform_scale(&self.state.ctm) else {
-                    self.lacks(
-                        at,
-                        "three-dimensional `checkerboard` placed by a transform that moves or turns it",
-                        "its cubes in the world, of the transform's size",
-                    )?;
-                    let side = matrix::det3(&self.state.ctm).abs().cbrt();
-                    let side = if side.is_normal() { side } else { 1.0 };
-                    return self.checker(name, float, side, even, odd);
+                let side = match uniform_scale(&self.state.ctm) {
+                    Some(side) => side,
+                    None => {
+                        self.lacks(
+                            at,
+                            "three-dimensional `checkerboard` placed by a transform that moves or turns it",
+                            "its cubes in the world, of the transform's size",
+                        )?;
+                        let side = matrix::det3(&self.state.ctm).abs().cbrt();
+                        if side.is_normal() {
+                            side
+                        } else {
+                            1.0
+                        }
+                    }
                 };
-                return self.checker(name, float, side, even, odd);
+                let lumen = self.name("checker");
+                self.desc.textures.insert(
+                    lumen.clone(),
+                    TextureDesc::Checker {
+                        scale: side,
+                        even,
+                        odd,
+                    },
+                );
+                Tex::Named(lumen)
             }
             "checkerboard" => {
                 let d = p.int("dimension")?.unwrap_or(2);
@@ -866,31 +881,6 @@ impl Builder {
             }
         };
         self.textures.insert((name.to_string(), float), tex);
-        Ok(())
-    }
-
-    /// Texture `name` (a float texture if `float`): lumen's checker of
-    /// cubes of side `side` in the world, `even` where the sum of the
-    /// cubes' integer coordinates is even.
-    fn checker(
-        &mut self,
-        name: &str,
-        float: bool,
-        side: f64,
-        even: ColorDesc,
-        odd: ColorDesc,
-    ) -> Result<(), Problem> {
-        let lumen = self.name("checker");
-        self.desc.textures.insert(
-            lumen.clone(),
-            TextureDesc::Checker {
-                scale: side,
-                even,
-                odd,
-            },
-        );
-        self.textures
-            .insert((name.to_string(), float), Tex::Named(lumen));
         Ok(())
     }
 

@@ -173,16 +173,8 @@ impl Input {
         let path = self.dir.join(name);
         let fail = |message: String| (at, message, None);
         let canon = canonical(&path).unwrap_or_else(|| path.clone());
-        if !self.options.allow_outside && !canon.starts_with(&self.root) {
-            return Err(fail(format!(
-                "{name}: lies outside the scene's folder ({}); --allow-outside reads it",
-                self.root.display()
-            )));
-        }
-        let bytes = crate::input::read(&path, crate::input::MAX_SCENE_BYTES)
-            .map_err(|e| fail(format!("{name}: {e}")))?;
-        let text =
-            String::from_utf8(bytes).map_err(|_| fail(format!("{name}: is not UTF-8 text")))?;
+        self.within_folder(&canon, name).map_err(fail)?;
+        let text = read_text(&path, name).map_err(fail)?;
         let mut numbers = Vec::new();
         for (line, content) in text.lines().enumerate() {
             let content = content.split('#').next().unwrap_or("");
@@ -216,6 +208,18 @@ impl Input {
         Ok(numbers)
     }
 
+    /// Refuses file `name` (canonical path `canon`) outside the scene's
+    /// folder unless `--allow-outside` was given.
+    fn within_folder(&self, canon: &Path, name: &str) -> Result<(), String> {
+        if self.options.allow_outside || canon.starts_with(&self.root) {
+            return Ok(());
+        }
+        Err(format!(
+            "{name}: lies outside the scene's folder ({}); --allow-outside reads it",
+            self.root.display()
+        ))
+    }
+
     /// Opens the file at `path` (included at `from`).
     fn open(&mut self, path: &Path, from: Option<At>) -> Result<(), Problem> {
         let name = path.display().to_string();
@@ -243,18 +247,9 @@ impl Input {
                     "includes nest more than {MAX_INCLUDE_DEPTH} deep"
                 )));
             }
-            if !self.options.allow_outside && !canon.starts_with(&self.root) {
-                return Err(fail(format!(
-                    "{name}: lies outside the scene's folder ({}); --allow-outside reads it",
-                    self.root.display()
-                )));
-            }
+            self.within_folder(&canon, &name).map_err(fail)?;
         }
-        let bytes = crate::input::read(path, crate::input::MAX_SCENE_BYTES)
-            .map_err(|e| fail(format!("{name}: {e}")))?;
-        let text =
-            String::from_utf8(bytes).map_err(|_| fail(format!("{name}: is not UTF-8 text")))?;
-        let text: Arc<str> = text.into();
+        let text: Arc<str> = read_text(path, &name).map_err(fail)?.into();
         let index = self.files.len() as u32;
         self.files.push((name, Arc::clone(&text)));
         self.open.push((Lexer::new(text, index), canon));
@@ -468,4 +463,12 @@ impl Input {
         }
         Ok(values.unwrap_or(Values::Nums(Vec::new())))
     }
+}
+
+/// The text of the file at `path` (`name` in messages), at most a scene
+/// file's size.
+fn read_text(path: &Path, name: &str) -> Result<String, String> {
+    let bytes = crate::input::read(path, crate::input::MAX_SCENE_BYTES)
+        .map_err(|e| format!("{name}: {e}"))?;
+    String::from_utf8(bytes).map_err(|_| format!("{name}: is not UTF-8 text"))
 }

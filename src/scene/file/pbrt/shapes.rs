@@ -20,6 +20,13 @@ const SHAPES: &[&str] = &[
 ];
 
 impl Builder {
+    /// Whether pbrt finds a sphere, disk or cylinder placed now with its
+    /// outside turned in: for ReverseOrientation and, separately, for a
+    /// transform that mirrors (a mirror keeps lumen's outside).
+    fn quadric_turned(&self) -> bool {
+        self.state.reverse != (matrix::det3(&self.state.ctm) < 0.0)
+    }
+
     pub(super) fn shape(
         &mut self,
         ty: &str,
@@ -53,9 +60,7 @@ impl Builder {
                 let area = 4.0 * std::f64::consts::PI * radius * radius;
                 let material = self.surface(p, at, Some(area))?;
                 p.finish("a sphere", &["radius", "zmin", "zmax", "phimax", "alpha"])?;
-                // pbrt turns a sphere's outside in for ReverseOrientation
-                // and for a transform that mirrors; a mirror keeps lumen's.
-                let turned = self.state.reverse != (matrix::det3(&self.state.ctm) < 0.0);
+                let turned = self.quadric_turned();
                 // Turned so that its (u, v) are pbrt's.
                 let turn = matrix::z_up_sphere([0.0; 3]);
                 let transform = vec![TransformDesc::Matrix(matrix::mul(&self.state.ctm, &turn))];
@@ -285,11 +290,8 @@ impl Builder {
                         Lights::Whole(area),
                     );
                 }
-                // pbrt turns a shape's outside over for ReverseOrientation
-                // and for a transform that mirrors; lumen keeps the outside
-                // a mirror gives.
                 let ctm = self.state.ctm;
-                let turned = self.state.reverse != (matrix::det3(&ctm) < 0.0);
+                let turned = self.quadric_turned();
                 let object = if ty == "disk" {
                     let height = p.float("height")?.unwrap_or(0.0);
                     let area = std::f64::consts::PI * radius * radius;
@@ -298,15 +300,9 @@ impl Builder {
                         "a disk",
                         &["radius", "height", "innerradius", "phimax", "alpha"],
                     )?;
-                    // Turned over in z about its own plane where pbrt turns
-                    // it.
-                    let side = if turned { -1.0 } else { 1.0 };
-                    let place = matrix::mul(
-                        &matrix::translation([0.0, 0.0, height]),
-                        &matrix::scaling([1.0, 1.0, side]),
-                    );
+                    let place = matrix::translation([0.0, 0.0, height]);
                     ObjectDesc::Disk {
-                        flip_normals: false,
+                        flip_normals: turned,
                         center: [0.0; 3],
                         normal: [0.0, 0.0, 1.0],
                         radius,
