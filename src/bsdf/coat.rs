@@ -111,7 +111,6 @@ fn integrate(d: &Microfacet, mu: f32, eta: f32, what: Scattering) -> f32 {
         INSIDE.get_or_init(|| gauss_legendre(128))
     };
     let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-    let g1_wi = d.g1(wi);
     let mut sum = 0.0f64;
     for (x, wx) in nodes.iter().zip(weights) {
         for (y, wy) in nodes.iter().zip(weights) {
@@ -121,12 +120,6 @@ fn integrate(d: &Microfacet, mu: f32, eta: f32, what: Scattering) -> f32 {
             if !(cos_m > 0.0) {
                 continue;
             }
-            // Beckmann's normals are drawn by D(m) cos θm, not by their
-            // visible density G₁(wi) D(m) (wi·m)/μ.
-            let visible = match d.model {
-                Model::Ggx => 1.0,
-                Model::Beckmann => g1_wi * cos_m / (mu * m.z),
-            };
             let f = fresnel::dielectric(cos_m, eta);
             let value = match what {
                 Scattering::Reflected => {
@@ -142,7 +135,7 @@ fn integrate(d: &Microfacet, mu: f32, eta: f32, what: Scattering) -> f32 {
                     _ => 0.0,
                 },
             };
-            sum += f64::from(value * visible) * wx * wy * 0.25;
+            sum += f64::from(value) * wx * wy * 0.25;
         }
     }
     sum as f32

@@ -53,8 +53,8 @@ impl Conductor {
         };
         let wm = d.sample_wm(wo, u);
         let wi = fresnel::reflect(wo, wm);
-        // A microfacet seen from behind (Beckmann's normals are not drawn
-        // as seen) reflects nothing.
+        // A microfacet seen from behind (drawn so only by rounding, at a
+        // grazing view) reflects nothing.
         if !(wi.z > 0.0 && wo.dot(wm) > 0.0) {
             return None;
         }

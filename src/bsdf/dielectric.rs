@@ -124,8 +124,8 @@ impl ExactDielectric {
         // Sampled as seen from the side `wo` is on.
         let up = if wo.z < 0.0 { -wo } else { wo };
         let wm = d.sample_wm(up, u);
-        // A microfacet seen from behind (Beckmann's normals are not drawn
-        // as seen) scatters nothing.
+        // A microfacet seen from behind (drawn so only by rounding, at a
+        // grazing view) scatters nothing.
         if !(up.dot(wm) > 0.0) {
             return None;
         }

@@ -3,9 +3,12 @@
 //! its neighbours (Smith's G, height-correlated).
 //!
 //! Two distributions, both anisotropic (α along the frame's tangent and
-//! bitangent): Trowbridge–Reitz (GGX), sampled by its visible normals with
-//! the spherical caps of Dupuy & Benyoub (2023); and Beckmann, sampled by
-//! its normals weighted by their cosine. Directions are in the local frame
+//! bitangent), each sampled by its visible normals: Trowbridge–Reitz
+//! (GGX) with the spherical caps of Dupuy & Benyoub (2023); Beckmann by
+//! inverting the distribution of its visible slopes (Heitz & d'Eon 2014,
+//! as Mitsuba samples it), so that a grazing view draws the normals it
+//! sees rather than normals it cannot, whose weights would spike.
+//! Directions are in the local frame
 //! (z along the macro-surface's normal). pbrt-v4's `scattering.h` is the
 //! model.
 
@@ -140,14 +143,11 @@ impl Microfacet {
     }
 
     /// The density with which [`sample_wm`](Self::sample_wm) draws `wm`
-    /// seen from `w` (with `w.z > 0`): for GGX the visible normals
-    /// G₁(w)/cos θ · D(wm) · max(0, w·wm); for Beckmann D(wm) cos θm.
+    /// seen from `w` (with `w.z > 0`): that of the visible normals,
+    /// G₁(w)/cos θ · D(wm) · max(0, w·wm).
     #[inline]
     pub fn pdf(&self, w: Vec3, wm: Vec3) -> f32 {
-        match self.model {
-            Model::Ggx => self.g1(w) / w.z.abs() * self.d(wm) * w.dot(wm).max(0.0),
-            Model::Beckmann => self.d(wm) * wm.z.max(0.0),
-        }
+        self.g1(w) / w.z.abs() * self.d(wm) * w.dot(wm).max(0.0)
     }
 
     /// A microfacet normal seen from `w` (with `w.z > 0`), from `u`
@@ -166,15 +166,106 @@ impl Microfacet {
                 Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z.max(1e-6)).normalize()
             }
             Model::Beckmann => {
-                // Beckmann's slopes are Gaussian, of deviation α/√2 along
-                // each axis: drawn by Box–Muller, their normal's density
-                // is D(wm) cos θm.
-                let r = (-(1.0 - u[1]).ln()).sqrt();
-                let (s, c) = sin_cos_turns(u[0]);
-                Vec3::new(self.alpha_x * r * c, self.alpha_y * r * s, 1.0).normalize()
+                // Stretched to α = 1, the visible slopes along the view's
+                // azimuth and across it are drawn, turned to the view's
+                // azimuth, and stretched back.
+                let ws = Vec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();
+                let (x, y) = beckmann_visible_slopes(ws.z, u);
+                let r = ws.x.hypot(ws.y);
+                let (c, s) = if r > 0.0 {
+                    (ws.x / r, ws.y / r)
+                } else {
+                    (1.0, 0.0)
+                };
+                let (sx, sy) = (c * x - s * y, s * x + c * y);
+                Vec3::new(-self.alpha_x * sx, -self.alpha_y * sy, 1.0).normalize()
             }
         }
     }
+}
+
+/// The inverse of the error function on (−1, 1), to about 10⁻⁶ relative
+/// (Giles 2010's single-precision fit).
+#[inline]
+fn erf_inv(x: f32) -> f32 {
+    let x = x.clamp(-0.99999, 0.99999);
+    let w = -((1.0 - x) * (1.0 + x)).ln();
+    let p = if w < 5.0 {
+        let w = w - 2.5;
+        [
+            3.432_739_4e-7,
+            -3.523_387_7e-6,
+            -4.391_506_5e-6,
+            2.185_808_7e-4,
+            -1.253_725e-3,
+            -4.177_681_6e-3,
+            0.246_640_73,
+            1.501_409_4,
+        ]
+        .iter()
+        .fold(2.810_226_4e-8, |p, &k| k + p * w)
+    } else {
+        let w = w.sqrt() - 3.0;
+        [
+            1.009_505_6e-4,
+            1.349_343_2e-3,
+            -3.673_428_4e-3,
+            5.739_507_7e-3,
+            -7.622_461_3e-3,
+            9.438_870_5e-3,
+            1.001_674,
+            2.832_976_8,
+        ]
+        .iter()
+        .fold(-2.002_142_6e-4, |p, &k| k + p * w)
+    };
+    p * x
+}
+
+/// Slopes (along the view's azimuth, across it) of the visible normals of
+/// the Beckmann surface of α = 1 seen at cosine `cos_theta`, from `u`
+/// uniform in [0, 1)²: the first by inverting its distribution (Newton's
+/// method kept within a bisection bracket, in the domain of erf), the
+/// second a Gaussian.
+fn beckmann_visible_slopes(cos_theta: f32, u: [f32; 2]) -> (f32, f32) {
+    let across = erf_inv(2.0 * u[1].max(1e-6) - 1.0);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    if sin_theta < 1e-4 {
+        // Seen from straight above, the visible slopes are the slopes (a
+        // view only a little off would skew them measurably: by tan θ).
+        let r = (-(1.0 - u[0]).ln()).sqrt();
+        let (s, c) = sin_cos_turns(u[1]);
+        return (r * c, r * s);
+    }
+    let tan_theta = sin_theta / cos_theta;
+    let cot_theta = 1.0 / tan_theta;
+    // The distribution of b = erf(slope) over [−1, erf(cot θ)]:
+    // F(b) = (1 + b + tan θ e^(−erf⁻¹(b)²)/√π) / (1 + c + tan θ e^(−cot²θ)/√π).
+    let (mut lo, mut hi) = (-1.0f32, erf(cot_theta));
+    let target = u[0].max(1e-6);
+    let inv_sqrt_pi = 1.0 / PI.sqrt();
+    let norm = 1.0 / (1.0 + hi + inv_sqrt_pi * tan_theta * (-cot_theta * cot_theta).exp());
+    // A first guess close to the inverse.
+    let theta = cos_theta.acos();
+    let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
+    let mut b = hi - (1.0 + hi) * (1.0 - target).powf(fit);
+    for _ in 0..10 {
+        if !(b >= lo && b <= hi) {
+            b = 0.5 * (lo + hi);
+        }
+        let slope = erf_inv(b);
+        let value = norm * (1.0 + b + inv_sqrt_pi * tan_theta * (-slope * slope).exp()) - target;
+        if value.abs() < 1e-5 {
+            break;
+        }
+        if value > 0.0 {
+            hi = b;
+        } else {
+            lo = b;
+        }
+        b -= value / (norm * (1.0 - slope * tan_theta));
+    }
+    (erf_inv(b), across)
 }
 
 #[cfg(test)]
@@ -182,7 +273,7 @@ mod tests {
     use super::*;
     use crate::rng::Rng;
 
-    /// ∫ D(wm) cos θm dωm = 1 over the hemisphere, and for GGX the visible
+    /// ∫ D(wm) cos θm dωm = 1 over the hemisphere, and the visible
     /// normals' density integrates to 1 from every direction: midpoint sums
     /// over a fine grid of θ and φ.
     #[test]
@@ -219,6 +310,63 @@ mod tests {
                     "{model:?} {ax},{ay}: ∫pdf = {visible}"
                 );
             }
+        }
+    }
+
+    /// The visible slopes of the Beckmann surface (α = 1) seen at θ have
+    /// density ∝ max(0, cot θ − x)·e^(−x²) along the view (slope x, the
+    /// normal's x being −x): their sampled mean and spread match it.
+    #[test]
+    fn beckmann_visible_slopes_follow_their_density() {
+        for theta in [0.3f64, 1.0, 1.4, 1.55] {
+            let cot = 1.0 / theta.tan();
+            // The moments by quadrature over x in (−8, cot θ).
+            let (mut m0, mut m1, mut m2) = (0.0, 0.0, 0.0);
+            let n = 200_000;
+            for i in 0..n {
+                let x = -8.0 + (cot + 8.0) * (i as f64 + 0.5) / n as f64;
+                let p = (cot - x) * (-x * x).exp();
+                m0 += p;
+                m1 += p * x;
+                m2 += p * x * x;
+            }
+            let (mean, var) = (m1 / m0, m2 / m0 - (m1 / m0).powi(2));
+            let mut rng = Rng::new(3);
+            let k = 200_000;
+            let (mut s1, mut s2) = (0.0f64, 0.0f64);
+            for _ in 0..k {
+                let (x, _) =
+                    beckmann_visible_slopes(theta.cos() as f32, [rng.next_f32(), rng.next_f32()]);
+                assert!(
+                    f64::from(x) <= cot + 1e-3,
+                    "θ {theta}: slope {x} beyond cot θ {cot}"
+                );
+                s1 += f64::from(x);
+                s2 += f64::from(x) * f64::from(x);
+            }
+            let got = s1 / k as f64;
+            let got_var = s2 / k as f64 - got * got;
+            let se = (var / k as f64).sqrt();
+            assert!(
+                (got - mean).abs() < 5.0 * se,
+                "θ {theta}: mean {got} against {mean}"
+            );
+            assert!(
+                (got_var / var - 1.0).abs() < 0.03,
+                "θ {theta}: variance {got_var} against {var}"
+            );
+        }
+    }
+
+    /// erf⁻¹ undoes erf across its range.
+    #[test]
+    fn erf_inv_inverts_erf() {
+        for x in [-2.5f32, -1.0, -0.3, 0.0, 0.2, 0.9, 1.7, 2.6] {
+            let back = erf_inv(erf(x));
+            assert!(
+                (back - x).abs() < 2e-3 * (1.0 + x.abs()),
+                "erf⁻¹(erf({x})) = {back}"
+            );
         }
     }
 
