@@ -2,7 +2,7 @@
 //! ([`trace_path`]), and the same for a group of camera rays of one pixel
 //! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, LobeFlags};
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
 use crate::geometry::HitRecord;
@@ -14,6 +14,7 @@ use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
+use crate::volume::{self, Event};
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -61,18 +62,31 @@ struct PathState {
     /// could also have been sampled from there, and counts only for its
     /// share of the two strategies.
     sampled_from: Option<(Point3, f32)>,
-    /// Shadow rays traced (for statistics).
+    /// Shadow rays and crossings of interfaces traced (for statistics).
     shadow_rays: u64,
+    /// The medium the path travels in (an index in the scene's
+    /// [`volumes`](Scene::volumes)), none in empty space.
+    medium: Option<u32>,
 }
 
 impl PathState {
-    const START: PathState = PathState {
-        throughput: Color::ONE,
-        radiance: Color::ZERO,
-        sampled_from: None,
-        shadow_rays: 0,
-    };
+    /// A path leaving the camera of `scene`.
+    #[inline(always)]
+    fn start(scene: &Scene) -> PathState {
+        PathState {
+            throughput: Color::ONE,
+            radiance: Color::ZERO,
+            sampled_from: None,
+            shadow_rays: 0,
+            medium: scene.camera_medium,
+        }
+    }
 }
+
+/// The most interfaces a path crosses between two bounces before it is
+/// given up (a bound on the work of a ray caught between surfaces that
+/// round it back and forth).
+const MAX_CROSSINGS: u32 = 1024;
 
 /// The power heuristic (β = 2): the weight of a strategy that chose a
 /// sample with density `a` when another could have chosen it with density
@@ -98,6 +112,11 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 /// (next-event estimation): a shadow ray towards a point chosen on it, the
 /// light it brings weighted against the chance that the bounce would have
 /// found the same light (multiple importance sampling).
+///
+/// In a scene with [`volumes`](Scene::volumes) the path also travels
+/// through the medium it is in, which may scatter it before the surface
+/// (see [`volume::Volume::sample`]), and it crosses interfaces and thin
+/// glass straight on without counting a bounce, into the medium beyond.
 #[inline(always)]
 fn step(
     scene: &Scene,
@@ -107,11 +126,77 @@ fn step(
     path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Step {
-    if !scene.media.is_empty() {
-        if let Some(step) = meet_media(scene, ray, hit, depth, path, sampler) {
+    let (mut ray, mut hit) = (*ray, hit);
+    for _ in 0..MAX_CROSSINGS {
+        if let Some(step) = through_media(scene, &ray, hit, depth, path, sampler) {
             return step;
         }
+        match bounce(scene, &ray, hit, depth, path, sampler) {
+            Bounce::Step(step) => return step,
+            Bounce::Cross(next, left) => {
+                path.shadow_rays += 1;
+                hit = scene.intersect_leaving(&next, Some(&left), f32::INFINITY);
+                ray = next;
+            }
+        }
     }
+    Step::Done(path.radiance)
+}
+
+/// What a surface does with a path.
+enum Bounce {
+    /// It scatters it or ends it.
+    Step(Step),
+    /// The path crosses it straight on, along this ray, leaving this hit
+    /// (an interface, a thin sheet of glass in a scene with media).
+    Cross(Ray, Hit),
+}
+
+/// The media `ray` crosses before `hit`: the scene's fog, then the
+/// medium the path is in. A step where a particle scatters or absorbs the
+/// path; otherwise the throughput takes what got through.
+#[inline(always)]
+fn through_media(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+) -> Option<Step> {
+    if !scene.media.is_empty() {
+        if let Some(step) = meet_media(scene, ray, hit, depth, path, sampler) {
+            return Some(step);
+        }
+    }
+    let medium = path.medium?;
+    sampler.start_bounce(depth);
+    let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+    match scene.volumes[medium as usize].sample(ray, t_max, sampler) {
+        Event::Pass { weight } => {
+            path.throughput *= weight;
+            None
+        }
+        Event::Scatter { t, weight } => {
+            path.throughput *= weight;
+            Some(scatter_in_volume(scene, ray, t, depth, path, sampler))
+        }
+        Event::Absorbed => Some(Step::Done(path.radiance)),
+    }
+}
+
+/// The surface `ray` meets at `hit` (or the sky, where it meets none)
+/// at the end of segment `depth`: see [`step`].
+#[inline(always)]
+fn bounce(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+) -> Bounce {
+    let done = |c| Bounce::Step(Step::Done(c));
     let Some(hit) = hit else {
         let mut sky = path.throughput * scene.background.color(ray.direction);
         if let Some((_, bsdf_pdf)) = path.sampled_from {
@@ -120,7 +205,7 @@ fn step(
         if scene.lights.sources_seen() {
             sky += path.throughput * discs_of_sky(scene, ray.direction, path.sampled_from);
         }
-        return Step::Done(path.radiance + sky);
+        return done(path.radiance + sky);
     };
     let record = scene.record(ray, hit);
     let material = scene.material(&record);
@@ -133,34 +218,107 @@ fn step(
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }
-    // The last segment's bounce could only start a ray that is never traced.
-    if depth + 1 >= scene.settings.max_depth {
-        return Step::Done(path.radiance);
+    if material.is_interface() {
+        return cross(ray, &record, hit, material, path);
+    }
+    // The last segment's bounce could only start a ray that is never
+    // traced; in a scene with media it may still cross a sheet of glass.
+    let last = depth + 1 >= scene.settings.max_depth;
+    if last && !scene.volumetric {
+        return done(path.radiance);
     }
     let wo = -ray.direction;
     let Some(bsdf) = material.bsdf(&record, wo, &scene.textures) else {
-        return Step::Done(path.radiance);
+        return done(path.radiance);
     };
     sampler.start_bounce(depth);
     let nee = samples_lights(scene, depth) && bsdf.has_density();
     if nee {
         let (light, traced) =
-            light_at_surface(scene, &record, &hit, &bsdf, wo, ray.time(), sampler);
+            light_at_surface(scene, &record, &hit, &bsdf, wo, ray.time(), path, sampler);
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
     let Some(sample) = bsdf.sample(wo, sampler) else {
-        return Step::Done(path.radiance);
+        return done(path.radiance);
     };
+    if scene.volumetric && sample.flags.contains(LobeFlags::STRAIGHT) {
+        path.throughput *= sample.value;
+        return cross(ray, &record, hit, material, path);
+    }
+    if last {
+        return done(path.radiance);
+    }
     path.sampled_from = (nee && !sample.flags.is_specular()).then_some((record.point, sample.pdf));
     path.throughput *= sample.value;
+    if let Some(sides) = material.media {
+        path.medium = sides.beyond(record.outward_normal(), sample.wi);
+    }
+    if !goes_on(scene, depth, path, sampler) {
+        return done(path.radiance);
+    }
+    Bounce::Step(Step::Continue(
+        Ray::timed(record.spawn_origin(sample.wi), sample.wi, ray.time()),
+        Some(hit),
+    ))
+}
+
+/// The path crosses the surface at `record` (of `hit`, made of `material`)
+/// straight on, into the medium beyond it.
+#[inline(never)]
+fn cross(
+    ray: &Ray,
+    record: &HitRecord,
+    hit: Hit,
+    material: &Material,
+    path: &mut PathState,
+) -> Bounce {
+    let d = ray.direction;
+    if let Some(sides) = material.media {
+        path.medium = sides.beyond(record.outward_normal(), d);
+    }
+    Bounce::Cross(Ray::timed(record.spawn_origin(d), d, ray.time()), hit)
+}
+
+/// A path meets a particle of the medium it travels in at distance `t`
+/// along `ray` (the end of segment `depth`), its throughput already
+/// weighted: it samples a light from there, and goes on in a direction
+/// drawn from the isotropic phase function.
+#[inline(never)]
+fn scatter_in_volume(
+    scene: &Scene,
+    ray: &Ray,
+    t: f32,
+    depth: u32,
+    path: &mut PathState,
+    sampler: &mut impl Sampler,
+) -> Step {
+    if depth + 1 >= scene.settings.max_depth {
+        return Step::Done(path.radiance);
+    }
+    let point = ray.at(t);
+    let nee = samples_lights(scene, depth);
+    if nee {
+        let medium = path.medium;
+        let (light, traced) = direct_light(
+            scene,
+            point,
+            ray.time(),
+            |_| (Color::splat(volume::ISOTROPIC), volume::ISOTROPIC),
+            |_| point,
+            |_| medium,
+            None,
+            sampler,
+        );
+        path.radiance += path.throughput * light;
+        path.shadow_rays += u64::from(traced);
+    }
+    let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
+    path.sampled_from = nee.then_some((point, volume::ISOTROPIC));
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);
     }
-    Step::Continue(
-        Ray::timed(record.spawn_origin(sample.wi), sample.wi, ray.time()),
-        Some(hit),
-    )
+    Step::Continue(Ray::timed(point, direction, ray.time()), None)
 }
 
 /// The radiance of the discs of the sky (directional lights with an
@@ -205,6 +363,7 @@ fn emission(
 
 /// [`direct_light`] at a surface point `record` (of `hit`) scattering by
 /// `bsdf`, seen from `wo` (pointing back along the ray).
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn light_at_surface(
     scene: &Scene,
@@ -213,14 +372,20 @@ fn light_at_surface(
     bsdf: &Bsdf,
     wo: Vec3,
     time: f32,
+    path: &PathState,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
+    let sides = scene.material(record).media;
     direct_light(
         scene,
         record.point,
         time,
         |wi| bsdf.eval_and_pdf(wo, wi),
         |wi| record.spawn_origin(wi),
+        |wi| match sides {
+            Some(s) => s.beyond(record.outward_normal(), wi),
+            None => path.medium,
+        },
         Some(hit),
         sampler,
     )
@@ -268,12 +433,14 @@ fn scatter_in_medium(
     let point = ray.at(t);
     let nee = samples_lights(scene, depth);
     if nee {
+        let inside = path.medium;
         let (light, traced) = direct_light(
             scene,
             point,
             ray.time(),
             |_| (medium.albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
             |_| point,
+            |_| inside,
             None,
             sampler,
         );
@@ -342,8 +509,10 @@ fn samples_lights(scene: &Scene, depth: u32) -> bool {
 /// particle's) sends towards the path per unit light arriving from it
 /// (f · |cos θ| for a surface) and the density with which it would scatter
 /// there itself (0 where it cannot); `spawn` where a ray leaving along a
-/// direction starts (a surface's rounding bound off it); `from` the
-/// surface's hit (none at a particle).
+/// direction starts (a surface's rounding bound off it); `medium` the
+/// medium a ray leaving along a direction travels in; `from` the surface's
+/// hit (none at a particle).
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn direct_light(
     scene: &Scene,
@@ -351,6 +520,7 @@ fn direct_light(
     time: f32,
     scatter: impl Fn(Vec3) -> (Color, f32),
     spawn: impl Fn(Vec3) -> Point3,
+    medium: impl Fn(Vec3) -> Option<u32>,
     from: Option<&Hit>,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
@@ -381,7 +551,16 @@ fn direct_light(
         // At the start: out of reach.
         return (Color::ZERO, false);
     }
-    if scene.occluded_leaving(&shadow, from, end) {
+    // In a scene with media the shadow ray crosses interfaces and thin
+    // glass, and takes what gets through them and the media between.
+    let share = if scene.volumetric {
+        scene.transmittance_along(&shadow, from, end, medium(wi), sampler)
+    } else if scene.occluded_leaving(&shadow, from, end) {
+        Color::ZERO
+    } else {
+        Color::ONE
+    };
+    if share == Color::ZERO {
         return (Color::ZERO, true);
     }
     // No bounce finds a delta light: its sample has all the weight.
@@ -390,7 +569,7 @@ fn direct_light(
     } else {
         power_heuristic(sample.pdf, scatter_pdf)
     };
-    let mut light = sample.radiance * value * (weight / sample.pdf);
+    let mut light = sample.radiance * value * (weight / sample.pdf) * share;
     if !scene.media.is_empty() {
         light *= scene.transmittance(&shadow, end);
     }
@@ -410,7 +589,7 @@ pub fn trace_path(
     sampler: &mut impl Sampler,
     rays: &mut u64,
 ) -> Color {
-    let mut path = PathState::START;
+    let mut path = PathState::start(scene);
     let mut from = None;
     // A path still going after `max_depth` segments keeps what it gathered.
     let mut colour = None;
@@ -475,7 +654,7 @@ pub fn trace_paths<S: Sampler>(
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
-    let mut paths = [PathState::START; PATHS];
+    let mut paths = [PathState::start(scene); PATHS];
     let mut hits = [None; PATHS];
     // The surface each path's ray leaves.
     let mut from: [Option<Hit>; PATHS] = [None; PATHS];

@@ -17,6 +17,8 @@
 //!   (next-event estimation); [`distribution`]: drawing in proportion to a
 //!   table of weights.
 //! - [`medium`]: fog and smoke of constant density.
+//! - [`volume`]: participating media that fill what surfaces enclose
+//!   (constant or voxel grids), entered and left through surfaces.
 //! - [`texture`]: solid colours, checkers, images and noise.
 //! - [`mesh`]: triangle meshes and their materials from OBJ, glTF and PLY files.
 //! - [`integrator`]: the path of one ray, top to bottom, in one function.
@@ -89,3 +91,4 @@ pub mod scene;
 mod testing;
 pub mod texture;
 pub mod tile;
+pub mod volume;

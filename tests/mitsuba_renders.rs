@@ -201,3 +201,55 @@ fn bsdf_spheres_identity_normal_map_anisotropic_conductor() {
 fn bsdf_spheres_textured_rough_conductor() {
     check("bsdf_spheres", "test_textured_roughconductor_path.xml");
 }
+
+/// The surfaces of the media scenes, without media: Mitsuba's volumetric
+/// path tracer on plastic under an area light and a sky.
+#[test]
+fn participating_media_surfaces_only() {
+    check("participating_media", "test_surf_area_light_volpath.xml");
+}
+
+/// Homogeneous media of grey and coloured extinction inside spheres of
+/// null, thin-glass, glass and rough-glass boundaries, lit by a sky, an
+/// area light, a spot light and a light inside the medium.
+#[test]
+fn participating_media_homogeneous() {
+    for scene in [
+        "test_homo_null_envmap_volpath.xml",
+        "test_homo_spectral_sigmat_volpathmis.xml",
+        "test_homo_area_light_volpath.xml",
+        "test_homo_emitter_inside_medium_volpath.xml",
+        "test_homo_obj_inside_medium_volpath.xml",
+    ] {
+        check("participating_media", scene);
+    }
+}
+
+/// Homogeneous media behind index-mismatched boundaries: smooth glass
+/// under a sky, rough glass under a spot light.
+#[test]
+fn participating_media_behind_glass() {
+    check(
+        "participating_media",
+        "test_homo_dielectric_envmap_volpath.xml",
+    );
+    check(
+        "participating_media",
+        "test_homo_roughdielectric_spot_volpath.xml",
+    );
+}
+
+/// Heterogeneous media: voxel grids of extinction and albedo (delta and
+/// ratio tracking), and a constant coloured extinction filling only its
+/// volume's box.
+#[test]
+fn participating_media_heterogeneous() {
+    for scene in [
+        "test_hetero_spectral_sigmat_no_scattering_volpath.xml",
+        "test_hetero_sigmat_volpath.xml",
+        "test_hetero_sigmat_albedo_volpath.xml",
+        "test_hetero_spectral_sigmat_volpathmis.xml",
+    ] {
+        check("participating_media", scene);
+    }
+}

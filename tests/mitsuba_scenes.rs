@@ -30,6 +30,9 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
         "bsdf_spheres/test_textured_diffuse_path.xml",
         "instancing/test_instancing_path.xml",
         "floating_sphere/test_directional_direct.xml",
+        "participating_media/test_homo_area_light_volpath.xml",
+        "participating_media/test_hetero_sigmat_albedo_volpath.xml",
+        "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath.xml",
         concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/scripts/peers/flip_normals/flip_normals.xml"

@@ -124,6 +124,9 @@ impl LobeFlags {
     pub const GLOSSY: LobeFlags = LobeFlags(8);
     /// Along a single direction (a delta distribution).
     pub const SPECULAR: LobeFlags = LobeFlags(16);
+    /// Transmission that leaves the direction as it was (a thin sheet's):
+    /// in a scene with media, a crossing rather than a bounce.
+    pub const STRAIGHT: LobeFlags = LobeFlags(32);
 
     /// Both sets of flags.
     #[inline(always)]

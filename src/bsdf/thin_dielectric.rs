@@ -50,7 +50,7 @@ impl ThinDielectric {
         let (wi, pdf, side) = if uc < r {
             (Vec3::new(-wo.x, -wo.y, wo.z), r, LobeFlags::REFLECTION)
         } else {
-            (-wo, 1.0 - r, LobeFlags::TRANSMISSION)
+            (-wo, 1.0 - r, LobeFlags::TRANSMISSION | LobeFlags::STRAIGHT)
         };
         Some(BsdfSample {
             value: Color::ONE,

@@ -260,6 +260,12 @@ impl Transform {
         self.to_world.transform_point3a(p)
     }
 
+    /// The object-space position of the world point `p`.
+    #[inline]
+    pub fn inverse_point(&self, p: Point3) -> Point3 {
+        self.to_object.transform_point3a(p)
+    }
+
     /// The world vector of the object-space vector `v` (no translation, no
     /// normalisation: lengths scale with the transform).
     #[inline]

@@ -95,6 +95,9 @@ pub struct Light {
     pub emission: Emissive,
     /// The texture of its radiance, if it has one.
     pub texture: Option<LightTexture>,
+    /// The emitting object it is part of (the triangles of a mesh, or of
+    /// an instance, share one), for [`LightSelection::Objects`].
+    pub object: u32,
 }
 
 /// The radiance of a light given by a texture.
@@ -210,8 +213,14 @@ pub enum LightSelection {
     /// scene's bounding sphere).
     #[default]
     Power,
-    /// Every light that emits anything equally often.
+    /// Every light that emits anything equally often (each triangle of
+    /// a mesh a light of its own, as in pbrt).
     Uniform,
+    /// Every emitting object equally often (a whole mesh as one light,
+    /// its triangles in proportion to their area), and each light that is
+    /// no surface and the environment as one object each: Mitsuba's
+    /// choice.
+    Objects,
 }
 
 /// The lights of a scene (its emissive surfaces, and the environment when
@@ -294,9 +303,29 @@ impl Lights {
         powers.extend(sources.iter().map(|s| s.power(scene_radius)));
         powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
         let environment = environment.map(|(_, e)| e);
-        if selection == LightSelection::Uniform {
-            for p in &mut powers {
-                *p = if *p > 0.0 { 1.0 } else { 0.0 };
+        match selection {
+            LightSelection::Power => {}
+            LightSelection::Uniform => {
+                for p in &mut powers {
+                    *p = if *p > 0.0 { 1.0 } else { 0.0 };
+                }
+            }
+            LightSelection::Objects => {
+                // Each object's share is 1, split among its parts by area.
+                let mut areas: std::collections::HashMap<u32, f64> = Default::default();
+                let area = |l: &Light| f64::from(Surface::of(&l.shape).area);
+                for (l, p) in lights.iter().zip(&powers) {
+                    if *p > 0.0 {
+                        *areas.entry(l.object).or_default() += area(l);
+                    }
+                }
+                for (i, p) in powers.iter_mut().enumerate() {
+                    *p = match lights.get(i) {
+                        _ if *p <= 0.0 => 0.0,
+                        Some(l) => area(l) / areas[&l.object],
+                        None => 1.0,
+                    };
+                }
             }
         }
         let Some(choice) = Distribution1D::new(&powers) else {

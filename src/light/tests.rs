@@ -13,6 +13,7 @@ fn emitting(shape: Shape, radiance: Color, two_sided: bool) -> Light {
             two_sided,
         },
         texture: None,
+        object: 0,
     }
 }
 

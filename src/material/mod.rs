@@ -129,6 +129,13 @@ macro_rules! material_desc {
             /// (Cycles').
             #[serde(default, skip_serializing_if = "std::ops::Not::not")]
             pub bump_shadowing: bool,
+            /// The medium inside the surface (a name in `media`): a path
+            /// that crosses it inwards travels in it. None when absent.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub interior: Option<String>,
+            /// The medium outside the surface; none when absent.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub exterior: Option<String>,
         }
 
         impl $name {
@@ -146,6 +153,8 @@ macro_rules! material_desc {
                     alpha_cutoff: self.alpha_cutoff,
                     one_sided: self.one_sided,
                     bump_shadowing: self.bump_shadowing,
+                    interior: self.interior.as_deref(),
+                    exterior: self.exterior.as_deref(),
                 }
             }
 
@@ -162,6 +171,8 @@ macro_rules! material_desc {
                     alpha_cutoff: &mut self.alpha_cutoff,
                     one_sided: &mut self.one_sided,
                     bump_shadowing: &mut self.bump_shadowing,
+                    interior: &mut self.interior,
+                    exterior: &mut self.exterior,
                 }
             }
         }
@@ -251,6 +262,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod emissive;
+pub mod interface;
 pub mod metal;
 pub mod metals;
 pub mod mix;
@@ -266,6 +278,7 @@ pub use conductor::{Conductor, ConductorDesc};
 pub use dielectric::{Dielectric, DielectricDesc};
 pub use diffuse::{AttenuationDesc, BounceDesc, Diffuse, DiffuseDesc};
 pub use emissive::{Emission, Emissive, EmissiveDesc};
+pub use interface::InterfaceDesc;
 pub use metal::{Metal, MetalDesc};
 pub use mix::{Mix, MixDesc};
 pub use param::{ColorDesc, ColorParam, Invalid, ScalarDesc, ScalarParam, Textures};
@@ -295,6 +308,8 @@ material_kinds! {
     Principled(PrincipledDesc) = "principled", "a principled material";
     /// Two materials, one or the other at each point.
     Mix(MixDesc) = "mix", "a mix material";
+    /// No surface: the boundary between two media, crossed unchanged.
+    Interface(InterfaceDesc) = "interface", "an interface material";
 }
 
 /// A kind of material as the readers know it.
@@ -333,6 +348,10 @@ pub struct SurfaceDesc<'a> {
     pub one_sided: bool,
     /// Shadow a normal or bump map's bumps.
     pub bump_shadowing: bool,
+    /// The medium inside, by name.
+    pub interior: Option<&'a str>,
+    /// The medium outside, by name.
+    pub exterior: Option<&'a str>,
 }
 
 /// The fields every kind of material has, borrowed to be changed (by a
@@ -360,6 +379,10 @@ pub struct SurfaceMut<'a> {
     pub one_sided: &'a mut bool,
     /// Shadow a normal or bump map's bumps.
     pub bump_shadowing: &'a mut bool,
+    /// The medium inside.
+    pub interior: &'a mut Option<String>,
+    /// The medium outside.
+    pub exterior: &'a mut Option<String>,
 }
 
 impl SurfaceDesc<'_> {
@@ -680,6 +703,32 @@ pub enum Kind {
     Principled(Box<Principled>),
     /// One of two materials at each point.
     Mix(Box<Mix>),
+    /// No surface: the boundary between two media, which rays cross
+    /// unchanged (see [`Material::straight_through`]).
+    Interface,
+}
+
+/// The media on the two sides of a surface, by index in the scene's
+/// [`volumes`](crate::scene::Scene::volumes); `None`: empty space.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MediumInterface {
+    /// The medium inside (the side away from the outward normal).
+    pub interior: Option<u32>,
+    /// The medium outside.
+    pub exterior: Option<u32>,
+}
+
+impl MediumInterface {
+    /// The medium a path leaving the surface along `direction` enters,
+    /// where the surface's outward geometric normal is `outward`.
+    #[inline]
+    pub fn beyond(&self, outward: Vec3, direction: Vec3) -> Option<u32> {
+        if direction.dot(outward) < 0.0 {
+            self.interior
+        } else {
+            self.exterior
+        }
+    }
 }
 
 /// A surface material.
@@ -698,6 +747,8 @@ pub struct Material {
     /// A normal or bump map's bumps shadow the light (see
     /// [`Terminator`]).
     pub bump_shadowing: bool,
+    /// The media on its two sides, where it bounds any.
+    pub media: Option<MediumInterface>,
 }
 
 impl Material {
@@ -710,6 +761,7 @@ impl Material {
             opacity: None,
             one_sided: false,
             bump_shadowing: false,
+            media: None,
         }
     }
 
@@ -722,6 +774,7 @@ impl Material {
             opacity: None,
             one_sided: false,
             bump_shadowing: false,
+            media: None,
         }
     }
 
@@ -779,7 +832,7 @@ impl Material {
         };
         match &self.kind {
             // `bsdf` gives a mix's chosen material, never the mix.
-            Kind::Black | Kind::Mix(_) => None,
+            Kind::Black | Kind::Mix(_) | Kind::Interface => None,
             Kind::Diffuse(d) => notes(Lobe::Diffuse(d.at(hit, textures))),
             Kind::Metal(m) => notes(Lobe::Metal(m.at(hit, textures))),
             Kind::Dielectric(d) => match d.at(hit, textures) {
@@ -815,6 +868,29 @@ impl Material {
         match &self.kind {
             Kind::Principled(p) => p.absorption.filter(|_| p.thickness.at(hit, textures) > 0.0),
             _ => None,
+        }
+    }
+
+    /// Whether it is no surface but the boundary of media, which paths
+    /// cross unchanged.
+    #[inline(always)]
+    pub fn is_interface(&self) -> bool {
+        matches!(self.kind, Kind::Interface)
+    }
+
+    /// The share of light that goes straight through the surface at `hit`
+    /// (seen from `wo`, back along the ray), undeviated: all of it at an
+    /// interface, what a thin sheet of glass lets through, none elsewhere.
+    /// What a shadow ray carries past it in a scene with media.
+    pub fn straight_through(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Color {
+        if self.is_interface() {
+            return Color::ONE;
+        }
+        match self.bsdf(hit, wo, textures).map(|b| b.lobe) {
+            Some(Lobe::ThinDielectric(sheet)) => {
+                Color::splat(1.0 - sheet.reflectance(wo.dot(hit.normal)))
+            }
+            _ => Color::ZERO,
         }
     }
 
@@ -862,7 +938,7 @@ impl Material {
             Kind::Plastic(p) => p.textures(),
             Kind::Principled(p) => p.textures(),
             Kind::Mix(m) => m.textures(),
-            Kind::Black => Vec::new(),
+            Kind::Black | Kind::Interface => Vec::new(),
         };
         out.extend(self.emission.and_then(|e| e.radiance.texture()));
         out.extend(self.shape.map(|s| match s {

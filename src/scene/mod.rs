@@ -18,11 +18,12 @@ use crate::geometry::{HitRecord, RayBundle, Sphere};
 pub use crate::light::LightSelection;
 use crate::light::{Environment, Lights};
 use crate::material::Material;
-use crate::math::Interval;
+use crate::math::{Color, Interval};
 use crate::medium::Medium;
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::texture::Texture;
+use crate::volume::Volume;
 use desc::{IntegratorDesc, SamplingDesc, ShadingDesc};
 use thiserror::Error;
 pub use world::PlacedShapes;
@@ -197,6 +198,15 @@ pub struct Scene {
     light_ids: LightIds,
     /// The fog and smoke of the scene.
     pub media: Vec<Medium>,
+    /// The media that fill what surfaces enclose, which materials name
+    /// (see [`crate::volume`]).
+    pub volumes: Vec<Volume>,
+    /// The medium the camera stands in, by index in `volumes`.
+    pub camera_medium: Option<u32>,
+    /// Whether paths keep track of the medium they travel in, and cross
+    /// interfaces and thin glass without a bounce: in scenes with
+    /// `volumes` or interface materials.
+    pub volumetric: bool,
     /// What each mesh file loaded holds, and what of it lumen does not
     /// render.
     pub reports: Vec<FileReport>,
@@ -506,6 +516,53 @@ impl Scene {
             .iter()
             .map(|m| m.transmittance(ray, t_max))
             .product()
+    }
+
+    /// The share of light, per channel, that gets along `ray` (leaving the
+    /// surface of hit `from`, see [`Scene::intersect_leaving`]) to
+    /// distance `t_max`, starting in `medium`: through the media it
+    /// travels in, and straight through the interfaces and thin glass it
+    /// crosses (see [`Material::straight_through`]), entering the medium
+    /// beyond each; 0 where any other surface stands in the way. A shadow
+    /// ray's question in a scene with [`volumes`](Scene::volumes); an
+    /// unbiased estimate where a medium's density varies.
+    pub fn transmittance_along(
+        &self,
+        ray: &Ray,
+        from: Option<&Hit>,
+        t_max: f32,
+        mut medium: Option<u32>,
+        sampler: &mut impl Sampler,
+    ) -> Color {
+        let (mut ray, mut from, mut left) = (*ray, from.copied(), t_max);
+        let mut share = Color::ONE;
+        for _ in 0..MAX_CUTOUTS {
+            let hit = self.intersect_leaving(&ray, from.as_ref(), left);
+            if let Some(m) = medium {
+                let reach = hit.map_or(left, |h| h.t);
+                share *= self.volumes[m as usize].transmittance(&ray, reach, sampler);
+            }
+            let Some(hit) = hit else {
+                return share;
+            };
+            let record = self.record(&ray, hit);
+            let material = self.material(&record);
+            share *= material.straight_through(&record, -ray.direction, &self.textures);
+            if share == Color::ZERO {
+                return share;
+            }
+            if let Some(sides) = material.media {
+                medium = sides.beyond(record.outward_normal(), ray.direction);
+            }
+            left -= hit.t;
+            ray = Ray::timed(
+                record.spawn_origin(ray.direction),
+                ray.direction,
+                ray.time(),
+            );
+            from = Some(hit);
+        }
+        Color::ZERO
     }
 
     /// The nearest hit within `interval` of each ray `rays[lanes[k]]` (1 to

@@ -949,16 +949,22 @@ impl World {
         };
         let mut lights = Vec::new();
         let mut ids = LightIds::default();
-        let add =
-            |shape: LightShape, (emission, texture): Emission, uvs, lights: &mut Vec<Light>| {
-                let texture = texture.map(|texture| LightTexture { texture, uvs });
-                lights.push(Light {
-                    shape,
-                    emission,
-                    texture,
-                });
-                (lights.len() - 1) as u32
-            };
+        // The emitting object the next light belongs to.
+        let mut object = 0u32;
+        let add = |shape: LightShape,
+                   (emission, texture): Emission,
+                   uvs,
+                   object: u32,
+                   lights: &mut Vec<Light>| {
+            let texture = texture.map(|texture| LightTexture { texture, uvs });
+            lights.push(Light {
+                shape,
+                emission,
+                texture,
+                object,
+            });
+            (lights.len() - 1) as u32
+        };
         let top = &self.top;
         for s in &top.spheres {
             // A sphere that shines inwards only is found by the bounces.
@@ -968,7 +974,8 @@ impl World {
                     center: s.center,
                     radius: s.radius,
                 };
-                add(shape, e, CORNER_UVS, &mut lights)
+                object += 1;
+                add(shape, e, CORNER_UVS, object, &mut lights)
             }));
         }
         for (q, material) in &top.quads {
@@ -991,7 +998,8 @@ impl World {
                     };
                     (shape, CORNER_UVS)
                 };
-                add(shape, e, uvs, &mut lights)
+                object += 1;
+                add(shape, e, uvs, object, &mut lights)
             }));
         }
         for (q, material) in &top.quadrics {
@@ -1000,15 +1008,23 @@ impl World {
             // over its area.
             let sampled = emitter(*material).filter(|_| q.round());
             ids.top.push(sampled.map_or(NO_LIGHT, |e| {
-                add(LightShape::Quadric(*q), e, CORNER_UVS, &mut lights)
+                object += 1;
+                add(LightShape::Quadric(*q), e, CORNER_UVS, object, &mut lights)
             }));
         }
         for mesh in &top.meshes {
+            object += 1;
             for k in 0..mesh.data.triangles.len() {
                 ids.top
                     .push(emitter(mesh.material(k)).map_or(NO_LIGHT, |e| {
                         let (vertices, uvs) = mesh.outward_corners(k);
-                        add(LightShape::Triangle { vertices }, e, uvs, &mut lights)
+                        add(
+                            LightShape::Triangle { vertices },
+                            e,
+                            uvs,
+                            object,
+                            &mut lights,
+                        )
                     }));
             }
         }
@@ -1030,6 +1046,7 @@ impl World {
                 continue;
             }
             ids.instance_first.push(lights.len() as u32);
+            object += 1;
             let transform = &self.bvh.instances()[i].transform;
             // Keep the outward side the hit record's: a mirroring transform
             // reverses the corners' order.
@@ -1048,7 +1065,13 @@ impl World {
                         two_sided: false,
                     };
                     let e = material(mesh.material(k)).unwrap_or((black, None));
-                    add(LightShape::Triangle { vertices }, e, uvs, &mut lights);
+                    add(
+                        LightShape::Triangle { vertices },
+                        e,
+                        uvs,
+                        object,
+                        &mut lights,
+                    );
                 }
             }
         }

@@ -78,6 +78,7 @@ pub fn furnace_desc(
             transform: Vec::new(),
         }],
         lights: Vec::new(),
+        media: Default::default(),
     }
 }
 

@@ -224,8 +224,11 @@ impl From<IntegratorArg> for Integrator {
 enum LightSelectionArg {
     /// In proportion to each light's power.
     Power,
-    /// Every light equally often.
+    /// Every light equally often (each triangle of a mesh one).
     Uniform,
+    /// Every emitting object equally often (a mesh as one light, its
+    /// triangles by area): Mitsuba's choice.
+    Objects,
 }
 
 impl From<LightSelectionArg> for LightSelection {
@@ -233,6 +236,7 @@ impl From<LightSelectionArg> for LightSelection {
         match l {
             LightSelectionArg::Power => LightSelection::Power,
             LightSelectionArg::Uniform => LightSelection::Uniform,
+            LightSelectionArg::Objects => LightSelection::Objects,
         }
     }
 }

@@ -30,6 +30,7 @@ use std::sync::Arc;
 use textures::{read_image, ColorRef, TextureKind, TextureTable};
 
 mod file_material;
+mod media;
 mod textures;
 
 /// The factor of [`HitRecord::error`]: the hit point and its offset from the
@@ -112,14 +113,18 @@ impl Scene {
             materials: &desc.materials,
             resolving: Vec::new(),
         };
+        let enclosed = media::Media::compile(desc, base)?;
         for (name, m) in &desc.materials {
             material_index.insert(name.as_str(), materials.len() as u32);
             context.resolving = vec![name.as_str()];
-            materials.push(
-                m.compile(&format!("materials.{name}"), &mut context)
-                    .map_err(|e| invalid(e.field, e.message))?,
-            );
+            let field = format!("materials.{name}");
+            let mut material = m
+                .compile(&field, &mut context)
+                .map_err(|e| invalid(e.field, e.message))?;
+            material.media = enclosed.of_material(&field, m)?;
+            materials.push(material);
         }
+        let camera_medium = enclosed.of_camera(desc.camera.medium.as_deref())?;
         context.resolving.clear();
         let mut light_sources = Vec::with_capacity(desc.lights.len());
         for (i, l) in desc.lights.iter().enumerate() {
@@ -202,7 +207,12 @@ impl Scene {
             settings.light_selection,
         );
         let cutouts = materials.iter().any(|m| m.opacity.is_some());
+        let volumes = enclosed.volumes;
+        let volumetric = !volumes.is_empty() || materials.iter().any(Material::is_interface);
         Ok(Scene {
+            volumes,
+            camera_medium,
+            volumetric,
             reports,
             settings,
             camera,
@@ -1365,6 +1375,11 @@ fn mat4_transform(m: &glam::Mat4) -> Option<Transform> {
 /// The transform of object `i`'s steps (its place at time 0), and how far
 /// its `motion` steps move it by time 1, in the world.
 fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<(Transform, Vec3), SceneError> {
+    transform_at(&format!("objects[{i}].transform"), steps)
+}
+
+/// The transform (and motion) of `steps`, the field at `at` (for messages).
+fn transform_at(at: &str, steps: &[TransformDesc]) -> Result<(Transform, Vec3), SceneError> {
     let placing = |steps: &[TransformDesc]| -> Vec<(usize, TransformStep)> {
         steps
             .iter()
@@ -1387,18 +1402,14 @@ fn compile_transform(i: usize, steps: &[TransformDesc]) -> Result<(Transform, Ve
     };
     let build = |offset: usize, steps: &[TransformDesc]| {
         let (index, steps): (Vec<usize>, Vec<TransformStep>) = placing(steps).into_iter().unzip();
-        Transform::from_steps(&steps).map_err(|e| {
-            invalid(
-                format!("objects[{i}].transform[{}]", offset + index[e.index]),
-                e.message,
-            )
-        })
+        Transform::from_steps(&steps)
+            .map_err(|e| invalid(format!("{at}[{}]", offset + index[e.index]), e.message))
     };
     let transform = build(0, steps)?;
     let mut motion = Vec3::ZERO;
     for (k, step) in steps.iter().enumerate() {
         if let TransformDesc::Motion(m) = step {
-            let field = format!("objects[{i}].transform[{k}].motion");
+            let field = format!("{at}[{k}].motion");
             finite(&field, m)?;
             // Carried by the steps after it, as the object is.
             motion += build(k + 1, &steps[k + 1..])?.vector(vec3(*m));

@@ -60,6 +60,72 @@ pub struct SceneDesc {
     /// (a surface shines by its material's emission).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightDesc>,
+    /// Participating media by name: materials name the medium inside and
+    /// outside their surfaces (`interior`, `exterior`), the camera the one
+    /// it stands in.
+    #[serde(
+        default,
+        skip_serializing_if = "BTreeMap::is_empty",
+        deserialize_with = "unique_names"
+    )]
+    pub media: BTreeMap<String, MediumDesc>,
+}
+
+/// A participating medium (see [`crate::volume`]): what fills the space a
+/// surface encloses, entered and left through surfaces whose material
+/// names it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumDesc {
+    /// The extinction σt per unit length (before `scale`): a number, a
+    /// colour, or a grid.
+    pub sigma_t: FieldDesc,
+    /// The share of the light meeting a particle that it scatters (the
+    /// rest it absorbs), in [0, 1]: a number, a colour, or a grid.
+    pub albedo: FieldDesc,
+    /// A factor on `sigma_t` (for data in other units); 1 when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
+    /// Where the medium is: nothing outside this box. A medium whose
+    /// `sigma_t` is a grid fills that grid's box when no box is given;
+    /// other media are everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none", rename = "box")]
+    pub bounds: Option<BoxDesc>,
+}
+
+/// A box from `min` to `max`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxDesc {
+    /// The lowest corner.
+    pub min: Triple,
+    /// The highest corner.
+    pub max: Triple,
+}
+
+/// A quantity of a medium: the same everywhere, or read from a grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum FieldDesc {
+    /// The same value in every channel.
+    Value(f64),
+    /// A value per channel.
+    Color(Triple),
+    /// A voxel grid.
+    Grid(GridDesc),
+}
+
+/// A voxel grid of a medium's quantity, read from a Mitsuba `.vol` file
+/// (1 or 3 channels of float32), filling the unit cube of its own space.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridDesc {
+    /// The `.vol` file, relative to the scene file.
+    pub grid: String,
+    /// Places the grid's unit cube in the world, applied in the order
+    /// written.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub transform: Vec<TransformDesc>,
 }
 
 /// A table of named entries in which no name is given twice (a JSON object
@@ -329,6 +395,10 @@ pub struct CameraDesc {
     /// light and shadows). None: no limit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub far_clip: Option<f64>,
+    /// The medium the camera stands in (a name in `media`); none when
+    /// absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub medium: Option<String>,
 }
 
 /// Which camera of the scene's glTF models.
@@ -366,6 +436,7 @@ impl Default for CameraDesc {
             mirror: false,
             near_clip: 0.0,
             far_clip: None,
+            medium: None,
         }
     }
 }

@@ -16,8 +16,9 @@ use crate::material::KindInfo;
 use crate::scene::desc::{
     BackgroundDesc, BoundaryDesc, CameraDesc, ChannelDesc, ColorDesc, EncodingDesc,
     EnvironmentLayoutDesc, FilterDesc, GltfCamera, IntegratorDesc, LightDesc, MaterialDesc,
-    NoisePatternDesc, ObjectDesc, PixelFilterDesc, RenderDesc, SamplingDesc, ScalarDesc, ScaleDesc,
-    SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc, MAX_SEED,
+    MediumDesc, NoisePatternDesc, ObjectDesc, PixelFilterDesc, RenderDesc, SamplingDesc,
+    ScalarDesc, ScaleDesc, SceneDesc, ShadingDesc, TextureDesc, TransformDesc, Triple, WrapDesc,
+    MAX_SEED,
 };
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -378,6 +379,7 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
             "materials",
             "objects",
             "lights",
+            "media",
         ],
         &[],
     )?;
@@ -403,7 +405,16 @@ pub fn scene(root: &Node) -> Result<SceneDesc> {
             .optional("objects", |n, _| objects(n))?
             .unwrap_or_default(),
         lights: t.optional("lights", |n, _| lights(n))?.unwrap_or_default(),
+        media: t
+            .optional("media", |n, _| named(n, "media", "medium", medium))?
+            .unwrap_or_default(),
     })
+}
+
+/// A medium of `[media]`, its fields as [`MediumDesc`] declares them.
+fn medium(node: &Node, path: &str) -> Result<MediumDesc> {
+    <MediumDesc as serde::Deserialize>::deserialize(NodeDe::new(node, path.to_string(), "a medium"))
+        .map_err(|e| e.into_decode(path, &node.span, "a medium"))
 }
 
 /// The `[[lights]]` tables: each kind's fields as the kind declares them
@@ -508,6 +519,7 @@ const INTEGRATORS: &[(&str, IntegratorDesc)] = &[
 const LIGHT_SELECTIONS: &[(&str, LightSelection)] = &[
     ("power", LightSelection::Power),
     ("uniform", LightSelection::Uniform),
+    ("objects", LightSelection::Objects),
 ];
 
 const SHADINGS: &[(&str, ShadingDesc)] = &[
@@ -617,6 +629,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "mirror",
             "near_clip",
             "far_clip",
+            "medium",
         ],
         &[],
     )?;
@@ -635,6 +648,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         mirror: t.optional("mirror", boolean)?.unwrap_or(false),
         near_clip: t.optional("near_clip", float)?.unwrap_or(d.near_clip),
         far_clip: t.optional("far_clip", float)?,
+        medium: t.optional("medium", string)?.map(str::to_string),
     })
 }
 

@@ -3,8 +3,8 @@
 
 use super::Format;
 use crate::scene::desc::{
-    BackgroundDesc, CameraDesc, LightDesc, MaterialDesc, ObjectDesc, RenderDesc, SceneDesc,
-    TextureDesc,
+    BackgroundDesc, CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, RenderDesc,
+    SceneDesc, TextureDesc,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -44,6 +44,7 @@ pub fn write_scene(desc: &SceneDesc, format: Format, out: &mut impl Write) -> io
                 textures: &desc.textures,
                 materials: &desc.materials,
                 lights: &desc.lights,
+                media: &desc.media,
             };
             out.write_all(TOML_HEADER.as_bytes())?;
             out.write_all(toml::to_string(&head).map_err(io::Error::other)?.as_bytes())?;
@@ -78,6 +79,8 @@ struct Head<'a> {
     materials: &'a BTreeMap<String, MaterialDesc>,
     #[serde(skip_serializing_if = "<[LightDesc]>::is_empty")]
     lights: &'a [LightDesc],
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    media: &'a BTreeMap<String, MediumDesc>,
 }
 
 /// One object, as a `[[objects]]` table.

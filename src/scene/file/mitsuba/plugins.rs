@@ -25,6 +25,8 @@ use crate::scene::desc::{
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+mod media;
+
 /// The plugins lumen reads, by tag, for messages.
 const SHAPES: &[&str] = &[
     "obj",
@@ -87,6 +89,11 @@ pub struct Convert<'d> {
     counter: usize,
     /// Where the background came from, when an emitter gave one.
     background: Option<&'d Element>,
+    /// Each medium element's medium, by its address.
+    media: HashMap<*const Element, String>,
+    /// Each material with media on its sides (material, interior,
+    /// exterior), by the names it was made from.
+    bounded: HashMap<(String, Option<String>, Option<String>), String>,
 }
 
 impl<'d> Convert<'d> {
@@ -103,6 +110,8 @@ impl<'d> Convert<'d> {
             textures: HashMap::new(),
             counter: 0,
             background: None,
+            media: HashMap::new(),
+            bounded: HashMap::new(),
         };
         fn gather<'d>(
             e: &'d Element,
@@ -141,7 +150,7 @@ impl<'d> Convert<'d> {
         cx.desc.render.samples_per_pixel = 4;
         cx.desc.render.max_depth = UNLIMITED_DEPTH;
         // Mitsuba 3 chooses among its emitters uniformly.
-        cx.desc.render.light_selection = crate::light::LightSelection::Uniform;
+        cx.desc.render.light_selection = crate::light::LightSelection::Objects;
         Ok(cx)
     }
 
@@ -290,14 +299,13 @@ impl<'d> Convert<'d> {
                         ));
                     }
                 }
-                "medium" | "phase" | "volume" => {
-                    return Err(self.fail(
-                        e,
-                        format!(
-                            "<{}>: participating media of Mitsuba scenes are not read yet",
-                            e.tag
-                        ),
-                    ))
+                "medium" => {
+                    if e.attr("id").is_none() {
+                        return Err(self.fail(
+                            e,
+                            "a <medium> outside a shape needs an `id` to be referred to".into(),
+                        ));
+                    }
                 }
                 other => {
                     let known = [
@@ -307,6 +315,7 @@ impl<'d> Convert<'d> {
                         "emitter",
                         "bsdf",
                         "texture",
+                        "medium",
                         "default",
                         "include",
                         "path",
@@ -885,10 +894,16 @@ impl<'d> Convert<'d> {
         // meshes keep it under a mirror; an instance's transform keeps it
         // in both.
         let winding_turned = flip != (transform::det3(&local) < 0.0);
-        if p.has("interior") || p.has("exterior") {
-            return Err(self.fail(e, "media inside or outside shapes are not read yet".into()));
+        let mut material = self.shape_material(e, &p)?;
+        let interior = p.peek("interior").map(|m| self.medium(m)).transpose()?;
+        let exterior = p.peek("exterior").map(|m| self.medium(m)).transpose()?;
+        if interior.is_some() || exterior.is_some() {
+            p.take("interior");
+            p.take("exterior");
+            let null = p.objects("bsdf").first().and_then(|b| b.attr("type")) == Some("null")
+                && p.objects("emitter").is_empty();
+            material = self.with_media(material, interior, exterior, null);
         }
-        let material = self.shape_material(e, &p)?;
         let matrix = |m: &Mat4| -> Vec<TransformDesc> {
             if *m == IDENTITY {
                 Vec::new()

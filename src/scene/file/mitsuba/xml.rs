@@ -265,7 +265,14 @@ impl Loader<'_> {
                             self.failure(e.at, "<include> needs a `filename` attribute".into())
                         );
                     };
-                    let included = dir.join(file);
+                    // Beside the including file, else where Mitsuba looks:
+                    // the scene's folder and the `<path>`s so far.
+                    let beside = dir.join(file);
+                    let included = std::iter::once(beside.clone())
+                        .chain(std::iter::once(self.root.join(file)))
+                        .chain(self.search.iter().rev().map(|d| d.join(file)))
+                        .find(|p| p.is_file())
+                        .unwrap_or(beside);
                     let elements = self.file(&included, Some((e.at, file)))?;
                     out.extend(elements);
                 }

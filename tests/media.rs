@@ -1,0 +1,170 @@
+//! Participating media that fill what surfaces enclose (`[media]`, a
+//! material's `interior` and `exterior`): checked against what they must
+//! give in closed form. Tolerances are K standard errors from each render's
+//! own per-pixel sample variance; seeds are fixed.
+
+mod common;
+
+use common::{compile_file, pixel_stats, scratch_dir, K};
+use lumen::scene::file::SceneFile;
+use lumen::scene::Overrides;
+
+/// A scene of a camera looking at a unit ball whose material is
+/// `material` (TOML fields), with `media` (TOML tables), under a white
+/// sky of radiance 1.
+fn ball(media: &str, material: &str, camera: &str, depth: u32) -> String {
+    format!(
+        "[render]\nwidth = 8\nheight = 8\nsamples_per_pixel = 256\nmax_depth = {depth}\nseed = 5\n\
+         [camera]\nlookfrom = [0, 0, 3]\nlookat = [0, 0, 0]\nvfov = 20\n{camera}\n\
+         [background]\ntype = \"solid\"\ncolor = [1, 1, 1]\n\
+         {media}\n\
+         [materials.ball]\n{material}\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"ball\"\n"
+    )
+}
+
+/// A white furnace: a medium that absorbs nothing, in a ball of no
+/// surface under a sky of 1, returns exactly 1 wherever it is seen, for a
+/// grey and a coloured extinction (whose channels are weighted apart).
+#[test]
+fn a_medium_that_absorbs_nothing_is_a_white_furnace() {
+    let dir = scratch_dir("media-furnace");
+    for sigma in ["2", "[0.5, 2, 6]"] {
+        let media = format!("[media.fog]\nsigma_t = {sigma}\nalbedo = 1");
+        let text = ball(&media, "type = \"interface\"\ninterior = \"fog\"", "", 1000);
+        let scene = compile_file(&dir, "furnace.toml", &text);
+        let stats = pixel_stats(&scene);
+        for c in 0..3 {
+            let (m, se) = stats.image(c);
+            assert!(
+                (m - 1.0).abs() <= K * se + 1e-6,
+                "σt {sigma}, channel {c}: {m} ± {se}"
+            );
+            assert!(se > 0.0 || m == 1.0, "σt {sigma}: no noise and not 1");
+        }
+    }
+}
+
+/// A ball of pure absorber seen against the sky: the centre pixels show
+/// e^(−σt·2) per channel (the chord through the centre is 2 long), with
+/// the medium entered through an interface, through a thin sheet of glass
+/// (whose two crossings let (1 − R′)² through at normal incidence) and
+/// with the camera inside it.
+#[test]
+fn an_absorber_lets_through_what_beer_lambert_says() {
+    let dir = scratch_dir("media-absorber");
+    let sigma = [0.3f64, 1.0, 2.0];
+    let media = format!("[media.ink]\nsigma_t = {sigma:?}\nalbedo = 0");
+    let scene = compile_file(
+        &dir,
+        "ink.toml",
+        &ball(&media, "type = \"interface\"\ninterior = \"ink\"", "", 8),
+    );
+    let stats = pixel_stats(&scene);
+    for (c, s) in sigma.iter().enumerate() {
+        let (m, se) = stats.region(3..5, 3..5, c);
+        // The central pixels' chords are 2 to within 0.3 %.
+        let want = (-s * 2.0).exp();
+        assert!(
+            (m - want).abs() <= K * se + 0.01 * want,
+            "interface, channel {c}: {m} ± {se} against {want}"
+        );
+    }
+    // The camera inside the ink sees the sky through 1 unit of it.
+    let scene = compile_file(
+        &dir,
+        "inside.toml",
+        &ball(
+            &media,
+            "type = \"interface\"\ninterior = \"ink\"",
+            "medium = \"ink\"",
+            8,
+        )
+        .replace("lookfrom = [0, 0, 3]", "lookfrom = [0, 0, 0.001]")
+        .replace("lookat = [0, 0, 0]", "lookat = [0, 0, -1]"),
+    );
+    let stats = pixel_stats(&scene);
+    for (c, s) in sigma.iter().enumerate() {
+        let (m, se) = stats.region(3..5, 3..5, c);
+        let want = (-s * 1.001).exp();
+        assert!(
+            (m - want).abs() <= K * se + 0.01 * want,
+            "camera inside, channel {c}: {m} ± {se} against {want}"
+        );
+    }
+}
+
+/// Thin glass around a medium lets shadow rays through: a ball of thin
+/// glass holding a white fog, lit by the sky, gives the same image whether
+/// paths find the sky by sampling it or only by their bounces.
+#[test]
+fn light_sampled_through_thin_glass_agrees_with_the_bounces() {
+    let dir = scratch_dir("media-thin");
+    let media = "[media.fog]\nsigma_t = 1.5\nalbedo = [0.9, 0.6, 0.3]";
+    let material = "type = \"dielectric\"\nior = 1.5\nthin = true\ninterior = \"fog\"";
+    let text = ball(media, material, "", 12);
+    let sampled = text.replace("seed = 5", "seed = 5\nsample_background = true");
+    let bounces = text.replace("seed = 5", "seed = 9\nintegrator = \"bsdf\"");
+    let a = pixel_stats(&compile_file(&dir, "a.toml", &sampled));
+    let b = pixel_stats(&compile_file(&dir, "b.toml", &bounces));
+    for c in 0..3 {
+        common::assert_agree(
+            &format!("channel {c}"),
+            a.region(2..6, 2..6, c),
+            b.region(2..6, 2..6, c),
+        );
+    }
+}
+
+/// What is wrong with a medium or a reference to one is named.
+#[test]
+fn bad_media_are_refused_with_the_field() {
+    let dir = scratch_dir("media-errors");
+    let fail = |media: &str, material: &str, camera: &str| -> String {
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, ball(media, material, camera, 4)).unwrap();
+        match SceneFile::read(&path).and_then(|f| f.compile(&Overrides::default())) {
+            Ok(_) => panic!("accepted: {media} / {material} / {camera}"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let fog = "[media.fog]\nsigma_t = 1\nalbedo = 0.5";
+    let e = fail(fog, "type = \"interface\"\ninterior = \"smoke\"", "");
+    assert!(
+        e.contains("materials.ball.interior") && e.contains("smoke") && e.contains("fog"),
+        "{e}"
+    );
+    let e = fail(
+        fog,
+        "type = \"diffuse\"\nalbedo = [1, 1, 1]",
+        "medium = \"mist\"",
+    );
+    assert!(e.contains("camera.medium") && e.contains("mist"), "{e}");
+    let e = fail(
+        "[media.fog]\nsigma_t = 1\nalbedo = 1.5",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(e.contains("media.fog.albedo"), "{e}");
+    let e = fail(
+        "[media.fog]\nsigma_t = -1\nalbedo = 0.5",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(e.contains("media.fog.sigma_t"), "{e}");
+    let e = fail(
+        "[media.fog]\nsigma_t = { grid = \"missing.vol\" }\nalbedo = 0.5",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(
+        e.contains("media.fog.sigma_t.grid") && e.contains("missing.vol"),
+        "{e}"
+    );
+    let e = fail(
+        "[media.fog]\nsigma_t = 1\nalbedo = 0.5\ncolour = 3",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(e.contains("colour"), "{e}");
+}
