@@ -9,12 +9,12 @@ use crate::geometry::HitRecord;
 use crate::halt::Halt;
 use crate::material::Material;
 use crate::math::{Color, Interval, Point3, Vec3};
-use crate::medium::{Medium, ISOTROPIC_PDF};
+use crate::medium::ISOTROPIC_PDF;
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
-use crate::volume::{self, Event};
+use crate::volume::Event;
 
 /// Paths traced side by side by [`trace_paths`].
 pub const PATHS: usize = 32;
@@ -115,7 +115,7 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 ///
 /// In a scene with [`volumes`](Scene::volumes) the path also travels
 /// through the medium it is in, which may scatter it before the surface
-/// (see [`volume::Volume::sample`]), and it crosses interfaces and thin
+/// (see [`crate::volume::Volume::sample`]), and it crosses interfaces and thin
 /// glass straight on without counting a bounce, into the medium beyond.
 #[inline(always)]
 fn step(
@@ -179,7 +179,7 @@ fn through_media(
         }
         Event::Scatter { t, weight } => {
             path.throughput *= weight;
-            Some(scatter_in_volume(scene, ray, t, depth, path, sampler))
+            Some(scatter_at(scene, ray, t, Color::ONE, depth, path, sampler))
         }
         Event::Absorbed => Some(Step::Done(path.radiance)),
     }
@@ -280,47 +280,6 @@ fn cross(
     Bounce::Cross(Ray::timed(record.spawn_origin(d), d, ray.time()), hit)
 }
 
-/// A path meets a particle of the medium it travels in at distance `t`
-/// along `ray` (the end of segment `depth`), its throughput already
-/// weighted: it samples a light from there, and goes on in a direction
-/// drawn from the isotropic phase function.
-#[inline(never)]
-fn scatter_in_volume(
-    scene: &Scene,
-    ray: &Ray,
-    t: f32,
-    depth: u32,
-    path: &mut PathState,
-    sampler: &mut impl Sampler,
-) -> Step {
-    if depth + 1 >= scene.settings.max_depth {
-        return Step::Done(path.radiance);
-    }
-    let point = ray.at(t);
-    let nee = samples_lights(scene, depth);
-    if nee {
-        let medium = path.medium;
-        let (light, traced) = direct_light(
-            scene,
-            point,
-            ray.time(),
-            |_| (Color::splat(volume::ISOTROPIC), volume::ISOTROPIC),
-            |_| point,
-            |_| medium,
-            None,
-            sampler,
-        );
-        path.radiance += path.throughput * light;
-        path.shadow_rays += u64::from(traced);
-    }
-    let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
-    path.sampled_from = nee.then_some((point, volume::ISOTROPIC));
-    if !goes_on(scene, depth, path, sampler) {
-        return Step::Done(path.radiance);
-    }
-    Step::Continue(Ray::timed(point, direction, ray.time()), None)
-}
-
 /// The radiance of the discs of the sky (directional lights with an
 /// angular radius) seen along unit `direction` by an escaping ray, each
 /// weighted, where the segment's start sampled a light (`sampled_from`),
@@ -392,7 +351,7 @@ fn light_at_surface(
 }
 
 /// Whether `ray` meets a particle of the scene's media before `hit`: if it
-/// does, the path scatters there (see [`scatter_in_medium`]).
+/// does, the path scatters there (see [`scatter_at`]).
 #[inline(never)]
 fn meet_media(
     scene: &Scene,
@@ -405,31 +364,30 @@ fn meet_media(
     sampler.start_bounce(depth);
     let t_max = hit.map_or(f32::INFINITY, |h| h.t);
     let (t, i) = scene.medium_event(ray, t_max, sampler)?;
-    Some(scatter_in_medium(
-        scene,
-        ray,
-        t,
-        &scene.media[i],
-        depth,
-        path,
-        sampler,
-    ))
+    let albedo = scene.media[i].albedo;
+    Some(scatter_at(scene, ray, t, albedo, depth, path, sampler))
 }
 
-/// A path meets a particle of `medium` at distance `t` along `ray` (the end
-/// of segment `depth`): with the `path` integrator it samples a light from
-/// there, and it goes on in a direction drawn from the isotropic phase
-/// function, its throughput multiplied by the medium's albedo.
-#[inline(always)]
-fn scatter_in_medium(
+/// A path meets a particle at distance `t` along `ray` (the end of
+/// segment `depth`), which scatters `albedo` of the light (1 for a medium
+/// whose tracking weighted the throughput already): with the `path`
+/// integrator it samples a light from there, and it goes on in a direction
+/// drawn from the isotropic phase function, its throughput multiplied by
+/// the albedo.
+#[inline(never)]
+fn scatter_at(
     scene: &Scene,
     ray: &Ray,
     t: f32,
-    medium: &Medium,
+    albedo: Color,
     depth: u32,
     path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Step {
+    // The last segment's scattering could only start a ray never traced.
+    if depth + 1 >= scene.settings.max_depth {
+        return Step::Done(path.radiance);
+    }
     let point = ray.at(t);
     let nee = samples_lights(scene, depth);
     if nee {
@@ -438,7 +396,7 @@ fn scatter_in_medium(
             scene,
             point,
             ray.time(),
-            |_| (medium.albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
+            |_| (albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
             |_| point,
             |_| inside,
             None,
@@ -449,7 +407,7 @@ fn scatter_in_medium(
     }
     let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
     path.sampled_from = nee.then_some((point, ISOTROPIC_PDF));
-    path.throughput *= medium.albedo;
+    path.throughput *= albedo;
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);
     }

@@ -8,7 +8,8 @@
 //! meets a particle, per colour channel) and its single-scattering albedo
 //! (the share of that light a particle scatters rather than absorbs), each
 //! a constant or a voxel [`Grid`]; particles scatter equally in every
-//! direction.
+//! direction (the isotropic phase function,
+//! [`ISOTROPIC_PDF`](crate::medium::ISOTROPIC_PDF)).
 //!
 //! Along a ray, [`Volume::sample`] decides whether light met a particle
 //! before the next surface, and where:
@@ -35,11 +36,7 @@ use crate::geometry::transform::Transform;
 use crate::math::{Color, Point3};
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
-use std::f32::consts::PI;
 use std::path::Path;
-
-/// The density per unit solid angle of the isotropic phase function.
-pub const ISOTROPIC: f32 = 1.0 / (4.0 * PI);
 
 /// The most tentative collisions a ray's tracking takes before it counts
 /// the ray as absorbed: a bound on the work of a ray through a dense grid

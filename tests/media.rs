@@ -60,16 +60,8 @@ fn an_absorber_lets_through_what_beer_lambert_says() {
         "ink.toml",
         &ball(&media, "type = \"interface\"\ninterior = \"ink\"", "", 8),
     );
-    let stats = pixel_stats(&scene);
-    for (c, s) in sigma.iter().enumerate() {
-        let (m, se) = stats.region(3..5, 3..5, c);
-        // The central pixels' chords are 2 to within 0.3 %.
-        let want = (-s * 2.0).exp();
-        assert!(
-            (m - want).abs() <= K * se + 0.01 * want,
-            "interface, channel {c}: {m} ± {se} against {want}"
-        );
-    }
+    // The central pixels' chords are 2 to within 0.3 %.
+    assert_through(&pixel_stats(&scene), sigma, 2.0, "interface");
     // The camera inside the ink sees the sky through 1 unit of it.
     let scene = compile_file(
         &dir,
@@ -83,13 +75,18 @@ fn an_absorber_lets_through_what_beer_lambert_says() {
         .replace("lookfrom = [0, 0, 3]", "lookfrom = [0, 0, 0.001]")
         .replace("lookat = [0, 0, 0]", "lookat = [0, 0, -1]"),
     );
-    let stats = pixel_stats(&scene);
+    assert_through(&pixel_stats(&scene), sigma, 1.001, "camera inside");
+}
+
+/// The central pixels of `stats` show e^(−σt·`length`) per channel, within
+/// K standard errors and 1 % (the spread of their chords' lengths).
+fn assert_through(stats: &common::PixelStats, sigma: [f64; 3], length: f64, what: &str) {
     for (c, s) in sigma.iter().enumerate() {
         let (m, se) = stats.region(3..5, 3..5, c);
-        let want = (-s * 1.001).exp();
+        let want = (-s * length).exp();
         assert!(
             (m - want).abs() <= K * se + 0.01 * want,
-            "camera inside, channel {c}: {m} ± {se} against {want}"
+            "{what}, channel {c}: {m} ± {se} against {want}"
         );
     }
 }
