@@ -128,8 +128,10 @@ fn step(
 ) -> Step {
     let (mut ray, mut hit) = (*ray, hit);
     for _ in 0..MAX_CROSSINGS {
-        if let Some(step) = through_media(scene, &ray, hit, depth, path, sampler) {
-            return step;
+        if !scene.media.is_empty() || path.medium.is_some() {
+            if let Some(step) = through_media(scene, &ray, hit, depth, path, sampler) {
+                return step;
+            }
         }
         match bounce(scene, &ray, hit, depth, path, sampler) {
             Bounce::Step(step) => return step,
@@ -152,10 +154,12 @@ enum Bounce {
     Cross(Ray, Hit),
 }
 
-/// The media `ray` crosses before `hit`: the scene's fog, then the
+/// The media `ray` crosses before `hit`: the scene's fog (each draws how
+/// far the ray gets into it, and the nearest particle counts), then the
 /// medium the path is in. A step where a particle scatters or absorbs the
-/// path; otherwise the throughput takes what got through.
-#[inline(always)]
+/// path (see [`scatter_at`]); otherwise the throughput takes what got
+/// through.
+#[inline(never)]
 fn through_media(
     scene: &Scene,
     ray: &Ray,
@@ -164,14 +168,13 @@ fn through_media(
     path: &mut PathState,
     sampler: &mut impl Sampler,
 ) -> Option<Step> {
-    if !scene.media.is_empty() {
-        if let Some(step) = meet_media(scene, ray, hit, depth, path, sampler) {
-            return Some(step);
-        }
-    }
-    let medium = path.medium?;
     sampler.start_bounce(depth);
     let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+    if let Some((t, i)) = scene.medium_event(ray, t_max, sampler) {
+        let albedo = scene.media[i].albedo;
+        return Some(scatter_at(scene, ray, t, albedo, depth, path, sampler));
+    }
+    let medium = path.medium?;
     match scene.volumes[medium as usize].sample(ray, t_max, sampler) {
         Event::Pass { weight } => {
             path.throughput *= weight;
@@ -334,38 +337,20 @@ fn light_at_surface(
     path: &PathState,
     sampler: &mut impl Sampler,
 ) -> (Color, bool) {
-    let sides = scene.material(record).media;
     direct_light(
         scene,
         record.point,
         time,
         |wi| bsdf.eval_and_pdf(wo, wi),
         |wi| record.spawn_origin(wi),
-        |wi| match sides {
+        // Asked only in scenes with media.
+        |wi| match scene.material(record).media {
             Some(s) => s.beyond(record.outward_normal(), wi),
             None => path.medium,
         },
         Some(hit),
         sampler,
     )
-}
-
-/// Whether `ray` meets a particle of the scene's media before `hit`: if it
-/// does, the path scatters there (see [`scatter_at`]).
-#[inline(never)]
-fn meet_media(
-    scene: &Scene,
-    ray: &Ray,
-    hit: Option<Hit>,
-    depth: u32,
-    path: &mut PathState,
-    sampler: &mut impl Sampler,
-) -> Option<Step> {
-    sampler.start_bounce(depth);
-    let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-    let (t, i) = scene.medium_event(ray, t_max, sampler)?;
-    let albedo = scene.media[i].albedo;
-    Some(scatter_at(scene, ray, t, albedo, depth, path, sampler))
 }
 
 /// A path meets a particle at distance `t` along `ray` (the end of

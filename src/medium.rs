@@ -37,7 +37,7 @@ pub enum Boundary {
 impl Boundary {
     /// The parameters `(t0, t1)` between which the line `origin + t·direction`
     /// (any direction length) is inside, if it ever is.
-    fn span(&self, ray: &Ray) -> Option<(f32, f32)> {
+    pub(crate) fn span(&self, ray: &Ray) -> Option<(f32, f32)> {
         let (o, d) = (ray.origin(), ray.direction);
         match *self {
             Boundary::Sphere { center, radius } => {

@@ -34,6 +34,7 @@
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::Transform;
 use crate::math::{Color, Point3};
+use crate::medium::Boundary;
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use std::path::Path;
@@ -272,7 +273,7 @@ pub struct Volume {
     /// Where the medium is, in the world: outside this box there is
     /// nothing (a medium whose extinction is a grid fills that grid's box
     /// only, as in Mitsuba); `None`: everywhere.
-    bounds: Option<Aabb>,
+    bounds: Option<Boundary>,
     /// The largest extinction of any channel anywhere: the rate of
     /// tentative collisions.
     majorant: f32,
@@ -292,7 +293,10 @@ impl Volume {
         Volume {
             sigma_t,
             albedo,
-            bounds,
+            bounds: bounds.map(|b| Boundary::Box {
+                min: b.min,
+                max: b.max,
+            }),
             majorant,
         }
     }
@@ -304,12 +308,8 @@ impl Volume {
         let Some(b) = &self.bounds else {
             return Some((0.0, t_max));
         };
-        let inverse = ray.direction.recip();
-        let o = ray.origin();
-        let (a, c) = ((b.min - o) * inverse, (b.max - o) * inverse);
-        // NaN (a ray in a face's plane, parallel to it) loses to numbers.
-        let near = a.min(c).max_element().max(0.0);
-        let far = a.max(c).min_element().min(t_max);
+        let (near, far) = b.span(ray)?;
+        let (near, far) = (near.max(0.0), far.min(t_max));
         (near < far).then_some((near, far))
     }
 
@@ -356,16 +356,11 @@ impl Volume {
                 Event::Absorbed
             };
         }
-        let length = end - start;
-        let through = Color::new(
-            through(sigma_t.x, length),
-            through(sigma_t.y, length),
-            through(sigma_t.z, length),
-        );
-        let chance = mean(through);
+        let passed = through(sigma_t, end - start);
+        let chance = mean(passed);
         if chance > 0.0 {
             Event::Pass {
-                weight: through / chance,
+                weight: passed / chance,
             }
         } else {
             Event::Absorbed
@@ -417,13 +412,8 @@ impl Volume {
         let Some((start, end)) = self.span(ray, t_max) else {
             return Color::ONE;
         };
-        let length = end - start;
         match &self.sigma_t {
-            Field::Constant(s) => Color::new(
-                through(s.x, length),
-                through(s.y, length),
-                through(s.z, length),
-            ),
+            Field::Constant(s) => through(*s, end - start),
             Field::Grid(_) => {
                 let mu = self.majorant;
                 let mut t = start;
@@ -448,14 +438,12 @@ impl Volume {
     }
 }
 
-/// e^{−σℓ}, 1 where nothing attenuates (even over an infinite length).
+/// e^{−σℓ} per channel, 1 where nothing attenuates (even over an
+/// infinite length).
 #[inline]
-fn through(sigma: f32, length: f32) -> f32 {
-    if sigma > 0.0 {
-        (-sigma * length).exp()
-    } else {
-        1.0
-    }
+fn through(sigma: Color, length: f32) -> Color {
+    let channel = |s: f32| if s > 0.0 { (-s * length).exp() } else { 1.0 };
+    Color::new(channel(sigma.x), channel(sigma.y), channel(sigma.z))
 }
 
 #[cfg(test)]

@@ -228,7 +228,6 @@ fn erf_inv(x: f32) -> f32 {
 /// method kept within a bisection bracket, in the domain of erf), the
 /// second a Gaussian.
 fn beckmann_visible_slopes(cos_theta: f32, u: [f32; 2]) -> (f32, f32) {
-    let across = erf_inv(2.0 * u[1].max(1e-6) - 1.0);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     if sin_theta < 1e-4 {
         // Seen from straight above, the visible slopes are the slopes (a
@@ -265,7 +264,7 @@ fn beckmann_visible_slopes(cos_theta: f32, u: [f32; 2]) -> (f32, f32) {
         }
         b -= value / (norm * (1.0 - slope * tan_theta));
     }
-    (erf_inv(b), across)
+    (erf_inv(b), erf_inv(2.0 * u[1].max(1e-6) - 1.0))
 }
 
 #[cfg(test)]

@@ -303,6 +303,7 @@ impl Lights {
         powers.extend(sources.iter().map(|s| s.power(scene_radius)));
         powers.extend(environment.as_ref().map(|(integral, _)| integral * disc));
         let environment = environment.map(|(_, e)| e);
+        let surfaces: Vec<Surface> = lights.iter().map(|l| Surface::of(&l.shape)).collect();
         match selection {
             LightSelection::Power => {}
             LightSelection::Uniform => {
@@ -313,17 +314,16 @@ impl Lights {
             LightSelection::Objects => {
                 // Each object's share is 1, split among its parts by area.
                 let mut areas: std::collections::HashMap<u32, f64> = Default::default();
-                let area = |l: &Light| f64::from(Surface::of(&l.shape).area);
-                for (l, p) in lights.iter().zip(&powers) {
+                for ((l, s), p) in lights.iter().zip(&surfaces).zip(&powers) {
                     if *p > 0.0 {
-                        *areas.entry(l.object).or_default() += area(l);
+                        *areas.entry(l.object).or_default() += f64::from(s.area);
                     }
                 }
                 for (i, p) in powers.iter_mut().enumerate() {
-                    *p = match lights.get(i) {
+                    *p = match (lights.get(i), surfaces.get(i)) {
                         _ if *p <= 0.0 => 0.0,
-                        Some(l) => area(l) / areas[&l.object],
-                        None => 1.0,
+                        (Some(l), Some(s)) => f64::from(s.area) / areas[&l.object],
+                        _ => 1.0,
                     };
                 }
             }
@@ -340,7 +340,7 @@ impl Lights {
             Vec::new()
         };
         Lights {
-            surfaces: lights.iter().map(|l| Surface::of(&l.shape)).collect(),
+            surfaces,
             lights,
             textures,
             sources_seen: sources.iter().any(LightSource::is_visible),

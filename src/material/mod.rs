@@ -883,8 +883,12 @@ impl Material {
     /// interface, what a thin sheet of glass lets through, none elsewhere.
     /// What a shadow ray carries past it in a scene with media.
     pub fn straight_through(&self, hit: &HitRecord, wo: Vec3, textures: &[Texture]) -> Color {
-        if self.is_interface() {
-            return Color::ONE;
+        match self.kind {
+            Kind::Interface => return Color::ONE,
+            // Only glass (or a mix holding some) can be a thin sheet: the
+            // rest block without their scattering worked out.
+            Kind::Dielectric(_) | Kind::Mix(_) => {}
+            _ => return Color::ZERO,
         }
         match self.bsdf(hit, wo, textures).map(|b| b.lobe) {
             Some(Lobe::ThinDielectric(sheet)) => {

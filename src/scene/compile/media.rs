@@ -1,10 +1,9 @@
 //! The scene's participating media (`[media]`), and the names by which
 //! materials and the camera refer to them.
 
-use super::{finite, invalid, model_path, transform_at, vec3};
+use super::{albedo, color, finite, invalid, model_path, transform_at, vec3};
 use crate::geometry::bvh_build::Aabb;
 use crate::material::{MaterialDesc, MediumInterface};
-use crate::math::Color;
 use crate::scene::desc::{FieldDesc, MediumDesc, SceneDesc};
 use crate::scene::SceneError;
 use crate::volume::{Field, Grid, Volume};
@@ -84,8 +83,8 @@ fn medium(field: &str, m: &MediumDesc, base: &Path) -> Result<Volume, SceneError
         None => 1.0,
     };
     let at = |name: &str| format!("{field}.{name}");
-    let sigma_t = quantity(&at("sigma_t"), &m.sigma_t, scale, None, base)?;
-    let albedo = quantity(&at("albedo"), &m.albedo, 1.0, Some(1.0), base)?;
+    let sigma_t = quantity(&at("sigma_t"), &m.sigma_t, scale, false, base)?;
+    let albedo = quantity(&at("albedo"), &m.albedo, 1.0, true, base)?;
     let bounds = match (&m.bounds, &sigma_t) {
         (Some(b), _) => {
             let field = at("box");
@@ -105,28 +104,22 @@ fn medium(field: &str, m: &MediumDesc, base: &Path) -> Result<Volume, SceneError
     Ok(Volume::new(sigma_t, albedo, bounds))
 }
 
-/// A quantity of a medium at `field`, multiplied by `factor`; at most
-/// `max`, where it has one.
+/// A quantity of a medium at `field`, multiplied by `factor`: ≥ 0, and
+/// at most 1 where it is an `albedo`.
 fn quantity(
     field: &str,
     d: &FieldDesc,
     factor: f32,
-    max: Option<f64>,
+    is_albedo: bool,
     base: &Path,
 ) -> Result<Field, SceneError> {
     let constant = |c: [f64; 3]| {
-        finite(field, &c)?;
-        let fits = |v: f64| v >= 0.0 && max.is_none_or(|m| v <= m);
-        if !c.iter().all(|&v| fits(v)) {
-            let range = match max {
-                Some(m) => format!("in [0, {m}]"),
-                None => "≥ 0".to_string(),
-            };
-            return Err(invalid(field, format!("must be {range}, got {c:?}")));
-        }
-        Ok(Field::Constant(
-            Color::new(c[0] as f32, c[1] as f32, c[2] as f32) * factor,
-        ))
+        let value = if is_albedo {
+            albedo(field, c)?
+        } else {
+            color(field, c)?
+        };
+        Ok(Field::Constant(value * factor))
     };
     match d {
         FieldDesc::Value(v) => constant([*v; 3]),
@@ -142,13 +135,11 @@ fn quantity(
             let path = model_path(base, &g.grid);
             let grid = Grid::read(&path, factor, transform)
                 .map_err(|e| invalid(format!("{field}.grid"), format!("{}: {e}", g.grid)))?;
-            if let Some(m) = max {
-                if grid.max() > m as f32 {
-                    return Err(invalid(
-                        format!("{field}.grid"),
-                        format!("{}: holds {}, above {m}", g.grid, grid.max()),
-                    ));
-                }
+            if is_albedo && grid.max() > 1.0 {
+                return Err(invalid(
+                    format!("{field}.grid"),
+                    format!("{}: holds {}, above 1", g.grid, grid.max()),
+                ));
             }
             Ok(Field::Grid(Box::new(grid)))
         }

@@ -78,7 +78,7 @@ pub(super) fn color(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
     Ok(vec3(c))
 }
 
-fn albedo(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
+pub(super) fn albedo(field: &str, c: [f64; 3]) -> Result<Color, SceneError> {
     let v = color(field, c)?;
     if c.iter().any(|&x| x > 1.0) {
         return Err(invalid(
