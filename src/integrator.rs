@@ -9,10 +9,9 @@ use crate::geometry::HitRecord;
 use crate::halt::Halt;
 use crate::material::Material;
 use crate::math::{Color, Interval, Point3, Vec3};
-use crate::medium::ISOTROPIC_PDF;
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
-use crate::sampling;
 use crate::scene::{Integrator, Scene, Shading};
 use crate::volume::Event;
 
@@ -172,17 +171,31 @@ fn through_media(
     let t_max = hit.map_or(f32::INFINITY, |h| h.t);
     if let Some((t, i)) = scene.medium_event(ray, t_max, sampler) {
         let albedo = scene.media[i].albedo;
-        return Some(scatter_at(scene, ray, t, albedo, depth, path, sampler));
+        let phase = Phase::Isotropic;
+        return Some(scatter_at(
+            scene, ray, t, albedo, phase, depth, path, sampler,
+        ));
     }
     let medium = path.medium?;
-    match scene.volumes[medium as usize].sample(ray, t_max, sampler) {
+    let volume = &scene.volumes[medium as usize];
+    match volume.sample(ray, t_max, sampler) {
         Event::Pass { weight } => {
             path.throughput *= weight;
             None
         }
         Event::Scatter { t, weight } => {
             path.throughput *= weight;
-            Some(scatter_at(scene, ray, t, Color::ONE, depth, path, sampler))
+            let phase = volume.phase;
+            Some(scatter_at(
+                scene,
+                ray,
+                t,
+                Color::ONE,
+                phase,
+                depth,
+                path,
+                sampler,
+            ))
         }
         Event::Absorbed => Some(Step::Done(path.radiance)),
     }
@@ -355,16 +368,18 @@ fn light_at_surface(
 
 /// A path meets a particle at distance `t` along `ray` (the end of
 /// segment `depth`), which scatters `albedo` of the light (1 for a medium
-/// whose tracking weighted the throughput already): with the `path`
-/// integrator it samples a light from there, and it goes on in a direction
-/// drawn from the isotropic phase function, its throughput multiplied by
+/// whose tracking weighted the throughput already) by `phase`: with the
+/// `path` integrator it samples a light from there, and it goes on in a
+/// direction drawn from the phase function, its throughput multiplied by
 /// the albedo.
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn scatter_at(
     scene: &Scene,
     ray: &Ray,
     t: f32,
     albedo: Color,
+    phase: Phase,
     depth: u32,
     path: &mut PathState,
     sampler: &mut impl Sampler,
@@ -381,7 +396,10 @@ fn scatter_at(
             scene,
             point,
             ray.time(),
-            |_| (albedo * ISOTROPIC_PDF, ISOTROPIC_PDF),
+            |wi| {
+                let p = phase.pdf(ray.direction, wi);
+                (albedo * p, p)
+            },
             |_| point,
             |_| inside,
             None,
@@ -390,8 +408,8 @@ fn scatter_at(
         path.radiance += path.throughput * light;
         path.shadow_rays += u64::from(traced);
     }
-    let direction = sampling::unit_vector(sampler.get_2d(Dim::Bsdf));
-    path.sampled_from = nee.then_some((point, ISOTROPIC_PDF));
+    let (direction, pdf) = phase.sample(ray.direction, sampler.get_2d(Dim::Bsdf));
+    path.sampled_from = nee.then_some((point, pdf));
     path.throughput *= albedo;
     if !goes_on(scene, depth, path, sampler) {
         return Step::Done(path.radiance);

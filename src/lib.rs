@@ -80,6 +80,7 @@ pub mod memory;
 pub mod mesh;
 pub mod output;
 pub mod part;
+pub mod phase;
 pub mod progressive;
 pub mod ray;
 pub mod render;

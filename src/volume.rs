@@ -7,9 +7,8 @@
 //! A medium is its extinction σt (the chance per unit length that light
 //! meets a particle, per colour channel) and its single-scattering albedo
 //! (the share of that light a particle scatters rather than absorbs), each
-//! a constant or a voxel [`Grid`]; particles scatter equally in every
-//! direction (the isotropic phase function,
-//! [`ISOTROPIC_PDF`](crate::medium::ISOTROPIC_PDF)).
+//! a constant or a voxel [`Grid`]; and its [`Phase`] function, how its
+//! particles spread the light they scatter over directions.
 //!
 //! Along a ray, [`Volume::sample`] decides whether light met a particle
 //! before the next surface, and where:
@@ -35,6 +34,7 @@ use crate::geometry::bvh_build::Aabb;
 use crate::geometry::transform::Transform;
 use crate::math::{Color, Point3};
 use crate::medium::Boundary;
+use crate::phase::Phase;
 use crate::ray::Ray;
 use crate::sampler::{Dim, Sampler};
 use std::path::Path;
@@ -277,6 +277,8 @@ pub struct Volume {
     /// The largest extinction of any channel anywhere: the rate of
     /// tentative collisions.
     majorant: f32,
+    /// How particles scatter: isotropic unless set.
+    pub phase: Phase,
 }
 
 /// The mean of a colour's channels.
@@ -298,7 +300,13 @@ impl Volume {
                 max: b.max,
             }),
             majorant,
+            phase: Phase::Isotropic,
         }
+    }
+
+    /// The medium with particles that scatter by `phase`.
+    pub fn with_phase(self, phase: Phase) -> Volume {
+        Volume { phase, ..self }
     }
 
     /// The part `[start, end)` of `[0, t_max)` along `ray` inside the

@@ -113,6 +113,68 @@ fn light_sampled_through_thin_glass_agrees_with_the_bounces() {
     }
 }
 
+/// Particles that scatter forward or back (Henyey–Greenstein): light
+/// found by sampling the sky and light found only by the bounces agree, so
+/// the density a scattering is sampled with is the one light sampling
+/// weighs it by.
+#[test]
+fn forward_and_back_scattering_agree_between_estimators() {
+    let dir = scratch_dir("media-hg");
+    for g in ["0.7", "-0.6"] {
+        let media = format!("[media.fog]\nsigma_t = 2\nalbedo = [0.95, 0.8, 0.5]\ng = {g}");
+        let material = "type = \"interface\"\ninterior = \"fog\"";
+        let text = ball(&media, material, "", 12);
+        let sampled = text.replace("seed = 5", "seed = 5\nsample_background = true");
+        let bounces = text.replace("seed = 5", "seed = 9\nintegrator = \"bsdf\"");
+        let a = pixel_stats(&compile_file(&dir, "a.toml", &sampled));
+        let b = pixel_stats(&compile_file(&dir, "b.toml", &bounces));
+        for c in 0..3 {
+            common::assert_agree(
+                &format!("g = {g}, channel {c}"),
+                a.region(2..6, 2..6, c),
+                b.region(2..6, 2..6, c),
+            );
+        }
+    }
+}
+
+/// Single scattering of sunlight in a slab, seen from the camera through
+/// it: with paths of two segments (the camera's and the shadow ray), the
+/// image is ∫ σs E p(θ) e^(−σt t) e^(−σt (1 − t)/cos θ) dt over the slab's
+/// depth, θ the angle between the sunlight and the view. Forward
+/// scattering (g > 0, the sun behind the slab) brightens it by the
+/// Henyey–Greenstein factor, back scattering dims it.
+#[test]
+fn sunlight_scattered_once_in_a_slab_follows_the_phase_function() {
+    let dir = scratch_dir("media-slab");
+    let (sigma_t, albedo, irradiance) = (0.5f64, 0.8f64, 2.0f64);
+    // The sun 30° off the view axis, behind the slab.
+    let cos = 30f64.to_radians().cos();
+    for g in [0.0f64, 0.6, -0.6] {
+        let text = format!(
+            "[render]\nwidth = 4\nheight = 4\nsamples_per_pixel = 1024\nmax_depth = 2\nseed = 3\n\
+             [camera]\nlookfrom = [0, 0, -5]\nlookat = [0, 0, 0]\nvfov = 1\nmedium = \"slab\"\n\
+             [background]\ntype = \"solid\"\ncolor = [0, 0, 0]\n\
+             [media.slab]\nsigma_t = {sigma_t}\nalbedo = {albedo}\ng = {g}\n\
+             box = {{ min = [-100, -100, 0], max = [100, 100, 1] }}\n\
+             [[lights]]\ntype = \"directional\"\ndirection = [{}, 0, {}]\nirradiance = [{irradiance}, {irradiance}, {irradiance}]\n",
+            (1.0 - cos * cos).sqrt(),
+            -cos
+        );
+        let stats = pixel_stats(&compile_file(&dir, "slab.toml", &text));
+        let phase =
+            (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * cos).powf(1.5));
+        let k = sigma_t * (1.0 / cos - 1.0);
+        let depth_integral = (-sigma_t / cos).exp() * (k.exp() - 1.0) / k;
+        let want = sigma_t * albedo * irradiance * phase * depth_integral;
+        let (m, se) = stats.image(1);
+        assert!(
+            (m - want).abs() <= K * se,
+            "g = {g}: {m} ± {se} against {want}"
+        );
+    }
+}
+
 /// What is wrong with a medium or a reference to one is named.
 #[test]
 fn bad_media_are_refused_with_the_field() {
@@ -164,4 +226,10 @@ fn bad_media_are_refused_with_the_field() {
         "",
     );
     assert!(e.contains("colour"), "{e}");
+    let e = fail(
+        "[media.fog]\nsigma_t = 1\nalbedo = 0.5\ng = 1",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(e.contains("media.fog.g") && e.contains("0.999"), "{e}");
 }

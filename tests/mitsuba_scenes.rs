@@ -1137,3 +1137,54 @@ fn a_conductors_index_of_refraction_may_be_textured() {
     assert!(close(seen[0].0, 0.2) && close(seen[0].1, 0.7), "{seen:?}");
     assert!(close(seen[1].0, 0.9) && close(seen[1].1, 0.5), "{seen:?}");
 }
+
+/// A medium's Henyey–Greenstein phase (`hg`, its `g` 0.8 when absent) and
+/// the medium a sensor stands in are read, exported and read back alike;
+/// other phase functions are refused with what lumen has.
+#[test]
+fn phase_functions_and_the_sensors_medium_are_read() {
+    let dir = scratch_dir("mitsuba_scenes_phase");
+    let body = |phase: &str| {
+        scene(&format!(
+            "  <medium type=\"homogeneous\" id=\"fog\">\
+             <float name=\"sigma_t\" value=\"0.5\"/>{phase}</medium>\
+             <medium type=\"homogeneous\" id=\"mist\">\
+             <float name=\"sigma_t\" value=\"0.1\"/><phase type=\"hg\"/></medium>\
+             <sensor type=\"perspective\"><ref id=\"mist\"/>\
+             <film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>\
+             <integer name=\"height\" value=\"4\"/></film></sensor>\
+             <emitter type=\"constant\"/>\
+             <shape type=\"sphere\"><bsdf type=\"null\"/>\
+             <ref name=\"interior\" id=\"fog\"/><ref name=\"exterior\" id=\"mist\"/></shape>"
+        ))
+    };
+    let path = dir.join("s.xml");
+    std::fs::write(
+        &path,
+        body("<phase type=\"hg\"><float name=\"g\" value=\"-0.3\"/></phase>"),
+    )
+    .unwrap();
+    let file =
+        SceneFile::read_with(&path, &mitsuba::Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let desc = &file.desc;
+    assert_eq!(desc.media["fog"].g, Some(-0.3));
+    assert_eq!(desc.media["mist"].g, Some(0.8));
+    assert_eq!(desc.camera.medium.as_deref(), Some("mist"));
+    let text = lumen::scene::file::export(desc, Format::Toml).unwrap();
+    assert!(text.contains("g = -0.3"), "{text}");
+    let exported = SceneFile::parse("exported.toml", text, Format::Toml).unwrap();
+    assert_eq!(&exported.desc, desc);
+    file.compile(&Overrides::default()).unwrap();
+    let e = refused(
+        &dir,
+        "rayleigh.xml",
+        &body("<phase type=\"rayleigh\"/>"),
+        &mitsuba::Options::default(),
+    );
+    assert!(
+        e.contains("rayleigh")
+            && e.contains("`isotropic` and `hg`")
+            && e.contains("rayleigh.xml:2:"),
+        "{e}"
+    );
+}

@@ -4,6 +4,7 @@
 use super::{albedo, color, finite, invalid, model_path, transform_at, vec3};
 use crate::geometry::bvh_build::Aabb;
 use crate::material::{MaterialDesc, MediumInterface};
+use crate::phase::{Phase, MAX_ASYMMETRY};
 use crate::scene::desc::{FieldDesc, MediumDesc, SceneDesc};
 use crate::scene::SceneError;
 use crate::volume::{Field, Grid, Volume};
@@ -101,7 +102,16 @@ fn medium(field: &str, m: &MediumDesc, base: &Path) -> Result<Volume, SceneError
         (None, Field::Grid(g)) => Some(g.bounds()),
         (None, Field::Constant(_)) => None,
     };
-    Ok(Volume::new(sigma_t, albedo, bounds))
+    let g = match m.g {
+        Some(g) if !(g.abs() <= f64::from(MAX_ASYMMETRY)) => {
+            return Err(invalid(
+                at("g"),
+                format!("must lie between −{MAX_ASYMMETRY} and {MAX_ASYMMETRY}, got {g}"),
+            ))
+        }
+        g => g.unwrap_or(0.0) as f32,
+    };
+    Ok(Volume::new(sigma_t, albedo, bounds).with_phase(Phase::with_asymmetry(g)))
 }
 
 /// A quantity of a medium at `field`, multiplied by `factor`: ≥ 0, and

@@ -91,6 +91,11 @@ pub struct MediumDesc {
     /// other media are everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none", rename = "box")]
     pub bounds: Option<BoxDesc>,
+    /// The asymmetry of the Henyey–Greenstein phase function, the mean
+    /// cosine of the scattering angle, in (−1, 1): above 0 light scatters
+    /// on, below 0 back; isotropic (0) when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub g: Option<f64>,
 }
 
 /// A box from `min` to `max`.

@@ -397,7 +397,7 @@ impl<'d> Convert<'d> {
         }
     }
 
-    fn sensor(&mut self, e: &Element) -> Result<(), Failure> {
+    fn sensor(&mut self, e: &'d Element) -> Result<(), Failure> {
         let t = self.type_of(e)?;
         if !matches!(t, "perspective" | "thinlens") {
             return Err(self.unknown_type(e, "sensor", &["perspective", "thinlens"]));
@@ -553,6 +553,13 @@ impl<'d> Convert<'d> {
             camera.defocus_angle = (2.0 * (radius / focus).atan()).to_degrees();
             camera.focus_dist = Some(focus);
         }
+        // Mitsuba takes a medium nested in the sensor, whatever its name,
+        // as the one the camera stands in.
+        camera.medium = match p.objects("medium")[..] {
+            [] => None,
+            [m] => Some(self.medium(m)?),
+            _ => return Err(self.fail(e, "a sensor stands in one <medium>".into())),
+        };
         p.finish(&known, self)?;
         camera.near_clip = near_clip;
         camera.far_clip = Some(far_clip);

@@ -1,6 +1,6 @@
 //! Mitsuba's participating media as lumen's `[media]`: `homogeneous` and
 //! `heterogeneous` media with `constvolume` and `gridvolume` volumes and
-//! the isotropic phase function, and the media a shape names inside and
+//! the isotropic and Henyey–Greenstein (`hg`) phase functions, and the media a shape names inside and
 //! outside it, carried by its material.
 
 use super::super::props::{Colour, Props};
@@ -40,16 +40,21 @@ impl<'d> Convert<'d> {
             return Err(self.unknown_type(e, "medium", MEDIA));
         }
         let p = Props::of(e, self)?;
+        let mut g = None;
         for phase in p.objects("phase") {
-            let kind = self.type_of(phase)?;
-            if kind != "isotropic" {
-                self.lacks(
+            match self.type_of(phase)? {
+                "isotropic" => Props::of(phase, self)?.finish(&[], self)?,
+                "hg" => {
+                    let q = Props::of(phase, self)?;
+                    // Mitsuba's default asymmetry.
+                    g = Some(q.float("g", self)?.unwrap_or(0.8));
+                    q.finish(&["g"], self)?;
+                }
+                kind => self.lacks(
                     phase,
-                    &format!("the phase function `{kind}`"),
+                    &format!("the phase function `{kind}` (lumen has `isotropic` and `hg`)"),
                     "the isotropic one",
-                )?;
-            } else {
-                Props::of(phase, self)?.finish(&[], self)?;
+                )?,
             }
         }
         let scale = p.float("scale", self)?;
@@ -70,6 +75,7 @@ impl<'d> Convert<'d> {
             albedo,
             scale,
             bounds,
+            g,
         };
         let name = match e.attr("id") {
             Some(id) if !self.desc.media.contains_key(id) => id.to_string(),
