@@ -42,6 +42,7 @@ pub enum Phase {
 impl Phase {
     /// The phase function of asymmetry `g`: isotropic at 0.
     pub fn with_asymmetry(g: f32) -> Phase {
+        debug_assert!(g.abs() <= MAX_ASYMMETRY, "{g}");
         if g == 0.0 {
             Phase::Isotropic
         } else {

@@ -37,6 +37,10 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
             env!("CARGO_MANIFEST_DIR"),
             "/scripts/peers/flip_normals/flip_normals.xml"
         ),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scripts/peers/hg_media/hg_media.xml"
+        ),
     ] {
         let path = data().join(scene);
         let direct = SceneFile::read_with(&path, &spp(4)).unwrap_or_else(|e| panic!("{e}"));

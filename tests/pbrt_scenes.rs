@@ -45,6 +45,9 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
     for scene in ["box.pbrt", "killeroos/killeroo-simple.pbrt"] {
         exported_renders_the_same(&assets().join(scene));
     }
+    exported_renders_the_same(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peers/hg_media/hg_media.pbrt"),
+    );
 }
 
 /// pbrt-v4's own killeroo scene (from `mmp/pbrt-v4-scenes`) reads as
@@ -432,6 +435,15 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("WorldBegin\nCoordSysTransform \"camra\"\n", "no coordinate system `camra`"),
         ("WorldBegin\n\"float x\" 1\n", "expected a directive"),
         ("WorldBegin\nTranslate 1 2\n", "expected a number, but the file ends"),
+        ("MediumInterface \"fgo\" \"\"\nWorldBegin\n", "s.pbrt:1:1: no medium is named `fgo`; no medium is defined"),
+        ("MakeNamedMedium \"m\"\n", "a medium needs a \"string type\""),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogenous\"\n", "no medium kind is called `homogenous`; pbrt has homogeneous"),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1\n", "s.pbrt:1:49: `g` must lie between −0.999 and 0.999"),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n", "s.pbrt:1:49: `sigma_a` must be finite and ≥ 0"),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float sigma_z\" 1\n", "did you mean `sigma_a`?"),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n", "s.pbrt:2:17: the medium `m` is defined twice"),
+        ("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\"\n", "--approximate renders a medium of its sigma_a and sigma_s"),
+        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"string preset\" \"Wholemilk\"\n", "table of measured media"),
     ];
     for (text, expected) in cases {
         let message = read_in(&dir, text, &Options::default())
@@ -1170,4 +1182,71 @@ fn an_image_sky_takes_its_illuminance_as_pbrt_computes_it() {
     )
     .unwrap_err();
     assert!(e.contains("black above its horizon"), "{e}");
+}
+
+/// `MakeNamedMedium`'s homogeneous media become lumen's (σt = σa + σs
+/// with pbrt's scale beside it, the albedo σs / σt, g); the outside medium
+/// given before `Camera` is the camera's; `MediumInterface` puts media on
+/// the materials of the shapes that follow, except where both sides are
+/// the same (no boundary, in pbrt); a grid medium is refused, or with
+/// `--approximate` its σs and σa fill its box.
+#[test]
+fn media_are_read_with_the_sides_pbrt_gives_them() {
+    let d = read(
+        "media",
+        "MakeNamedMedium \"mist\" \"string type\" \"homogeneous\" \"float sigma_a\" 0.5\n\
+         \"rgb sigma_s\" [1.5 0.5 0] \"float scale\" 2 \"float g\" 0.4\n\
+         MediumInterface \"\" \"mist\"\nCamera \"perspective\"\nWorldBegin\n\
+         AttributeBegin\nMediumInterface \"mist\"\nShape \"sphere\"\nAttributeEnd\n\
+         Material \"interface\"\nShape \"sphere\"\n\
+         Material \"dielectric\"\nMediumInterface \"mist\" \"\"\nShape \"sphere\"\n",
+    );
+    let m = &d.media["mist"];
+    use lumen::scene::desc::FieldDesc;
+    assert_eq!(m.sigma_t, FieldDesc::Color([2.0, 1.0, 0.5]));
+    assert_eq!(m.albedo, FieldDesc::Color([0.75, 0.5, 0.0]));
+    assert_eq!((m.scale, m.g, &m.bounds), (Some(2.0), Some(0.4), &None));
+    assert_eq!(d.camera.medium.as_deref(), Some("mist"));
+    let sides: Vec<(&str, Option<&str>, Option<&str>)> = d
+        .objects
+        .iter()
+        .map(|o| {
+            let ObjectDesc::Sphere { material, .. } = o else {
+                panic!("{o:?}")
+            };
+            let m = &d.materials[material];
+            let kind = match m {
+                MaterialDesc::Interface(_) => "interface",
+                MaterialDesc::Dielectric(_) => "dielectric",
+                _ => "other",
+            };
+            let s = m.surface();
+            (kind, s.interior, s.exterior)
+        })
+        .collect();
+    assert_eq!(
+        sides,
+        [
+            ("other", None, None),
+            ("interface", None, Some("mist")),
+            ("dielectric", Some("mist"), None),
+        ]
+    );
+    let dir = scratch_dir("pbrt_scenes_grid_medium");
+    let options = Options {
+        approximate: true,
+        ..Options::default()
+    };
+    let file = read_in(
+        &dir,
+        "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"float sigma_s\" 3\n\
+         \"integer nx\" 1 \"integer ny\" 1 \"integer nz\" 2 \"float density\" [0.2 0.4]\n\
+         \"point3 p0\" [-1 0 0] \"point3 p1\" [1 2 3]\nWorldBegin\n",
+        &options,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(file.import_warnings.len(), 1, "{:?}", file.import_warnings);
+    let b = file.desc.media["smoke"].bounds.as_ref().unwrap();
+    assert_eq!((b.min, b.max), ([-1.0, 0.0, 0.0], [1.0, 2.0, 3.0]));
+    file.compile(&Overrides::default()).unwrap();
 }

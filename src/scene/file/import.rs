@@ -26,3 +26,42 @@ pub struct Imported {
     /// One line each.
     pub warnings: Vec<String>,
 }
+
+/// The copies a reader makes of its materials for surfaces between media
+/// (lumen sets a surface's media on its material, the formats it reads on
+/// the shape): one per material and pair of media.
+#[derive(Debug, Default)]
+pub(super) struct MediaCopies(
+    std::collections::HashMap<(String, Option<String>, Option<String>), String>,
+);
+
+impl MediaCopies {
+    /// The name of material `material` of `desc` with `interior` and
+    /// `exterior` media (an `interface` in their place where `interface`),
+    /// added to `desc` under `fresh(desc, stem)` the first time it is asked for.
+    pub fn of(
+        &mut self,
+        desc: &mut SceneDesc,
+        material: String,
+        [interior, exterior]: [Option<String>; 2],
+        interface: bool,
+        fresh: impl FnOnce(&SceneDesc, &str) -> String,
+    ) -> String {
+        let key = (material, interior, exterior);
+        if let Some(name) = self.0.get(&key) {
+            return name.clone();
+        }
+        let mut copy = if interface {
+            crate::material::MaterialDesc::Interface(Default::default())
+        } else {
+            desc.materials[&key.0].clone()
+        };
+        let sides = copy.surface_mut();
+        sides.interior.clone_from(&key.1);
+        sides.exterior.clone_from(&key.2);
+        let name = fresh(desc, &format!("{}-in-media", key.0));
+        desc.materials.insert(name.clone(), copy);
+        self.0.insert(key, name.clone());
+        name
+    }
+}

@@ -93,7 +93,7 @@ pub struct Convert<'d> {
     media: HashMap<*const Element, String>,
     /// Each material with media on its sides (material, interior,
     /// exterior), by the names it was made from.
-    bounded: HashMap<(String, Option<String>, Option<String>), String>,
+    bounded: crate::scene::file::import::MediaCopies,
 }
 
 impl<'d> Convert<'d> {
@@ -111,7 +111,7 @@ impl<'d> Convert<'d> {
             counter: 0,
             background: None,
             media: HashMap::new(),
-            bounded: HashMap::new(),
+            bounded: Default::default(),
         };
         fn gather<'d>(
             e: &'d Element,

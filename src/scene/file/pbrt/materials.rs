@@ -907,6 +907,7 @@ impl Builder {
         area: Option<f64>,
     ) -> Result<String, Problem> {
         let material = self.shape_material(at, area)?;
+        let material = self.in_media(material);
         let Some((a, aat)) = p.float_or_texture("alpha")? else {
             return Ok(material);
         };

@@ -13,6 +13,7 @@
 
 mod lex;
 mod materials;
+mod media;
 mod params;
 mod scene;
 mod shapes;

@@ -83,6 +83,9 @@ pub(super) struct State {
     /// Transforms apply at the shutter's open (`ActiveTransform
     /// StartTime` or `All`).
     pub start: bool,
+    /// The media `MediumInterface` set, inside and outside (pbrt's
+    /// names, which are lumen's; `None`: no medium).
+    pub media: [Option<String>; 2],
     /// Default parameters `Attribute` set, in the order written, each with
     /// the kind of directive it is for: "shape", "light", "material",
     /// "medium" or "texture".
@@ -95,6 +98,8 @@ struct Camera {
     fov: f64,
     lens_radius: f64,
     focal_distance: f64,
+    /// The medium it stands in: the outside one when it was given.
+    medium: Option<String>,
 }
 
 /// Turns directives into a scene description.
@@ -114,7 +119,7 @@ pub(super) struct Builder {
     instances: HashMap<String, Vec<ObjectDesc>>,
     /// The object being defined, if any.
     defining: Option<(String, Vec<ObjectDesc>)>,
-    counter: usize,
+    pub counter: usize,
     /// Named materials: pbrt's name to lumen's, and whether it is an
     /// `interface`.
     pub named_materials: HashMap<String, (String, bool)>,
@@ -124,6 +129,11 @@ pub(super) struct Builder {
     /// bits, or its texture's name).
     emitting: HashMap<(Option<String>, String, bool), String>,
     default_material: Option<String>,
+    /// Copies of materials with media on their sides.
+    pub media_copies: crate::scene::file::import::MediaCopies,
+    /// The media `MediumInterface` named, and where: checked once the
+    /// file is read.
+    pub medium_uses: Vec<(String, At)>,
 }
 
 /// One number or three numbers, by parameter.
@@ -176,6 +186,7 @@ impl Builder {
                 area: None,
                 area_power: None,
                 start: true,
+                media: [None, None],
                 attributes: Vec::new(),
             },
             stack: Vec::new(),
@@ -190,6 +201,8 @@ impl Builder {
             textures: HashMap::new(),
             emitting: HashMap::new(),
             default_material: None,
+            media_copies: Default::default(),
+            medium_uses: Vec::new(),
         }
     }
 
@@ -427,15 +440,18 @@ impl Builder {
                 }
             }
             "MakeNamedMedium" => {
-                let (_, nat) = input.string(at)?;
-                input.params(at)?.ignore_all();
-                self.lacks(nat, "participating medium of pbrt's kinds", "no medium")?;
+                let (name, nat) = input.string(at)?;
+                let p = self.defaults("medium", input.params(at)?);
+                self.named_medium(&name, nat, &p)?;
             }
             "MediumInterface" => {
-                input.string(at)?;
-                if input.string_follows()? {
-                    input.string(at)?;
-                }
+                let (inside, _) = input.string(at)?;
+                let outside = if input.string_follows()? {
+                    input.string(at)?.0
+                } else {
+                    inside.clone()
+                };
+                self.medium_interface(inside, outside, at);
             }
             "Attribute" => {
                 let (target, tat) = input.string(at)?;
@@ -662,6 +678,7 @@ impl Builder {
             fov,
             lens_radius,
             focal_distance,
+            medium: self.state.media[1].clone(),
         });
         Ok(())
     }
@@ -1184,6 +1201,7 @@ impl Builder {
         if let Some((_, at, what)) = self.stack.last() {
             return Err((*at, format!("this {what} is never closed"), None));
         }
+        self.check_media()?;
         let (width, height) = self.film;
         if let Some(c) = &self.camera {
             let m = matrix::inverse(&c.camera_from_world).expect("checked at Camera");
@@ -1223,6 +1241,7 @@ impl Builder {
                 // pbrt's image runs along the camera's +x: a frame that
                 // does not mirror (as LookAt's) mirrors the image.
                 mirror: matrix::det3(&m) > 0.0,
+                medium: c.medium.clone(),
                 ..CameraDesc::default()
             };
         } else {

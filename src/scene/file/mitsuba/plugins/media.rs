@@ -8,7 +8,6 @@ use super::super::spectrum::Use;
 use super::super::transform::Mat4;
 use super::super::xml::Element;
 use super::{Convert, Failure};
-use crate::material::{InterfaceDesc, MaterialDesc};
 use crate::scene::desc::{BoxDesc, FieldDesc, GridDesc, MediumDesc, TransformDesc};
 
 /// The media and volumes lumen reads, for messages.
@@ -194,24 +193,17 @@ impl<'d> Convert<'d> {
         exterior: Option<String>,
         null: bool,
     ) -> String {
-        let key = (material, interior, exterior);
-        if let Some(name) = self.bounded.get(&key) {
-            return name.clone();
-        }
-        let (material, interior, exterior) = key;
-        let mut desc = if null {
-            MaterialDesc::Interface(InterfaceDesc::default())
-        } else {
-            self.desc.materials[&material].clone()
-        };
-        let sides = desc.surface_mut();
-        sides.interior.clone_from(&interior);
-        sides.exterior.clone_from(&exterior);
-        let name = self.name(&format!("{material}-in-media"));
-        self.desc.materials.insert(name.clone(), desc);
-        self.bounded
-            .insert((material, interior, exterior), name.clone());
-        name
+        let counter = &mut self.counter;
+        self.bounded.of(
+            &mut self.desc,
+            material,
+            [interior, exterior],
+            null,
+            |_, stem| {
+                *counter += 1;
+                format!("{stem}-{counter}")
+            },
+        )
     }
 }
 
