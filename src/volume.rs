@@ -90,6 +90,8 @@ pub struct Grid {
     max: f32,
     /// Grid space (the unit cube) to world.
     transform: Transform,
+    /// Beyond the outer voxels: their values (clamped), or 0.
+    zero_outside: bool,
 }
 
 /// The largest grid [`Grid::read`] accepts, in voxels (a 1024³ grid of
@@ -139,7 +141,19 @@ impl Grid {
             values,
             max,
             transform,
+            zero_outside: false,
         })
+    }
+
+    /// The grid read as 0 outside its voxels (pbrt's `uniformgrid`), so
+    /// that values fall towards 0 beyond the outer centres (to half the
+    /// outer voxels' at the faces), rather than stay the outer voxels'
+    /// (Mitsuba's).
+    pub fn zero_outside(self) -> Grid {
+        Grid {
+            zero_outside: true,
+            ..self
+        }
     }
 
     /// Reads a grid from a Mitsuba `.vol` file (version 3, float32 values),
@@ -201,9 +215,16 @@ impl Grid {
         })
     }
 
-    /// The value of voxel (x, y, z), clamped to the grid.
+    /// The value of voxel (x, y, z), clamped to the grid (or 0 outside
+    /// it).
     #[inline]
     fn voxel(&self, x: isize, y: isize, z: isize) -> Color {
+        if self.zero_outside {
+            let inside = |v: isize, n: usize| (0..n as isize).contains(&v);
+            if !(inside(x, self.size[0]) && inside(y, self.size[1]) && inside(z, self.size[2])) {
+                return Color::ZERO;
+            }
+        }
         let clamp = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
         let (x, y, z) = (
             clamp(x, self.size[0]),
@@ -580,6 +601,31 @@ mod tests {
 
     /// A `.vol` file is read as written, and a broken one is refused with
     /// what is wrong.
+    /// A grid read as 0 outside falls towards 0 beyond its outer centres
+    /// (to half the outer value at its faces), and is its voxels' values
+    /// between them.
+    #[test]
+    fn grids_zero_outside_fall_to_zero_at_their_faces() {
+        let grid = Grid::new([2, 1, 1], 1, vec![1.0, 3.0], 1.0, Transform::IDENTITY)
+            .unwrap()
+            .zero_outside();
+        let at = |x: f32| grid.at(Vec3::new(x, 0.5, 0.5)).x;
+        for (x, want) in [
+            (0.0, 0.5),
+            (0.125, 0.75),
+            (0.25, 1.0),
+            (0.5, 2.0),
+            (0.875, 2.25),
+            (1.0, 1.5),
+        ] {
+            assert!(
+                (at(x) - want).abs() < 1e-5,
+                "at {x}: {} against {want}",
+                at(x)
+            );
+        }
+    }
+
     #[test]
     fn vol_files_are_read_and_broken_ones_refused() {
         let dir = std::env::temp_dir().join(format!("lumen-vol-{}", std::process::id()));

@@ -232,4 +232,22 @@ fn bad_media_are_refused_with_the_field() {
         "",
     );
     assert!(e.contains("media.fog.g") && e.contains("0.999"), "{e}");
+    let e = fail(
+        "[media.fog]\nsigma_t = { voxels = [2, 1, 1], values = [1, 2, 3, 4] }\nalbedo = 0.5",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(
+        e.contains("media.fog.sigma_t.values") && e.contains("holds 4 values for 2×1×1 voxels"),
+        "{e}"
+    );
+    let e = fail(
+        "[media.fog]\nsigma_t = { voxels = [1, 1, 1], values = [-1] }\nalbedo = 0.5",
+        "type = \"interface\"\ninterior = \"fog\"",
+        "",
+    );
+    assert!(
+        e.contains("media.fog.sigma_t.values") && e.contains("≥ 0"),
+        "{e}"
+    );
 }

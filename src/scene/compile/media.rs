@@ -5,7 +5,7 @@ use super::{albedo, color, finite, invalid, model_path, transform_at, vec3};
 use crate::geometry::bvh_build::Aabb;
 use crate::material::{MaterialDesc, MediumInterface};
 use crate::phase::{Phase, MAX_ASYMMETRY};
-use crate::scene::desc::{FieldDesc, MediumDesc, SceneDesc};
+use crate::scene::desc::{EdgeDesc, FieldDesc, MediumDesc, SceneDesc};
 use crate::scene::SceneError;
 use crate::volume::{Field, Grid, Volume};
 use std::collections::HashMap;
@@ -135,23 +135,74 @@ fn quantity(
         FieldDesc::Value(v) => constant([*v; 3]),
         FieldDesc::Color(c) => constant(*c),
         FieldDesc::Grid(g) => {
-            let (transform, motion) = transform_at(&format!("{field}.transform"), &g.transform)?;
-            if motion != crate::math::Vec3::ZERO {
-                return Err(invalid(
-                    format!("{field}.transform"),
-                    "a medium cannot move: a `motion` step is for surfaces",
-                ));
-            }
+            let transform = placement(field, &g.transform)?;
             let path = model_path(base, &g.grid);
             let grid = Grid::read(&path, factor, transform)
                 .map_err(|e| invalid(format!("{field}.grid"), format!("{}: {e}", g.grid)))?;
-            if is_albedo && grid.max() > 1.0 {
-                return Err(invalid(
-                    format!("{field}.grid"),
-                    format!("{}: holds {}, above 1", g.grid, grid.max()),
-                ));
-            }
-            Ok(Field::Grid(Box::new(grid)))
+            checked(field, "grid", &g.grid, grid, is_albedo)
+        }
+        FieldDesc::Voxels(v) => {
+            let transform = placement(field, &v.transform)?;
+            let size = v.voxels.map(|n| n as usize);
+            let voxels = size.iter().try_fold(1usize, |n, &s| n.checked_mul(s));
+            let channels = match voxels {
+                Some(n) if v.values.len() == n => 1,
+                Some(n) if Some(v.values.len()) == n.checked_mul(3) => 3,
+                _ => {
+                    return Err(invalid(
+                        format!("{field}.values"),
+                        format!(
+                            "holds {} values for {}×{}×{} voxels: one per voxel, or three",
+                            v.values.len(),
+                            size[0],
+                            size[1],
+                            size[2]
+                        ),
+                    ))
+                }
+            };
+            let values = v.values.iter().map(|&x| x as f32).collect();
+            let grid = Grid::new(size, channels, values, factor, transform)
+                .map_err(|e| invalid(format!("{field}.values"), format!("the grid {e}")))?;
+            let grid = match v.edge {
+                Some(EdgeDesc::Zero) => grid.zero_outside(),
+                _ => grid,
+            };
+            checked(field, "values", "the grid", grid, is_albedo)
         }
     }
+}
+
+/// The placement of a medium's grid at `field`: transform steps, no
+/// motion.
+fn placement(
+    field: &str,
+    steps: &[crate::scene::desc::TransformDesc],
+) -> Result<crate::geometry::transform::Transform, SceneError> {
+    let (transform, motion) = transform_at(&format!("{field}.transform"), steps)?;
+    if motion != crate::math::Vec3::ZERO {
+        return Err(invalid(
+            format!("{field}.transform"),
+            "a medium cannot move: a `motion` step is for surfaces",
+        ));
+    }
+    Ok(transform)
+}
+
+/// `grid` (named `name`, at `field`.`part`) as a field, refused above 1
+/// where it is an albedo.
+fn checked(
+    field: &str,
+    part: &str,
+    name: &str,
+    grid: Grid,
+    is_albedo: bool,
+) -> Result<Field, SceneError> {
+    if is_albedo && grid.max() > 1.0 {
+        return Err(invalid(
+            format!("{field}.{part}"),
+            format!("{name}: holds {}, above 1", grid.max()),
+        ));
+    }
+    Ok(Field::Grid(Box::new(grid)))
 }

@@ -118,6 +118,40 @@ pub enum FieldDesc {
     Color(Triple),
     /// A voxel grid.
     Grid(GridDesc),
+    /// A voxel grid written out in the scene.
+    Voxels(VoxelsDesc),
+}
+
+/// A voxel grid of a medium's quantity given value by value (pbrt's
+/// `uniformgrid`), filling the unit cube of its own space.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VoxelsDesc {
+    /// Voxels along x, y and z.
+    pub voxels: [u32; 3],
+    /// One value per voxel (or three, red, green and blue), x fastest,
+    /// then y, then z.
+    pub values: Vec<f64>,
+    /// Places the grid's unit cube in the world, applied in the order
+    /// written.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub transform: Vec<TransformDesc>,
+    /// What lies between the outer voxels' centres and the cube's faces:
+    /// the outer voxels' values (`"clamp"`, Mitsuba's way, the default) or
+    /// values falling towards 0, to half the outer voxels' at the faces,
+    /// as if 0 lay beyond (`"zero"`, pbrt's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge: Option<EdgeDesc>,
+}
+
+/// How a voxel grid is read beyond its outer voxels' centres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EdgeDesc {
+    /// The outer voxels' values.
+    Clamp,
+    /// 0 beyond the grid: values fall towards it at its faces.
+    Zero,
 }
 
 /// A voxel grid of a medium's quantity, read from a Mitsuba `.vol` file

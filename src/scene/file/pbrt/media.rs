@@ -1,15 +1,18 @@
 //! pbrt's participating media as lumen's `[media]`: `MakeNamedMedium`
-//! (the `homogeneous` kind; the others with `--approximate`), the media
+//! (the `homogeneous` and `uniformgrid` kinds; the others with
+//! `--approximate`), the media
 //! `MediumInterface` sets on the shapes that follow (carried by their
 //! materials) and the one the camera stands in.
 
 use super::lex::At;
 use super::params::{Params, Problem, Spectral};
 use super::scene::Builder;
-use crate::scene::desc::{BoxDesc, FieldDesc, MediumDesc};
+use crate::scene::desc::{
+    BoxDesc, EdgeDesc, FieldDesc, MediumDesc, ScaleDesc, TransformDesc, VoxelsDesc,
+};
 use crate::scene::file::matrix;
 
-/// The kinds of medium pbrt-v4 has; lumen reads the first.
+/// The kinds of medium pbrt-v4 has; lumen reads the first two.
 const KINDS: &[&str] = &["homogeneous", "uniformgrid", "rgbgrid", "cloud", "nanovdb"];
 
 /// The largest |g| lumen's phase function takes
@@ -32,9 +35,21 @@ impl Builder {
             "type", "sigma_a", "sigma_s", "scale", "g", "preset", "Le", "Lescale",
         ];
         let mut bounds = None;
+        let mut density = None;
         match kind.as_str() {
             "homogeneous" => {}
-            "uniformgrid" | "rgbgrid" | "cloud" | "nanovdb" => {
+            "uniformgrid" => {
+                known.extend(["density", "nx", "ny", "nz", "p0", "p1", "temperature"]);
+                density = Some(self.density(p, at)?);
+                if let Some((_, tat)) = p.nums("temperature", &["float"])? {
+                    self.lacks(
+                        tat,
+                        "medium that gives off light (`temperature`)",
+                        "no light from it",
+                    )?;
+                }
+            }
+            "rgbgrid" | "cloud" | "nanovdb" => {
                 // Whatever describes the density: the medium's own σa and
                 // σs, filling its box, stand for it.
                 known.extend([
@@ -121,10 +136,25 @@ impl Builder {
                 FieldDesc::Color(c)
             }
         };
+        let (sigma_t, scale) = match density {
+            None => (field(sigma_t), scale),
+            // σt is the density times σa + σs: a grey sum goes with the
+            // scale, a coloured one makes the grid's voxels RGB.
+            Some(mut voxels) => {
+                if let FieldDesc::Value(sum) = field(sigma_t) {
+                    (FieldDesc::Voxels(voxels), scale * sum)
+                } else {
+                    voxels.values = (voxels.values.iter())
+                        .flat_map(|d| sigma_t.map(|s| d * s))
+                        .collect();
+                    (FieldDesc::Voxels(voxels), scale)
+                }
+            }
+        };
         self.desc.media.insert(
             name.to_string(),
             MediumDesc {
-                sigma_t: field(sigma_t),
+                sigma_t,
                 albedo: field(albedo),
                 scale: (scale != 1.0).then_some(scale),
                 bounds,
@@ -132,6 +162,69 @@ impl Builder {
             },
         );
         Ok(())
+    }
+
+    /// A `uniformgrid` medium's density: `nx` × `ny` × `nz` values (x
+    /// fastest) over the box `p0`–`p1` of the medium's space, 0 beyond the
+    /// outer voxels as pbrt reads it.
+    fn density(&self, p: &Params, at: At) -> Result<VoxelsDesc, Problem> {
+        let Some((values, dat)) = p.nums("density", &["float"])? else {
+            return Err((
+                at,
+                "a uniformgrid medium needs its \"float density\" values".into(),
+                None,
+            ));
+        };
+        let mut size = [1u32; 3];
+        for (a, n) in ["nx", "ny", "nz"].into_iter().enumerate() {
+            if let Some(v) = p.int(n)? {
+                size[a] = u32::try_from(v).ok().filter(|&v| v > 0).ok_or((
+                    p.get(n).map_or(at, |q| q.at),
+                    format!("`{n}` must be at least 1, got {v}"),
+                    None,
+                ))?;
+            }
+        }
+        let count = size.iter().map(|&n| u64::from(n)).product::<u64>();
+        if values.len() as u64 != count {
+            return Err((
+                dat,
+                format!(
+                    "the grid has {} density values where nx × ny × nz = {count}",
+                    values.len()
+                ),
+                None,
+            ));
+        }
+        if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Err((
+                dat,
+                format!("a density must be finite and ≥ 0, got {v}"),
+                None,
+            ));
+        }
+        let p0 = p.triple("p0", &["point3", "point"])?.unwrap_or([0.0; 3]);
+        let p1 = p.triple("p1", &["point3", "point"])?.unwrap_or([1.0; 3]);
+        if (0..3).any(|a| !(p1[a] > p0[a])) {
+            return Err((
+                at,
+                format!("`p1` {p1:?} must lie above `p0` {p0:?} on every axis"),
+                None,
+            ));
+        }
+        let mut transform = vec![
+            TransformDesc::Scale(ScaleDesc::PerAxis(std::array::from_fn(|a| p1[a] - p0[a]))),
+            TransformDesc::Translate(p0),
+        ];
+        if self.state.ctm != matrix::IDENTITY {
+            transform.push(TransformDesc::Matrix(self.state.ctm));
+        }
+        Ok(VoxelsDesc {
+            voxels: size,
+            values: values.to_vec(),
+            transform,
+            edge: Some(EdgeDesc::Zero),
+        })
     }
 
     /// The box `p0`–`p1` of a grid medium, placed by the current
