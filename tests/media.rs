@@ -99,18 +99,7 @@ fn light_sampled_through_thin_glass_agrees_with_the_bounces() {
     let dir = scratch_dir("media-thin");
     let media = "[media.fog]\nsigma_t = 1.5\nalbedo = [0.9, 0.6, 0.3]";
     let material = "type = \"dielectric\"\nior = 1.5\nthin = true\ninterior = \"fog\"";
-    let text = ball(media, material, "", 12);
-    let sampled = text.replace("seed = 5", "seed = 5\nsample_background = true");
-    let bounces = text.replace("seed = 5", "seed = 9\nintegrator = \"bsdf\"");
-    let a = pixel_stats(&compile_file(&dir, "a.toml", &sampled));
-    let b = pixel_stats(&compile_file(&dir, "b.toml", &bounces));
-    for c in 0..3 {
-        common::assert_agree(
-            &format!("channel {c}"),
-            a.region(2..6, 2..6, c),
-            b.region(2..6, 2..6, c),
-        );
-    }
+    assert_estimators_agree(&dir, media, material, "thin glass");
 }
 
 /// Particles that scatter forward or back (Henyey–Greenstein): light
@@ -123,18 +112,25 @@ fn forward_and_back_scattering_agree_between_estimators() {
     for g in ["0.7", "-0.6"] {
         let media = format!("[media.fog]\nsigma_t = 2\nalbedo = [0.95, 0.8, 0.5]\ng = {g}");
         let material = "type = \"interface\"\ninterior = \"fog\"";
-        let text = ball(&media, material, "", 12);
-        let sampled = text.replace("seed = 5", "seed = 5\nsample_background = true");
-        let bounces = text.replace("seed = 5", "seed = 9\nintegrator = \"bsdf\"");
-        let a = pixel_stats(&compile_file(&dir, "a.toml", &sampled));
-        let b = pixel_stats(&compile_file(&dir, "b.toml", &bounces));
-        for c in 0..3 {
-            common::assert_agree(
-                &format!("g = {g}, channel {c}"),
-                a.region(2..6, 2..6, c),
-                b.region(2..6, 2..6, c),
-            );
-        }
+        assert_estimators_agree(&dir, &media, material, &format!("g = {g}"));
+    }
+}
+
+/// The ball of `material` holding `media` under the sky gives the same
+/// middle of the image whether paths sample the sky or only find it by
+/// their bounces.
+fn assert_estimators_agree(dir: &std::path::Path, media: &str, material: &str, what: &str) {
+    let text = ball(media, material, "", 12);
+    let sampled = text.replace("seed = 5", "seed = 5\nsample_background = true");
+    let bounces = text.replace("seed = 5", "seed = 9\nintegrator = \"bsdf\"");
+    let a = pixel_stats(&compile_file(dir, "a.toml", &sampled));
+    let b = pixel_stats(&compile_file(dir, "b.toml", &bounces));
+    for c in 0..3 {
+        common::assert_agree(
+            &format!("{what}, channel {c}"),
+            a.region(2..6, 2..6, c),
+            b.region(2..6, 2..6, c),
+        );
     }
 }
 

@@ -9,7 +9,6 @@ Mitsuba's and lumen's -D). Example: the material preview,
 assets/mitsuba-data/scenes/matpreview/matpreview.xml 1024 width=342 height=256.
 """
 
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -18,24 +17,16 @@ import mitsuba as mi
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from peerlib import compare_images  # noqa: E402
+from peerlib import compare_images, render_xml_with_lumen, xml_arguments  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENE = Path(sys.argv[1]).resolve()
-SPP = int(sys.argv[2])
-DEFINES = dict(a.split("=", 1) for a in sys.argv[3:])
-DEFINES["spp"] = str(SPP)
+SCENE, SPP, DEFINES = xml_arguments(sys.argv)
 
 mi.set_variant("scalar_rgb")
 
 
 def lumen(seed, d):
     out = Path(d) / f"lumen{seed}.exr"
-    args = [str(ROOT / "target/release/lumen"), "render", str(SCENE), "--seed", str(seed),
-            "-o", str(out)]
-    for k, v in DEFINES.items():
-        args += ["-D", f"{k}={v}"]
-    subprocess.run(args, check=True, capture_output=True)
+    render_xml_with_lumen(SCENE, seed, DEFINES, out)
     return np.array(mi.Bitmap(str(out)))[..., :3]
 
 

@@ -26,24 +26,17 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENE = Path(sys.argv[1]).resolve()
-SPP = int(sys.argv[2])
-DEFINES = dict(a.split("=", 1) for a in sys.argv[3:])
-DEFINES["spp"] = str(SPP)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from peerlib import render_xml_with_lumen, xml_arguments  # noqa: E402
+
+SCENE, SPP, DEFINES = xml_arguments(sys.argv)
 
 mi.set_variant("llvm_ad_rgb")
 
 
 def lumen(seed, d):
     out = Path(d) / f"lumen{seed}.exr"
-    args = [str(ROOT / "target/release/lumen"), "render", str(SCENE), "--seed", str(seed),
-            "-o", str(out)]
-    for k, v in DEFINES.items():
-        args += ["-D", f"{k}={v}"]
-    t0 = time.perf_counter()
-    subprocess.run(args, check=True, capture_output=True)
-    seconds = time.perf_counter() - t0
+    seconds = render_xml_with_lumen(SCENE, seed, DEFINES, out)
     return np.array(mi.Bitmap(str(out)))[..., :3].astype(np.float64), seconds
 
 

@@ -11,11 +11,15 @@ scripts/peers/setup_cycles.sh) and in a plain Python with numpy.
 - compare_images(lumen, lumen_again, peer, peer_again, name): two renderers'
   images of one scene (each rendered twice with other seeds) compared: means,
   their ratio per half and quarter, and the difference beyond the noise.
+- xml_arguments(argv), render_xml_with_lumen(...): the command line of the
+  scripts that give a Mitsuba scene file to both renderers, and lumen's
+  render of such a file.
 """
 
 import json
 import math
 import os
+import subprocess
 import sys
 import time
 import tomllib
@@ -179,6 +183,31 @@ def rgb(x):
     if len(x) != 3 or not all(math.isfinite(float(c)) for c in x):
         raise ValueError(f"bad colour {x!r}")
     return [float(c) for c in x]
+
+
+# -------------------------------------------------------- mitsuba scene files
+def xml_arguments(argv):
+    """SCENE.xml SPP [NAME=VALUE ...]: the scene's path, the sample count
+    and the scene's defaults to set (spp among them), for both renderers."""
+    scene = Path(argv[1]).resolve()
+    spp = int(argv[2])
+    defines = dict(a.split("=", 1) for a in argv[3:])
+    defines["spp"] = str(spp)
+    return scene, spp, defines
+
+
+def render_xml_with_lumen(scene, seed, defines, out):
+    """lumen's release build renders Mitsuba scene file `scene` with `seed`
+    and `defines` (as -D) to `out`; returns the seconds it took, reading
+    the scene included."""
+    root = Path(__file__).resolve().parents[2]
+    args = [str(root / "target/release/lumen"), "render", str(scene), "--seed", str(seed),
+            "-o", str(out)]
+    for k, v in defines.items():
+        args += ["-D", f"{k}={v}"]
+    t0 = time.perf_counter()
+    subprocess.run(args, check=True, capture_output=True)
+    return time.perf_counter() - t0
 
 
 # ------------------------------------------------------------------ compare
