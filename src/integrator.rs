@@ -267,9 +267,7 @@ fn bounce(
     }
     path.sampled_from = (nee && !sample.flags.is_specular()).then_some((record.point, sample.pdf));
     path.throughput *= sample.value;
-    if let Some(sides) = material.media {
-        path.medium = sides.beyond(record.outward_normal(), sample.wi);
-    }
+    path.medium = material.medium_beyond(&record, sample.wi, path.medium);
     if !goes_on(scene, depth, path, sampler) {
         return done(path.radiance);
     }
@@ -290,9 +288,7 @@ fn cross(
     path: &mut PathState,
 ) -> Bounce {
     let d = ray.direction;
-    if let Some(sides) = material.media {
-        path.medium = sides.beyond(record.outward_normal(), d);
-    }
+    path.medium = material.medium_beyond(record, d, path.medium);
     Bounce::Cross(Ray::timed(record.spawn_origin(d), d, ray.time()), hit)
 }
 
@@ -357,9 +353,10 @@ fn light_at_surface(
         |wi| bsdf.eval_and_pdf(wo, wi),
         |wi| record.spawn_origin(wi),
         // Asked only in scenes with media.
-        |wi| match scene.material(record).media {
-            Some(s) => s.beyond(record.outward_normal(), wi),
-            None => path.medium,
+        |wi| {
+            scene
+                .material(record)
+                .medium_beyond(record, wi, path.medium)
         },
         Some(hit),
         sampler,

@@ -878,6 +878,22 @@ impl Material {
         matches!(self.kind, Kind::Interface)
     }
 
+    /// The medium a path leaving this surface at `hit` along `direction`
+    /// travels in: the one on that side where the material names media,
+    /// else `current`, the one it was in.
+    #[inline]
+    pub fn medium_beyond(
+        &self,
+        hit: &HitRecord,
+        direction: Vec3,
+        current: Option<u32>,
+    ) -> Option<u32> {
+        match self.media {
+            Some(sides) => sides.beyond(hit.outward_normal(), direction),
+            None => current,
+        }
+    }
+
     /// The share of light that goes straight through the surface at `hit`
     /// (seen from `wo`, back along the ray), undeviated: all of it at an
     /// interface, what a thin sheet of glass lets through, none elsewhere.

@@ -551,9 +551,7 @@ impl Scene {
             if share == Color::ZERO {
                 return share;
             }
-            if let Some(sides) = material.media {
-                medium = sides.beyond(record.outward_normal(), ray.direction);
-            }
+            medium = material.medium_beyond(&record, ray.direction, medium);
             left -= hit.t;
             ray = Ray::timed(
                 record.spawn_origin(ray.direction),

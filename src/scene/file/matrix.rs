@@ -45,6 +45,20 @@ pub fn point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|i| (m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3]) / w)
 }
 
+/// The smallest axis-aligned box around the box `min`–`max` moved by `m`
+/// (around its eight corners), as `(min, max)`.
+pub fn placed_box(m: &Mat4, min: [f64; 3], max: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for corner in 0..8 {
+        let q = std::array::from_fn(|a| if corner >> a & 1 == 1 { max[a] } else { min[a] });
+        for (a, v) in point(m, q).into_iter().enumerate() {
+            b.0[a] = b.0[a].min(v);
+            b.1[a] = b.1[a].max(v);
+        }
+    }
+    b
+}
+
 /// The vector `v` turned by `m`.
 pub fn vector(m: &Mat4, v: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])

@@ -232,20 +232,8 @@ impl Builder {
     fn medium_box(&self, p: &Params) -> Result<Option<BoxDesc>, Problem> {
         let p0 = p.triple("p0", &["point3", "point"])?.unwrap_or([0.0; 3]);
         let p1 = p.triple("p1", &["point3", "point"])?.unwrap_or([1.0; 3]);
-        let mut b = BoxDesc {
-            min: [f64::INFINITY; 3],
-            max: [f64::NEG_INFINITY; 3],
-        };
-        for corner in 0..8 {
-            let q: [f64; 3] =
-                std::array::from_fn(|a| if corner >> a & 1 == 1 { p1[a] } else { p0[a] });
-            let w = matrix::point(&self.state.ctm, q);
-            for (a, v) in w.into_iter().enumerate() {
-                b.min[a] = b.min[a].min(v);
-                b.max[a] = b.max[a].max(v);
-            }
-        }
-        Ok(Some(b))
+        let (min, max) = matrix::placed_box(&self.state.ctm, p0, p1);
+        Ok(Some(BoxDesc { min, max }))
     }
 
     /// `MediumInterface "inside" "outside"` (one name: both sides), at

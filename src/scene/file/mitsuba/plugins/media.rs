@@ -5,7 +5,6 @@
 
 use super::super::props::{Colour, Props};
 use super::super::spectrum::Use;
-use super::super::transform::Mat4;
 use super::super::xml::Element;
 use super::{Convert, Failure};
 use crate::scene::desc::{BoxDesc, FieldDesc, GridDesc, MediumDesc, TransformDesc};
@@ -133,7 +132,10 @@ impl<'d> Convert<'d> {
                     }
                 };
                 p.finish(&["value", "to_world"], self)?;
-                let b = to_world.map_or(UNIT_CUBE, |m| placed_cube(&m));
+                let b = to_world.map_or(UNIT_CUBE, |m| {
+                    let (min, max) = crate::scene::file::matrix::placed_box(&m, [0.0; 3], [1.0; 3]);
+                    BoxDesc { min, max }
+                });
                 Ok((value, boxed(b)))
             }
             "gridvolume" => {
@@ -205,21 +207,4 @@ impl<'d> Convert<'d> {
             },
         )
     }
-}
-
-/// The box of the unit cube placed by `m`.
-fn placed_cube(m: &Mat4) -> BoxDesc {
-    let mut b = BoxDesc {
-        min: [f64::INFINITY; 3],
-        max: [f64::NEG_INFINITY; 3],
-    };
-    for corner in 0..8 {
-        let p = [corner & 1, corner >> 1 & 1, corner >> 2 & 1].map(|c| c as f64);
-        for (a, row) in m.iter().take(3).enumerate() {
-            let v = row[0] * p[0] + row[1] * p[1] + row[2] * p[2] + row[3];
-            b.min[a] = b.min[a].min(v);
-            b.max[a] = b.max[a].max(v);
-        }
-    }
-    b
 }
