@@ -253,3 +253,10 @@ fn participating_media_heterogeneous() {
         check("participating_media", scene);
     }
 }
+
+/// A bitmap under each of Mitsuba's wrap modes (repeat, mirror, clamp) and
+/// both filters (bilinear, nearest), its coordinates scaled past [0, 1].
+#[test]
+fn texture_wrap_modes_and_filters() {
+    check("texture_interp", "test_texture_interp_direct.xml");
+}
