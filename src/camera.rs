@@ -6,6 +6,11 @@
 //! plane, `focus_dist` in front of the camera, and is 2·tan(vfov/2)·focus_dist
 //! high. Rays start from a random point of the defocus disk (the lens) and pass
 //! through a random point of their pixel, so only the focus plane is sharp.
+//!
+//! An orthographic camera instead sends parallel rays along −w from the
+//! points of a rectangle through `lookfrom`, of the height its projection
+//! gives and the image's aspect: a view without perspective, in which size
+//! does not change with distance.
 
 use crate::math::{Point3, Vec3};
 use crate::ray::Ray;
@@ -44,6 +49,22 @@ pub struct CameraSettings {
     /// The image is the window `[x, y, …]` of a full image of
     /// `[…, width, height]` pixels; `None`: the whole image.
     pub crop: Option<[u32; 4]>,
+    /// Perspective (framed by `vfov`) or orthographic.
+    pub projection: Projection,
+}
+
+/// How the camera maps the scene onto the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Rays from the lens through the image plane, `vfov` high.
+    Perspective,
+    /// Parallel rays along the view direction from the points of a
+    /// rectangle through `lookfrom`, `height` high in scene units (its
+    /// width follows the image's aspect); `vfov` does not apply.
+    Orthographic {
+        /// The height of the rectangle seen.
+        height: f32,
+    },
 }
 
 impl Default for CameraSettings {
@@ -60,6 +81,7 @@ impl Default for CameraSettings {
             near_clip: 0.0,
             far_clip: f32::INFINITY,
             crop: None,
+            projection: Projection::Perspective,
         }
     }
 }
@@ -124,6 +146,27 @@ pub enum CameraError {
     #[error("far_clip must be beyond near_clip ({1}), got {0}")]
     /// A far clipping distance not beyond the near one.
     FarClip(f32, f32),
+    /// An orthographic view's height is not positive and finite.
+    #[error("ortho_height must be positive, got {0}")]
+    OrthoHeight(f32),
+    /// An orthographic camera given a lens.
+    #[error("an orthographic camera has no lens: defocus_angle must be 0, got {0}")]
+    OrthographicLens(f32),
+    /// An orthographic view so small that neighbouring pixels' rays
+    /// coincide in `f32` at the camera's coordinates.
+    #[error(
+        "ortho_height {height:e} puts neighbouring pixels {step:e} apart at coordinates up to \
+         {scale:e}, closer than f32 can tell apart: make it larger or move the scene nearer \
+         the origin"
+    )]
+    OrthographicUnresolved {
+        /// The height given.
+        height: f32,
+        /// The distance between neighbouring pixels.
+        step: f32,
+        /// The largest coordinate of the viewed rectangle.
+        scale: f32,
+    },
 }
 
 /// A camera ready to generate rays for an image of a given size.
@@ -146,6 +189,9 @@ pub struct Camera {
     near_clip: f32,
     /// How far in front of the lens they end.
     far_clip: f32,
+    /// Orthographic: every ray's direction, from its point of the image
+    /// rectangle.
+    parallel: Option<Vec3>,
 }
 
 impl Camera {
@@ -178,8 +224,19 @@ impl Camera {
         if view == Vec3::ZERO {
             return Err(CameraError::NoViewDirection(s.lookfrom));
         }
-        if !(s.vfov > 0.0 && s.vfov < 180.0) {
-            return Err(CameraError::FieldOfView(s.vfov));
+        let ortho_height = match s.projection {
+            Projection::Perspective => None,
+            Projection::Orthographic { height } => Some(height),
+        };
+        match ortho_height {
+            None if !(s.vfov > 0.0 && s.vfov < 180.0) => {
+                return Err(CameraError::FieldOfView(s.vfov))
+            }
+            Some(h) if !(h > 0.0 && h.is_finite()) => return Err(CameraError::OrthoHeight(h)),
+            Some(_) if s.defocus_angle != 0.0 => {
+                return Err(CameraError::OrthographicLens(s.defocus_angle))
+            }
+            _ => {}
         }
         if !(s.focus_dist > 0.0) {
             return Err(CameraError::FocusDistance(s.focus_dist));
@@ -226,13 +283,17 @@ impl Camera {
             Some(crop) => return Err(CameraError::Crop(crop, width, height)),
         };
         let h = (s.vfov.to_radians() / 2.0).tan();
-        let viewport_height = 2.0 * h * s.focus_dist;
+        // An orthographic view's rectangle passes through the eye.
+        let (viewport_height, plane_dist) = match ortho_height {
+            None => (2.0 * h * s.focus_dist, s.focus_dist),
+            Some(height) => (height, 0.0),
+        };
         let viewport_width = viewport_height * (full_width as f32 / full_height as f32);
         let viewport_u = viewport_width * u;
         let viewport_v = -viewport_height * v; // image rows go down
         let pixel_du = viewport_u / full_width as f32;
         let pixel_dv = viewport_v / full_height as f32;
-        let upper_left = s.lookfrom - s.focus_dist * w - viewport_u / 2.0 - viewport_v / 2.0;
+        let upper_left = s.lookfrom - plane_dist * w - viewport_u / 2.0 - viewport_v / 2.0;
         let pixel00 =
             upper_left + 0.5 * (pixel_du + pixel_dv) + x0 as f32 * pixel_du + y0 as f32 * pixel_dv;
         let defocus_radius = s.focus_dist * (s.defocus_angle.to_radians() / 2.0).tan();
@@ -265,6 +326,13 @@ impl Camera {
             .max_element()
             .min(pixel_dv.abs().max_element());
         let resolution = 2.0 * f32::EPSILON * scale;
+        if let (Some(height), false) = (ortho_height, step > resolution) {
+            return Err(CameraError::OrthographicUnresolved {
+                height,
+                step,
+                scale,
+            });
+        }
         if !(step > resolution) {
             return Err(CameraError::Unresolved {
                 focus_dist: s.focus_dist,
@@ -295,6 +363,7 @@ impl Camera {
             filter: crate::filter::PixelFilter::Box,
             near_clip: s.near_clip,
             far_clip: s.far_clip,
+            parallel: ortho_height.map(|_| -w),
         })
     }
 
@@ -318,11 +387,14 @@ impl Camera {
     #[inline]
     pub fn central_ray(&self, x: u32, y: u32) -> Ray {
         let target = self.pixel00 + x as f32 * self.pixel_du + y as f32 * self.pixel_dv;
-        Ray::timed(
-            self.center,
-            (target - self.center).normalize(),
-            self.shutter_open,
-        )
+        match self.parallel {
+            Some(direction) => Ray::timed(target, direction, self.shutter_open),
+            None => Ray::timed(
+                self.center,
+                (target - self.center).normalize(),
+                self.shutter_open,
+            ),
+        }
     }
 
     /// The ray through pixel `(x, y)` at sub-pixel offset `(dx, dy)` ∈ [-0.5, 0.5)²
@@ -333,18 +405,23 @@ impl Camera {
         let (dx, dy) = (self.filter.offset(dx), self.filter.offset(dy));
         let target =
             self.pixel00 + (x as f32 + dx) * self.pixel_du + (y as f32 + dy) * self.pixel_dv;
-        let origin = if self.defocus_u == Vec3::ZERO {
-            self.center
-        } else {
-            let p = sampling::in_unit_disk(sampler, Dim::Lens);
-            self.center + p.x * self.defocus_u + p.y * self.defocus_v
+        let (origin, direction) = match self.parallel {
+            Some(direction) => (target, direction),
+            None => {
+                let origin = if self.defocus_u == Vec3::ZERO {
+                    self.center
+                } else {
+                    let p = sampling::in_unit_disk(sampler, Dim::Lens);
+                    self.center + p.x * self.defocus_u + p.y * self.defocus_v
+                };
+                (origin, (target - origin).normalize())
+            }
         };
         let time = if self.shutter_span > 0.0 {
             self.shutter_open + self.shutter_span * sampler.get_1d(Dim::Time)
         } else {
             self.shutter_open
         };
-        let direction = (target - origin).normalize();
         let origin = if self.near_clip > 0.0 {
             // On the near plane: its distance over the cosine to the view.
             origin + direction * (self.near_clip / -direction.dot(self.basis[2]))
@@ -373,6 +450,7 @@ mod tests {
             near_clip: 0.0,
             far_clip: f32::INFINITY,
             crop: None,
+            projection: Projection::Perspective,
         }
     }
 
@@ -589,5 +667,71 @@ mod tests {
                 Err(CameraError::NearClip(_))
             ));
         }
+    }
+
+    /// An orthographic camera's rays all run along the view, from the
+    /// points of a rectangle through the eye of the height asked and the
+    /// image's aspect, the clipping planes measured along them.
+    #[test]
+    fn orthographic_rays_are_parallel_from_a_rectangle_of_the_height_asked() {
+        let s = CameraSettings {
+            lookfrom: Vec3::new(1.0, 2.0, 3.0),
+            lookat: Vec3::new(1.0, 2.0, -5.0),
+            near_clip: 0.25,
+            far_clip: 10.25,
+            projection: Projection::Orthographic { height: 3.0 },
+            ..settings()
+        };
+        let (width, height) = (40, 30);
+        let camera = Camera::new(&s, width, height).unwrap();
+        let mut rng = Rng::new(3);
+        let view = Vec3::new(0.0, 0.0, -1.0);
+        let mut low = Vec3::splat(f32::INFINITY);
+        let mut high = Vec3::splat(f32::NEG_INFINITY);
+        for (x, y, dx, dy) in [
+            (0, 0, -0.5, -0.5),
+            (39, 29, 0.4999, 0.4999),
+            (20, 15, 0.0, 0.0),
+        ] {
+            let ray = camera.ray(x, y, dx, dy, &mut rng);
+            assert!((ray.direction - view).length() < 1e-6, "{ray:?}");
+            let o = ray.origin();
+            assert!(
+                (o.z - (3.0 - 0.25)).abs() < 1e-5,
+                "starts on the near plane: {o}"
+            );
+            assert!((camera.far(&ray) - 10.0).abs() < 1e-5);
+            low = low.min(o);
+            high = high.max(o);
+        }
+        // The corners span 4 × 3 about the eye; image rows run down.
+        assert!((high.x - low.x - 4.0).abs() < 1e-3 && (high.y - low.y - 3.0).abs() < 1e-3);
+        assert!((0.5 * (low + high) - Vec3::new(1.0, 2.0, 2.75)).length() < 1e-3);
+        let top_left = camera.ray(0, 0, -0.5, -0.5, &mut rng).origin();
+        assert!(top_left.x < 0.0 && top_left.y > 3.0, "{top_left}");
+        let centre = camera.central_ray(20, 15);
+        assert_eq!(centre.direction, view);
+        for (projection, defocus_angle, expected) in [
+            (0.0, 0.0, CameraError::OrthoHeight(0.0)),
+            (f32::INFINITY, 0.0, CameraError::OrthoHeight(f32::INFINITY)),
+            (1.0, 2.0, CameraError::OrthographicLens(2.0)),
+        ] {
+            let bad = CameraSettings {
+                projection: Projection::Orthographic { height: projection },
+                defocus_angle,
+                ..s
+            };
+            assert_eq!(Camera::new(&bad, 4, 4).unwrap_err(), expected);
+        }
+        let tiny = CameraSettings {
+            lookfrom: Vec3::new(1e6, 0.0, 0.0),
+            lookat: Vec3::new(1e6, 0.0, -1.0),
+            projection: Projection::Orthographic { height: 1e-3 },
+            ..s
+        };
+        assert!(matches!(
+            Camera::new(&tiny, 400, 300),
+            Err(CameraError::OrthographicUnresolved { .. })
+        ));
     }
 }

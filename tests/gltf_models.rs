@@ -190,3 +190,67 @@ file = "{}"
         }
     }
 }
+
+/// A glTF file's cameras frame the view: a perspective camera its place,
+/// direction and field of view; an orthographic one its place and twice
+/// its `ymag` up, scaled by the transforms above it. Each is found by
+/// number and by name.
+#[test]
+fn gltf_cameras_frame_the_view_perspective_and_orthographic() {
+    use base64::Engine;
+    let dir = scratch_dir("gltf-cameras");
+    let mut bytes = Vec::new();
+    for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in v {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    let gltf = format!(
+        r#"{{"asset":{{"version":"2.0"}},
+"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":36}}],
+"bufferViews":[{{"buffer":0,"byteLength":36}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+"cameras":[{{"name":"wide","type":"perspective","perspective":{{"yfov":0.5,"znear":0.1}}}},
+           {{"name":"plan","type":"orthographic","orthographic":{{"xmag":3,"ymag":2,"znear":0.1,"zfar":100}}}}],
+"nodes":[{{"mesh":0}},{{"camera":0,"translation":[0,0,5]}},
+         {{"camera":1,"translation":[1,2,6]}}],
+"scenes":[{{"nodes":[0,1,2]}}],"scene":0}}"#
+    );
+    std::fs::write(dir.join("cams.gltf"), gltf).unwrap();
+    let scene = |camera: &str| {
+        compile_file(
+            &dir,
+            "s.toml",
+            &format!(
+                "[render]\nwidth = 20\nheight = 10\n[camera]\n{camera}\n\
+                 [[objects]]\ntype = \"mesh\"\nfile = \"cams.gltf\"\n\
+                 transform = [{{ scale = 2 }}]\n"
+            ),
+        )
+        .camera
+    };
+    // Perspective: from (0, 0, 10) (the node's place scaled by 2) down −z,
+    // the pixel rows 0.5 rad apart top to bottom.
+    for pick in ["gltf = 0", "gltf = \"wide\""] {
+        let c = scene(pick);
+        let (top, bottom) = (c.central_ray(10, 0), c.central_ray(10, 9));
+        assert!((top.origin() - lumen::math::Vec3::new(0.0, 0.0, 10.0)).length() < 1e-5);
+        let spread = top.direction.angle_between(bottom.direction);
+        assert!((spread - 0.5 * 9.0 / 10.0).abs() < 2e-3, "{pick}: {spread}");
+    }
+    // Orthographic: parallel rays down −z from a rectangle 2·2·2 = 8 high
+    // (and 16 wide) about (2, 4, 12).
+    for pick in ["gltf = 1", "gltf = \"plan\""] {
+        let c = scene(pick);
+        let (a, b) = (c.central_ray(0, 0), c.central_ray(19, 9));
+        assert_eq!(a.direction, b.direction);
+        assert!((a.direction.z + 1.0).abs() < 1e-6);
+        let span = b.origin() - a.origin();
+        assert!((span.x - 16.0 * 19.0 / 20.0).abs() < 1e-4, "{pick}: {span}");
+        assert!((span.y + 8.0 * 9.0 / 10.0).abs() < 1e-4, "{pick}: {span}");
+        let centre = 0.5 * (a.origin() + b.origin());
+        assert!((centre - lumen::math::Vec3::new(2.0, 4.0, 12.0)).length() < 1e-4);
+    }
+}

@@ -260,3 +260,10 @@ fn participating_media_heterogeneous() {
 fn texture_wrap_modes_and_filters() {
     check("texture_interp", "test_texture_interp_direct.xml");
 }
+
+/// An orthographic sensor whose transform's scale sizes its view, looking
+/// obliquely at a checkerboard under a constant sky.
+#[test]
+fn orthographic_sensor() {
+    check("orthographic_sensor", "test_orthographic_path.xml");
+}

@@ -30,6 +30,7 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
         "bsdf_spheres/test_textured_diffuse_path.xml",
         "instancing/test_instancing_path.xml",
         "floating_sphere/test_directional_direct.xml",
+        "orthographic_sensor/test_orthographic_path.xml",
         "participating_media/test_homo_area_light_volpath.xml",
         "participating_media/test_hetero_sigmat_albedo_volpath.xml",
         "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath.xml",
@@ -177,6 +178,16 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         (
             scene("  <shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>"),
             vec!["bad.xml:2:", "undefined parameter `$r`", "<default name=\"r\""],
+        ),
+        // An orthographic view must keep its pixels square, and has no
+        // field of view.
+        (
+            scene("  <sensor type=\"orthographic\"><transform name=\"to_world\"><scale x=\"1\" y=\"2\"/></transform></sensor>"),
+            vec!["bad.xml:2:3", "scales x by 1 and y by 2", "must scale both alike"],
+        ),
+        (
+            scene("  <sensor type=\"orthographic\"><float name=\"fov\" value=\"40\"/></sensor>"),
+            vec!["bad.xml:2:", "has no parameter `fov`"],
         ),
         // Unknown plugins and parameters.
         (

@@ -159,6 +159,64 @@ fn cameras_follow_pbrts_conventions() {
     assert_eq!(plain.render.max_depth, 6);
 }
 
+/// An orthographic camera sees pbrt's screen window: 2 across the
+/// image's shorter side, or the `screenwindow` given, sized by the
+/// camera's transform; and the same view written for Mitsuba (whose
+/// sensor plane is 2 across the image's width, sized by its transform's
+/// scale) reads as the same camera.
+#[test]
+fn orthographic_cameras_see_the_window_each_format_gives_them() {
+    let camera = |name: &str, before: &str, params: &str, (w, h): (u32, u32)| {
+        read(
+            name,
+            &format!(
+                "{before}LookAt 1 2 3  1 2 0  0 1 0\nCamera \"orthographic\" {params}\n\
+                 Film \"rgb\" \"integer xresolution\" {w} \"integer yresolution\" {h}\nWorldBegin\n"
+            ),
+        )
+        .camera
+    };
+    let landscape = camera("ortho_landscape", "", "", (200, 100));
+    assert_eq!(landscape.ortho_height, Some(2.0));
+    assert!(landscape.mirror && close(landscape.lookfrom, [1.0, 2.0, 3.0]));
+    assert!(close(landscape.lookat, [1.0, 2.0, 2.0]));
+    assert_eq!(
+        camera("ortho_portrait", "", "", (100, 200)).ortho_height,
+        Some(4.0)
+    );
+    let window = camera(
+        "ortho_window",
+        "",
+        "\"float screenwindow\" [ -3 3 -1.5 1.5 ]",
+        (200, 100),
+    );
+    assert_eq!(window.ortho_height, Some(3.0));
+    // The camera's frame shrunk by half sees twice as much of the world.
+    let scaled = camera("ortho_scaled", "Scale 0.5 0.5 1\n", "", (200, 100));
+    assert!((scaled.ortho_height.unwrap() - 4.0).abs() < 1e-12);
+
+    let dir = scratch_dir("pbrt_scenes_ortho_mitsuba");
+    let xml = dir.join("ortho.xml");
+    std::fs::write(
+        &xml,
+        "<scene version=\"3.0.0\"><sensor type=\"orthographic\"><transform name=\"to_world\">\
+         <scale x=\"3\" y=\"3\"/><lookat origin=\"1, 2, 3\" target=\"1, 2, 0\" up=\"0, 1, 0\"/>\
+         </transform><float name=\"near_clip\" value=\"0\"/>\
+         <film type=\"hdrfilm\"><integer name=\"width\" value=\"200\"/>\
+         <integer name=\"height\" value=\"100\"/></film></sensor></scene>",
+    )
+    .unwrap();
+    let mitsuba = SceneFile::read(&xml)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .desc
+        .camera;
+    assert_eq!(mitsuba.ortho_height, window.ortho_height);
+    assert!(close(mitsuba.lookfrom, window.lookfrom) && close(mitsuba.lookat, window.lookat));
+    assert!(close(mitsuba.vup, window.vup));
+    // Mitsuba's image runs along the frame's −x, pbrt's along its +x.
+    assert!(!mitsuba.mirror && window.mirror);
+}
+
 #[test]
 fn transforms_instances_and_materials_are_placed_as_pbrt_places_them() {
     let mut d = read(
@@ -437,6 +495,10 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("WorldBegin\nTranslate 1 2\n", "expected a number, but the file ends"),
         ("MediumInterface \"fgo\" \"\"\nWorldBegin\n", "s.pbrt:1:1: no medium is named `fgo`; no medium is defined"),
         ("MakeNamedMedium \"m\"\n", "a medium needs a \"string type\""),
+        ("Camera \"orthographic\" \"float screenwindow\" [ -1 1 -1 ]\n", "s.pbrt:1:23: `screenwindow` takes 4 numbers [x0 x1 y0 y1], got 3"),
+        ("Camera \"orthographic\" \"float screenwindow\" [ 0 2 -1 1 ]\nFilm \"rgb\" \"integer xresolution\" 10 \"integer yresolution\" 10\nWorldBegin\n", "s.pbrt:1:8: lumen has no `screenwindow` shifted off centre"),
+        ("Scale 1 2 1\nCamera \"orthographic\"\nWorldBegin\n", "s.pbrt:2:8: the camera's transform scales x by 1 and y by 0.5"),
+        ("Camera \"orthographic\" \"float lensradius\" 0.1\n", "an orthographic camera's lens"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogenous\"\n", "no medium kind is called `homogenous`; pbrt has homogeneous"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1\n", "s.pbrt:1:49: `g` must lie between −0.999 and 0.999"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n", "s.pbrt:1:49: `sigma_a` must be finite and ≥ 0"),

@@ -359,6 +359,33 @@ fn vfov_outside_0_to_180() {
 }
 
 #[test]
+fn orthographic_views_without_a_height_or_with_a_lens() {
+    for bad in ["0", "-2", "inf", "nan"] {
+        let m = refused(&base_with(
+            "vfov = 90",
+            &format!("vfov = 90\northo_height = {bad}"),
+        ));
+        assert_mentions(&m, &["scene.toml:7:", "camera.ortho_height"]);
+    }
+    let m = refused(&base_with(
+        "vfov = 90",
+        "vfov = 90\northo_height = 2\ndefocus_angle = 1",
+    ));
+    assert_mentions(
+        &m,
+        &["camera.defocus_angle", "orthographic camera has no lens"],
+    );
+    // Out of its use, the field of view is not checked.
+    let file = SceneFile::parse(
+        "scene.toml",
+        base_with("vfov = 90", "vfov = 0\northo_height = 2"),
+        Format::Toml,
+    )
+    .unwrap();
+    assert!(file.compile(&Overrides::default()).is_ok());
+}
+
+#[test]
 fn lookfrom_equal_to_lookat() {
     let m = refused(&base_with("lookat = [0, 0, -1]", "lookat = [0, 0, 0]"));
     assert_mentions(

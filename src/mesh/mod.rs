@@ -245,7 +245,7 @@ pub struct Model {
     pub file_len: u64,
     /// What the file holds that lumen does not render, one line each.
     pub warnings: Vec<String>,
-    /// The file's perspective cameras (glTF), in the order of its nodes.
+    /// The file's cameras (glTF), in the order of its nodes.
     pub cameras: Vec<ModelCamera>,
 }
 
@@ -257,8 +257,23 @@ pub struct ModelCamera {
     /// Camera to model space (column-major): the camera looks along −z,
     /// +y up.
     pub transform: Mat4,
-    /// The vertical field of view, in radians.
-    pub yfov: f32,
+    /// How it projects.
+    pub view: ModelView,
+}
+
+/// How a model's camera projects the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelView {
+    /// Perspective, with this vertical field of view in radians.
+    Perspective {
+        /// The vertical field of view.
+        yfov: f32,
+    },
+    /// Orthographic, seeing ±`ymag` up and down its frame's y.
+    Orthographic {
+        /// Half the height seen, in camera space.
+        ymag: f32,
+    },
 }
 
 impl Model {

@@ -85,6 +85,10 @@ impl SceneError {
                 CameraError::Crop(..) => "render.crop".into(),
                 CameraError::NearClip(_) => "camera.near_clip".into(),
                 CameraError::FarClip(..) => "camera.far_clip".into(),
+                CameraError::OrthoHeight(_) | CameraError::OrthographicUnresolved { .. } => {
+                    "camera.ortho_height".into()
+                }
+                CameraError::OrthographicLens(_) => "camera.defocus_angle".into(),
             },
             SceneError::Invalid { field, .. } | SceneError::UnknownMaterial { field, .. } => {
                 field.clone()

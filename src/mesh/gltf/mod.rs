@@ -78,18 +78,27 @@ pub(super) fn load(
     let mut mesh_slot: Vec<Option<usize>> = vec![None; document.meshes().len()];
     for (node, transform) in walk_nodes(&document).map_err(err)? {
         if let Some(camera) = node.camera() {
-            match camera.projection() {
+            let view = match camera.projection() {
                 gltf::camera::Projection::Perspective(p)
                     if p.yfov().is_finite() && p.yfov() > 0.0 =>
                 {
-                    model.cameras.push(super::ModelCamera {
-                        name: camera.name().map(str::to_string),
-                        transform,
-                        yfov: p.yfov(),
-                    })
+                    Some(super::ModelView::Perspective { yfov: p.yfov() })
                 }
-                _ => model.warnings.push(format!(
-                    "camera {} is not a perspective camera lumen can use",
+                gltf::camera::Projection::Orthographic(o)
+                    if o.ymag().is_finite() && o.ymag() > 0.0 =>
+                {
+                    Some(super::ModelView::Orthographic { ymag: o.ymag() })
+                }
+                _ => None,
+            };
+            match view {
+                Some(view) => model.cameras.push(super::ModelCamera {
+                    name: camera.name().map(str::to_string),
+                    transform,
+                    view,
+                }),
+                None => model.warnings.push(format!(
+                    "camera {} has no field of view or magnification lumen can use",
                     camera.index()
                 )),
             }

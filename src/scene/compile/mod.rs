@@ -11,7 +11,7 @@ use super::{
     invalid, FileReport, MeshSource, Scene, SceneDesc, SceneError, SceneStats, Settings,
     MAX_COORDINATE, MAX_PIXELS,
 };
-use crate::camera::{Camera, CameraError, CameraSettings};
+use crate::camera::{Camera, CameraError, CameraSettings, Projection};
 use crate::filter::PixelFilter;
 use crate::geometry::bvh_build::Aabb;
 use crate::geometry::quadric;
@@ -22,7 +22,7 @@ use crate::material::param::{self, ColorRange, Range};
 use crate::material::{ColorParam, Invalid, Material, ScalarParam, Textures};
 use crate::math::{Color, Vec3};
 use crate::medium::{Boundary, Medium};
-use crate::mesh::{self, Model, TriangleMesh, NO_MATERIAL};
+use crate::mesh::{self, Model, ModelView, TriangleMesh, NO_MATERIAL};
 use crate::texture::{Channels, ImageMap, Texture};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -353,6 +353,15 @@ fn compile_camera(
             near_clip: cam.near_clip as f32,
             far_clip: cam.far_clip.map_or(f32::INFINITY, |f| f as f32),
             crop: settings.crop,
+            projection: match cam.ortho_height {
+                None => Projection::Perspective,
+                Some(height) => {
+                    finite("camera.ortho_height", &[height])?;
+                    Projection::Orthographic {
+                        height: height as f32,
+                    }
+                }
+            },
         },
         settings.width,
         settings.height,
@@ -1138,7 +1147,7 @@ impl Objects<'_> {
                 GltfCamera::Name(n) => format!("no camera named \"{n}\""),
             };
             let have = if names.is_empty() {
-                "the scene's glTF models have no perspective cameras".to_string()
+                "the scene's glTF models have no cameras".to_string()
             } else {
                 format!("the scene's glTF models have cameras {}", names.join(", "))
             };
@@ -1150,11 +1159,20 @@ impl Objects<'_> {
         let ahead = point(glam::Vec3::NEG_Z);
         let up = t.vector(Vec3::from(m.transform_vector3(glam::Vec3::Y)));
         let triple = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        let (vfov, ortho_height) = match c.view {
+            ModelView::Perspective { yfov } => (f64::from(yfov).to_degrees(), None),
+            // ±ymag up its frame, which the transforms may scale.
+            ModelView::Orthographic { ymag } => (
+                self.desc.camera.vfov,
+                Some(2.0 * f64::from(ymag) * f64::from(up.length())),
+            ),
+        };
         Ok(Some(CameraDesc {
             lookfrom: triple(eye),
             lookat: triple(ahead),
             vup: triple(up),
-            vfov: f64::from(c.yfov).to_degrees(),
+            vfov,
+            ortho_height,
             ..self.desc.camera.clone()
         }))
     }

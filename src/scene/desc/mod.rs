@@ -416,8 +416,8 @@ pub struct CameraDesc {
     pub shutter: [f64; 2],
     /// A camera of the scene's glTF models, by number (counting the
     /// cameras of every glTF mesh object in order) or by name: its place,
-    /// direction and field of view replace `lookfrom`, `lookat`, `vup` and
-    /// `vfov`.
+    /// direction and projection replace `lookfrom`, `lookat`, `vup`,
+    /// `vfov` and `ortho_height`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gltf: Option<GltfCamera>,
     /// Show the image mirrored left to right: +x of the image is
@@ -438,6 +438,11 @@ pub struct CameraDesc {
     /// absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<String>,
+    /// An orthographic camera seeing a rectangle this high, in scene units,
+    /// through `lookfrom` (its width follows the image's aspect): parallel
+    /// rays along the view direction, and `vfov` unused. None: perspective.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ortho_height: Option<f64>,
 }
 
 /// Which camera of the scene's glTF models.
@@ -476,6 +481,7 @@ impl Default for CameraDesc {
             near_clip: 0.0,
             far_clip: None,
             medium: None,
+            ortho_height: None,
         }
     }
 }

@@ -630,6 +630,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
             "near_clip",
             "far_clip",
             "medium",
+            "ortho_height",
         ],
         &[],
     )?;
@@ -649,6 +650,7 @@ fn camera(node: &Node) -> Result<CameraDesc> {
         near_clip: t.optional("near_clip", float)?.unwrap_or(d.near_clip),
         far_clip: t.optional("far_clip", float)?,
         medium: t.optional("medium", string)?.map(str::to_string),
+        ortho_height: t.optional("ortho_height", float)?,
     })
 }
 

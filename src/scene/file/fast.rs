@@ -250,6 +250,7 @@ fn camera(c: &CameraDesc) -> bool {
         && finite(&c.shutter)
         && finite(&[c.vfov, c.defocus_angle])
         && c.focus_dist.is_none_or(f64::is_finite)
+        && c.ortho_height.is_none_or(f64::is_finite)
 }
 
 fn background(b: &BackgroundDesc) -> bool {

@@ -399,21 +399,22 @@ impl<'d> Convert<'d> {
 
     fn sensor(&mut self, e: &'d Element) -> Result<(), Failure> {
         let t = self.type_of(e)?;
-        if !matches!(t, "perspective" | "thinlens") {
-            return Err(self.unknown_type(e, "sensor", &["perspective", "thinlens"]));
+        const SENSORS: &[&str] = &["perspective", "thinlens", "orthographic"];
+        if !SENSORS.contains(&t) {
+            return Err(self.unknown_type(e, "sensor", SENSORS));
         }
+        let orthographic = t == "orthographic";
         let p = Props::of(e, self)?;
-        let mut known = vec![
-            "to_world",
-            "fov",
-            "fov_axis",
-            "near_clip",
-            "far_clip",
-            "focal_length",
-            "principal_point_offset_x",
-            "principal_point_offset_y",
-            "srf",
-        ];
+        let mut known = vec!["to_world", "near_clip", "far_clip", "srf"];
+        if !orthographic {
+            known.extend([
+                "fov",
+                "fov_axis",
+                "focal_length",
+                "principal_point_offset_x",
+                "principal_point_offset_y",
+            ]);
+        }
         if t == "perspective" {
             // Every Mitsuba camera has one; a pinhole is in focus
             // everywhere.
@@ -435,6 +436,120 @@ impl<'d> Convert<'d> {
         }
         let to_world = p.transform("to_world", self)?.unwrap_or(IDENTITY);
         let aspect = f64::from(width) / f64::from(height);
+        let vfov = if orthographic {
+            None
+        } else {
+            Some(self.vertical_fov(e, &p, aspect)?)
+        };
+        // Mitsuba's camera rays start on the near plane (10⁻² by default).
+        let near_clip = p.float("near_clip", self)?.unwrap_or(1e-2);
+        let far_clip = p.float("far_clip", self)?.unwrap_or(1e4);
+        if !(near_clip >= 0.0) {
+            return Err(self.fail(
+                e,
+                format!("near_clip must not be negative, got {near_clip}"),
+            ));
+        }
+        for n in ["principal_point_offset_x", "principal_point_offset_y"] {
+            if !orthographic && p.float(n, self)?.is_some_and(|v| v != 0.0) {
+                self.lacks(e, &format!("{n} (a shifted lens)"), "a centred lens")?;
+            }
+        }
+        if p.has("srf") {
+            let _ = p.colour("srf", Use::Unbounded, self)?;
+            self.lacks(
+                e,
+                "a sensor response function (srf)",
+                "the RGB film's response",
+            )?;
+        }
+        let origin = transform::point(&to_world, [0.0; 3]);
+        let forward = transform::vector(&to_world, [0.0, 0.0, 1.0]);
+        let up = transform::vector(&to_world, [0.0, 1.0, 0.0]);
+        let lengths = [forward, up, transform::vector(&to_world, [1.0, 0.0, 0.0])]
+            .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt());
+        let [depth_scale, y_scale, x_scale] = lengths;
+        let (near_clip, far_clip, ortho_height) = if orthographic {
+            // The sensor's plane is [−1, 1] × [−1/aspect, 1/aspect] of its
+            // frame, at near_clip along its z: the frame's scale sizes it
+            // (and the near distance), and it must keep pixels square.
+            if !(x_scale > 0.0 && depth_scale > 0.0 && (y_scale / x_scale - 1.0).abs() <= 1e-3) {
+                return Err(self.fail(
+                    e,
+                    format!(
+                        "the sensor's to_world scales x by {x_scale} and y by {y_scale}: an \
+                         orthographic view must scale both alike"
+                    ),
+                ));
+            }
+            let near = near_clip * depth_scale;
+            (
+                near,
+                near + far_clip - near_clip,
+                Some(2.0 * y_scale / aspect),
+            )
+        } else {
+            if lengths.iter().any(|l| (l - 1.0).abs() > 1e-3) {
+                return Err(self.fail(
+                    e,
+                    "the sensor's to_world scales: a camera's transform may only turn and move it"
+                        .into(),
+                ));
+            }
+            (near_clip, far_clip, None)
+        };
+        let unit = |v: [f64; 3], l: f64| v.map(|c| c / l);
+        let (forward, up) = (unit(forward, depth_scale), unit(up, y_scale));
+        let mut camera = CameraDesc {
+            vfov: vfov.map_or(CameraDesc::default().vfov, f64::to_degrees),
+            ortho_height,
+            lookfrom: origin,
+            lookat: [
+                origin[0] + forward[0],
+                origin[1] + forward[1],
+                origin[2] + forward[2],
+            ],
+            vup: up,
+            // Mitsuba's image runs along −x of the sensor's frame: a frame
+            // that mirrors mirrors the image.
+            mirror: transform::det3(&to_world) < 0.0,
+            ..CameraDesc::default()
+        };
+        if t == "thinlens" {
+            known.extend(["aperture_radius", "focus_distance"]);
+            let radius = p.float("aperture_radius", self)?.ok_or_else(|| {
+                self.fail(e, "a thinlens sensor needs an `aperture_radius`".into())
+            })?;
+            // Mitsuba focuses at the far clipping plane by default.
+            let focus = p.float("focus_distance", self)?.unwrap_or(far_clip);
+            if !(radius >= 0.0 && focus > 0.0) {
+                return Err(self.fail(
+                    e,
+                    "aperture_radius must be ≥ 0 and focus_distance > 0".into(),
+                ));
+            }
+            camera.defocus_angle = (2.0 * (radius / focus).atan()).to_degrees();
+            camera.focus_dist = Some(focus);
+        }
+        // Mitsuba takes a medium nested in the sensor, whatever its name,
+        // as the one the camera stands in.
+        camera.medium = match p.objects("medium")[..] {
+            [] => None,
+            [m] => Some(self.medium(m)?),
+            _ => return Err(self.fail(e, "a sensor stands in one <medium>".into())),
+        };
+        p.finish(&known, self)?;
+        camera.near_clip = near_clip;
+        camera.far_clip = Some(far_clip);
+        self.desc.camera = camera;
+        self.desc.render.width = width;
+        self.desc.render.height = Some(height);
+        Ok(())
+    }
+
+    /// A perspective sensor's vertical field of view in radians, from its
+    /// `fov` and `fov_axis` or its `focal_length`.
+    fn vertical_fov(&self, e: &Element, p: &Props, aspect: f64) -> Result<f64, Failure> {
         let fov = p.float("fov", self)?;
         let focal = p.string("focal_length", self)?;
         let x_fov = match (fov, focal) {
@@ -488,85 +603,7 @@ impl<'d> Convert<'d> {
                 "the field of view must lie between 0 and 180 degrees".into(),
             ));
         }
-        let vfov = 2.0 * ((x_fov / 2.0).tan() / aspect).atan();
-        // Mitsuba's camera rays start on the near plane (10⁻² by default).
-        let near_clip = p.float("near_clip", self)?.unwrap_or(1e-2);
-        let far_clip = p.float("far_clip", self)?.unwrap_or(1e4);
-        if !(near_clip >= 0.0) {
-            return Err(self.fail(
-                e,
-                format!("near_clip must not be negative, got {near_clip}"),
-            ));
-        }
-        for n in ["principal_point_offset_x", "principal_point_offset_y"] {
-            if p.float(n, self)?.is_some_and(|v| v != 0.0) {
-                self.lacks(e, &format!("{n} (a shifted lens)"), "a centred lens")?;
-            }
-        }
-        if p.has("srf") {
-            let _ = p.colour("srf", Use::Unbounded, self)?;
-            self.lacks(
-                e,
-                "a sensor response function (srf)",
-                "the RGB film's response",
-            )?;
-        }
-        let origin = transform::point(&to_world, [0.0; 3]);
-        let forward = transform::vector(&to_world, [0.0, 0.0, 1.0]);
-        let up = transform::vector(&to_world, [0.0, 1.0, 0.0]);
-        let lengths = [forward, up, transform::vector(&to_world, [1.0, 0.0, 0.0])]
-            .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt());
-        if lengths.iter().any(|l| (l - 1.0).abs() > 1e-3) {
-            return Err(self.fail(
-                e,
-                "the sensor's to_world scales: a camera's transform may only turn and move it"
-                    .into(),
-            ));
-        }
-        let mut camera = CameraDesc {
-            vfov: vfov.to_degrees(),
-            lookfrom: origin,
-            lookat: [
-                origin[0] + forward[0],
-                origin[1] + forward[1],
-                origin[2] + forward[2],
-            ],
-            vup: up,
-            // Mitsuba's image runs along −x of the sensor's frame: a frame
-            // that mirrors mirrors the image.
-            mirror: transform::det3(&to_world) < 0.0,
-            ..CameraDesc::default()
-        };
-        if t == "thinlens" {
-            known.extend(["aperture_radius", "focus_distance"]);
-            let radius = p.float("aperture_radius", self)?.ok_or_else(|| {
-                self.fail(e, "a thinlens sensor needs an `aperture_radius`".into())
-            })?;
-            // Mitsuba focuses at the far clipping plane by default.
-            let focus = p.float("focus_distance", self)?.unwrap_or(far_clip);
-            if !(radius >= 0.0 && focus > 0.0) {
-                return Err(self.fail(
-                    e,
-                    "aperture_radius must be ≥ 0 and focus_distance > 0".into(),
-                ));
-            }
-            camera.defocus_angle = (2.0 * (radius / focus).atan()).to_degrees();
-            camera.focus_dist = Some(focus);
-        }
-        // Mitsuba takes a medium nested in the sensor, whatever its name,
-        // as the one the camera stands in.
-        camera.medium = match p.objects("medium")[..] {
-            [] => None,
-            [m] => Some(self.medium(m)?),
-            _ => return Err(self.fail(e, "a sensor stands in one <medium>".into())),
-        };
-        p.finish(&known, self)?;
-        camera.near_clip = near_clip;
-        camera.far_clip = Some(far_clip);
-        self.desc.camera = camera;
-        self.desc.render.width = width;
-        self.desc.render.height = Some(height);
-        Ok(())
+        Ok(2.0 * ((x_fov / 2.0).tan() / aspect).atan())
     }
 
     fn film(&mut self, e: &Element) -> Result<(u32, u32), Failure> {

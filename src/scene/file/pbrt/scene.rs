@@ -98,6 +98,8 @@ struct Camera {
     fov: f64,
     lens_radius: f64,
     focal_distance: f64,
+    /// Orthographic: where, and the `screenwindow` given.
+    orthographic: Option<(At, Option<[f64; 4]>)>,
     /// The medium it stands in: the outside one when it was given.
     medium: Option<String>,
 }
@@ -614,8 +616,13 @@ impl Builder {
     }
 
     fn camera(&mut self, ty: &str, at: At, p: &Params) -> Result<(), Problem> {
-        if ty != "perspective" {
-            self.lacks(at, &format!("`{ty}` camera"), "a perspective camera")?;
+        let orthographic = ty == "orthographic";
+        if !orthographic && ty != "perspective" {
+            self.lacks(
+                at,
+                &format!("`{ty}` camera"),
+                "a perspective or orthographic camera",
+            )?;
         }
         let fov = p.float("fov")?.unwrap_or(90.0);
         if !(fov > 0.0 && fov < 180.0) {
@@ -644,8 +651,30 @@ impl Builder {
                 "the image of a shutter open for 1",
             )?;
         }
+        let ortho = if orthographic {
+            if lens_radius > 0.0 {
+                self.lacks(at, "an orthographic camera's lens", "a pinhole")?;
+            }
+            let window = match p.nums("screenwindow", &["float"])? {
+                None => None,
+                Some((&[x0, x1, y0, y1], _)) => Some([x0, x1, y0, y1]),
+                Some((w, w_at)) => {
+                    return Err((
+                        w_at,
+                        format!(
+                            "`screenwindow` takes 4 numbers [x0 x1 y0 y1], got {}",
+                            w.len()
+                        ),
+                        None,
+                    ))
+                }
+            };
+            Some((at, window))
+        } else {
+            None
+        };
         for n in ["screenwindow", "frameaspectratio"] {
-            if p.nums(n, &["float"])?.is_some() {
+            if (!orthographic || n != "screenwindow") && p.nums(n, &["float"])?.is_some() {
                 self.lacks(
                     at,
                     &format!("`{n}` (a shifted or stretched image)"),
@@ -654,7 +683,7 @@ impl Builder {
             }
         }
         p.finish(
-            "a perspective camera",
+            "a perspective or orthographic camera",
             &[
                 "fov",
                 "lensradius",
@@ -676,11 +705,36 @@ impl Builder {
         self.camera = Some(Camera {
             camera_from_world,
             fov,
-            lens_radius,
+            lens_radius: if orthographic { 0.0 } else { lens_radius },
             focal_distance,
+            orthographic: ortho,
             medium: self.state.media[1].clone(),
         });
         Ok(())
+    }
+
+    /// The height of an orthographic camera's screen window: pbrt's
+    /// default spans 2 across the image's shorter side; a `screenwindow`
+    /// is taken when it is centred and keeps the image's aspect.
+    fn ortho_height(&mut self, at: At, window: Option<[f64; 4]>) -> Result<f64, Problem> {
+        let (width, height) = self.film;
+        let aspect = f64::from(width) / f64::from(height);
+        let default = if aspect >= 1.0 { 2.0 } else { 2.0 / aspect };
+        let Some([x0, x1, y0, y1]) = window else {
+            return Ok(default);
+        };
+        let (span_x, span_y) = (x1 - x0, y1 - y0);
+        let centred = (x0 + x1).abs() <= 1e-6 * span_x && (y0 + y1).abs() <= 1e-6 * span_y;
+        if span_x > 0.0 && span_y > 0.0 && centred && (span_x / span_y / aspect - 1.0).abs() <= 1e-3
+        {
+            return Ok(span_y);
+        }
+        self.lacks(
+            at,
+            "`screenwindow` shifted off centre or stretched from the image's shape",
+            "a centred window of the image's shape",
+        )?;
+        Ok(default)
     }
 
     fn film(&mut self, ty: &str, at: At, p: &Params) -> Result<(), Problem> {
@@ -1203,7 +1257,7 @@ impl Builder {
         }
         self.check_media()?;
         let (width, height) = self.film;
-        if let Some(c) = &self.camera {
+        if let Some(c) = self.camera.take() {
             let m = matrix::inverse(&c.camera_from_world).expect("checked at Camera");
             let origin = matrix::point(&m, [0.0; 3]);
             let forward = matrix::normalize(matrix::vector(&m, [0.0, 0.0, 1.0]));
@@ -1223,6 +1277,28 @@ impl Builder {
             } else {
                 (2.0 * (half / aspect).atan()).to_degrees()
             };
+            let ortho_height = match c.orthographic {
+                None => None,
+                Some((at, window)) => {
+                    let height = self.ortho_height(at, window)?;
+                    // The window is in camera space: the frame's scale
+                    // sizes it, alike across and up for square pixels.
+                    let length = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>().sqrt();
+                    let x_scale = length(matrix::vector(&m, [1.0, 0.0, 0.0]));
+                    let y_scale = length(matrix::vector(&m, [0.0, 1.0, 0.0]));
+                    if (y_scale / x_scale - 1.0).abs() > 1e-3 {
+                        return Err((
+                            at,
+                            format!(
+                                "the camera's transform scales x by {x_scale} and y by \
+                                 {y_scale}: an orthographic view must scale both alike"
+                            ),
+                            None,
+                        ));
+                    }
+                    Some(height * y_scale)
+                }
+            };
             let (defocus_angle, focus_dist) = if c.lens_radius > 0.0 {
                 (
                     (2.0 * (c.lens_radius / c.focal_distance).atan()).to_degrees(),
@@ -1241,7 +1317,8 @@ impl Builder {
                 // pbrt's image runs along the camera's +x: a frame that
                 // does not mirror (as LookAt's) mirrors the image.
                 mirror: matrix::det3(&m) > 0.0,
-                medium: c.medium.clone(),
+                medium: c.medium,
+                ortho_height,
                 ..CameraDesc::default()
             };
         } else {
