@@ -255,12 +255,14 @@ fn a_disc_sun_gives_its_irradiance_found_by_light_sampling_or_by_the_bounces_alo
 
 /// The lights that are no surface of the mixed scene, each as its own
 /// `[[lights]]` table.
-const MIXED: [&str; 3] = [
+const MIXED: [&str; 4] = [
     "[[lights]]\ntype = \"point\"\nposition = [1, 1, 0]\nintensity = [2, 2, 2]",
     "[[lights]]\ntype = \"spot\"\nposition = [-1, 1.5, 0.5]\ndirection = [0, -1, 0]\n\
      intensity = [3, 1, 1]\ncutoff_angle = 50",
     "[[lights]]\ntype = \"directional\"\ndirection = [-1, -3, 1]\nirradiance = [0.5, 1, 0.5]\n\
      angular_radius = 5",
+    "[[lights]]\ntype = \"projector\"\nposition = [1, 2, 1]\ntarget = [0.5, 0, 0.5]\nfov = 50\n\
+     irradiance = [1, 2, 3]\naspect = 1.5",
 ];
 
 #[test]
@@ -363,7 +365,7 @@ fn mistakes_in_lights_are_refused_with_the_field_and_a_hint() {
         ),
         (
             "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nirradiance = [1, 1, 1]",
-            &["lights[0].irradiance", "directional lights"],
+            &["lights[0].irradiance", "directional and projector lights"],
         ),
         (
             "[[lights]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
@@ -374,6 +376,31 @@ fn mistakes_in_lights_are_refused_with_the_field_and_a_hint() {
             "[[lights]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
              intensity = [1, 1, 1]\ntexture = \"nothing\"",
             &["lights[0].texture", "nothing"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 180",
+            &["lights[0].fov", "below 180 degrees"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 40\naspect = 0",
+            &["lights[0].aspect", "positive"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ntarget = [0, 1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 40",
+            &["lights[0].target", "own position"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]",
+            &["lights[0]", "fov"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 40\nup = [0, 2, 0]",
+            &["lights[0].up", "along the light's axis"],
         ),
     ];
     for (text, wanted) in cases {
@@ -390,7 +417,7 @@ fn lights_survive_export_and_json() {
     let text = MIXED.join("\n\n");
     let file = common::scene_file(&dir, "lights.toml", &text);
     let desc = file.desc;
-    assert_eq!(desc.lights.len(), 3);
+    assert_eq!(desc.lights.len(), 4);
     for format in [
         lumen::scene::file::Format::Toml,
         lumen::scene::file::Format::Json,
@@ -457,4 +484,102 @@ fn a_spot_projects_its_texture_upright_through_its_cone() {
         }
         assert!(red > 20 && blue > 20, "{red} red and {blue} blue pixels");
     }
+}
+
+/// A projector lights a plane across its axis evenly, with its
+/// irradiance at unit distance over the distance squared, within the
+/// rectangle its field of view and aspect make, and nothing outside.
+#[test]
+fn a_projector_lights_a_plane_across_its_axis_evenly_within_its_rectangle() {
+    let scene = floor(
+        "projector",
+        CENTRE,
+        "[[lights]]\ntype = \"projector\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\n\
+         up = [0, 0, -1]\nfov = 100\naspect = 2\nirradiance = [3, 2, 1]",
+        "",
+    );
+    // Its right is axis × up = +x: 2 tan 50° either side of the axis at
+    // distance 2, and half that either way along z.
+    let (half_x, half_z) = (2.0 * 50f64.to_radians().tan(), 50f64.to_radians().tan());
+    assert_floor("projector", &scene, |p| {
+        let (dx, dz) = (half_x - p[0].abs(), half_z - p[2].abs());
+        if dx.abs() < 0.05 || dz.abs() < 0.05 {
+            return None;
+        }
+        let inside = dx > 0.0 && dz > 0.0;
+        Some([3.0, 2.0, 1.0].map(|e: f64| if inside { e / 4.0 } else { 0.0 }))
+    });
+}
+
+/// A projector's image lies upright: its top towards `up`, its left to
+/// the left seen from the light; its shape (2 × 1 here) sets the height
+/// of the lit rectangle.
+#[test]
+fn a_projector_casts_its_image_upright_and_of_its_shape() {
+    let dir = scratch_dir("light_sources-projector-image");
+    // Top left red, top right green, bottom left blue, bottom right white:
+    // four texels, each two of the image's pixels wide.
+    let mut img = image::RgbImage::new(4, 2);
+    for (x, y, c) in [
+        (0, 0, [255, 0, 0]),
+        (1, 0, [255, 0, 0]),
+        (2, 0, [0, 255, 0]),
+        (3, 0, [0, 255, 0]),
+        (0, 1, [0, 0, 255]),
+        (1, 1, [0, 0, 255]),
+        (2, 1, [255, 255, 255]),
+        (3, 1, [255, 255, 255]),
+    ] {
+        img.put_pixel(x, y, image::Rgb(c));
+    }
+    img.save(dir.join("slide.png")).unwrap();
+    const N: u32 = 64;
+    let text = format!(
+        "[render]\nwidth = {N}\nheight = {N}\nsampler = \"center\"\n\
+         samples_per_pixel = 1\nmax_depth = 2\n\n\
+         [camera]\nvfov = 100\nlookfrom = [0, 4, 0]\nlookat = [0, 0, 0]\nvup = [0, 0, -1]\n\n\
+         [background]\ntype = \"solid\"\ncolor = [0, 0, 0]\n\n\
+         [textures.slide]\ntype = \"image\"\nfile = \"slide.png\"\nfilter = \"nearest\"\n\
+         encoding = \"linear\"\n\n\
+         [materials.floor]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n\n\
+         [[objects]]\ntype = \"quad\"\ncorner = [-8, 0, 8]\nu = [16, 0, 0]\nv = [0, 0, -16]\n\
+         material = \"floor\"\n\n\
+         [[lights]]\ntype = \"projector\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\n\
+         up = [0, 0, -1]\nfov = 90\nirradiance = [4, 4, 4]\ntexture = \"slide\"\n"
+    );
+    let scene = compile_file(&dir, "s.toml", &text);
+    let stats = pixel_stats(&scene);
+    // Seen from above with -z up the image, the light's left is -x. The
+    // image is 4 wide and 2 high across at distance 2 (fov 90°), so it
+    // reaches x = ±2 and z = ±1; each texel lights 1 π⁻¹ of radiance.
+    let mut counts = [0; 5];
+    for y in 0..N {
+        for x in 0..N {
+            let p = floor_point(&scene, x, y);
+            let c = stats.pixel(x, y);
+            let (ax, az) = (p[0].abs(), p[2].abs());
+            if ax < 0.1 || az < 0.1 || (ax - 2.0).abs() < 0.1 || (az - 1.0).abs() < 0.1 {
+                continue;
+            }
+            let (want, slot) = if ax > 2.0 || az > 1.0 {
+                ([0.0; 3], 4)
+            } else {
+                match (p[0] < 0.0, p[2] < 0.0) {
+                    (true, true) => ([1.0, 0.0, 0.0], 0),
+                    (false, true) => ([0.0, 1.0, 0.0], 1),
+                    (true, false) => ([0.0, 0.0, 1.0], 2),
+                    (false, false) => ([1.0, 1.0, 1.0], 3),
+                }
+            };
+            counts[slot] += 1;
+            for k in 0..3 {
+                let w = want[k] / PI;
+                assert!(
+                    (c[k] - w).abs() <= 1e-4 * w + 1e-7,
+                    "({x}, {y}) at {p:?}: {c:?}, expected {w} in channel {k}"
+                );
+            }
+        }
+    }
+    assert!(counts.iter().all(|&n| n > 50), "{counts:?}");
 }

@@ -267,3 +267,20 @@ fn texture_wrap_modes_and_filters() {
 fn orthographic_sensor() {
     check("orthographic_sensor", "test_orthographic_path.xml");
 }
+
+/// Projectors of an even light and of an image, seen over a wide field on
+/// the plane they light.
+#[test]
+fn projectors() {
+    check("projector", "test_projector_constant_direct.xml");
+    check("projector", "test_projector_textured_direct.xml");
+}
+
+/// Every light kind in a row, as Mitsuba's particle tracer renders them
+/// (the same image as its path tracer's, by which lumen renders it): area
+/// lights of a colour and of an image on a rectangle and a sphere, spot
+/// lights plain and projecting an image, a projector and a point light.
+#[test]
+fn various_emitters() {
+    check("various_emitters", "test_various_emitters_ptracer.xml");
+}

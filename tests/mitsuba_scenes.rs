@@ -31,6 +31,8 @@ fn a_scene_exported_to_toml_renders_to_the_same_bits() {
         "instancing/test_instancing_path.xml",
         "floating_sphere/test_directional_direct.xml",
         "orthographic_sensor/test_orthographic_path.xml",
+        "projector/test_projector_textured_direct.xml",
+        "various_emitters/test_various_emitters_ptracer.xml",
         "participating_media/test_homo_area_light_volpath.xml",
         "participating_media/test_hetero_sigmat_albedo_volpath.xml",
         "participating_media/test_hetero_spectral_sigmat_no_scattering_volpath.xml",
@@ -1202,4 +1204,67 @@ fn phase_functions_and_the_sensors_medium_are_read() {
             && e.contains("rayleigh.xml:2:"),
         "{e}"
     );
+}
+
+/// A projector reads as lumen's: its irradiance π · scale · the colour,
+/// its image's top towards the frame's +y, its field of view across the
+/// image's width worked out for the image's shape (carrot.png is 10 × 9)
+/// as Mitsuba's camera does for its film; one that scales is refused.
+#[test]
+fn a_projector_frames_its_image_as_mitsubas_camera_frames_its_film() {
+    use lumen::light::source::LightDesc;
+    let dir = scratch_dir("mitsuba_scenes_projector");
+    let read = |name: &str, body: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, scene(body)).unwrap();
+        SceneFile::read_with(&path, &mitsuba::Options::default())
+    };
+    let carrot = mitsuba_data().join("common/textures/carrot.png");
+    let lookat = "<transform name=\"to_world\"><lookat origin=\"0, 0, 1\" target=\"0, 0, 0\" \
+                  up=\"1, 0, 0\"/></transform>";
+    let image = format!(
+        "<texture type=\"bitmap\" name=\"irradiance\">\
+         <string name=\"filename\" value=\"{}\"/></texture>",
+        carrot.display()
+    );
+    let file = read(
+        "projector-test.xml",
+        &format!(
+            "<emitter type=\"projector\">{lookat}{image}<float name=\"scale\" value=\"3\"/>\
+             <float name=\"fov\" value=\"40\"/><string name=\"fov_axis\" value=\"y\"/></emitter>\
+             <emitter type=\"projector\">{lookat}<rgb name=\"irradiance\" value=\"0.5, 1, 2\"/>\
+             <float name=\"fov\" value=\"40\"/><string name=\"fov_axis\" value=\"y\"/></emitter>"
+        ),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let [LightDesc::Projector(textured), LightDesc::Projector(plain)] = &file.desc.lights[..]
+    else {
+        panic!("{:?}", file.desc.lights);
+    };
+    let pi = std::f64::consts::PI;
+    assert_eq!(textured.irradiance, [3.0 * pi; 3]);
+    assert_eq!(plain.irradiance, [0.5 * pi, pi, 2.0 * pi]);
+    assert!(textured.texture.is_some() && plain.texture.is_none());
+    assert_eq!(textured.direction, Some([0.0, 0.0, -1.0]));
+    let up = textured.up.unwrap();
+    assert!((up[0] - 1.0).abs() < 1e-12 && up[1].abs() < 1e-12, "{up:?}");
+    // 40° up the image: across, 2 atan(tan 20° · 10/9) for the carrot, 40°
+    // for a colour (a single texel).
+    let across = |aspect: f64| (2.0 * (20f64.to_radians().tan() * aspect).atan()).to_degrees();
+    assert!((textured.fov - across(10.0 / 9.0)).abs() < 1e-9, "{}", textured.fov);
+    assert!((plain.fov - across(1.0)).abs() < 1e-9, "{}", plain.fov);
+    for (body, wanted) in [
+        (
+            "<emitter type=\"projector\"><float name=\"fov\" value=\"40\"/></emitter>",
+            "needs an `irradiance`",
+        ),
+        (
+            "<emitter type=\"projector\"><rgb name=\"irradiance\" value=\"1\"/>\
+             <transform name=\"to_world\"><scale value=\"2\"/></transform></emitter>",
+            "may only turn and move it",
+        ),
+    ] {
+        let e = read("projector-bad.xml", body).unwrap_err().to_string();
+        assert!(e.contains("projector-bad.xml:2:") && e.contains(wanted), "{e}");
+    }
 }

@@ -404,6 +404,10 @@ pub trait Textures {
     /// A texture that is texture `t` times `factor`.
     fn scaled(&mut self, t: u32, factor: Color) -> u32;
 
+    /// The width over the height of the image texture `t` shows (through
+    /// any scaling); `None` when it shows no single image.
+    fn aspect(&self, t: u32) -> Option<f64>;
+
     /// The colour texture `name` of field `field` read as a tangent-space
     /// normal map (linear data, not sRGB-decoded colour).
     fn normal_map(&mut self, field: &str, name: &str) -> Result<u32, Invalid>;

@@ -1,10 +1,12 @@
-//! Lights that are no surface: point, spot and directional lights. Each
+//! Lights that are no surface: point, spot, directional lights and
+//! projectors. Each
 //! kind is declared once in its own file (its description's fields and
 //! what it sheds) and listed in `source_kinds!` below, which makes the
 //! description enum the scene readers decode, the table of kinds their
 //! messages use, and the dispatch.
 //!
-//! A point, a spot and a directional light without angular radius are
+//! A point, a spot, a projector and a directional light without angular
+//! radius are
 //! *delta* lights: no ray can meet them, so they are found only by
 //! next-event estimation, whose sample then needs no weight against the
 //! bounces. A directional light with an angular radius is a disc of the
@@ -12,15 +14,18 @@
 
 mod directional;
 mod point;
+mod projector;
 mod spot;
 
 pub use directional::{DirectionalLight, DirectionalLightDesc};
 pub use point::{PointLight, PointLightDesc};
+pub use projector::{ProjectorLight, ProjectorLightDesc};
 pub use spot::{SpotFalloffDesc, SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
 
 use crate::material::param::Textures;
 use crate::material::{Invalid, KindInfo};
 use crate::math::{Color, Point3, Vec3};
+use crate::scene::desc::Triple;
 use crate::texture::Texture;
 
 /// Lists the kinds once: the description enum (tagged by `type` in scene
@@ -96,6 +101,8 @@ source_kinds! {
     Spot(SpotLightDesc => SpotLight) = "spot", "a spot light";
     /// Parallel light from infinitely far, or a disc of the sky.
     Directional(DirectionalLightDesc => DirectionalLight) = "directional", "a directional light";
+    /// A point light casting an image through a rectangular frustum.
+    Projector(ProjectorLightDesc => ProjectorLight) = "projector", "a projector";
 }
 
 impl LightDesc {
@@ -104,7 +111,7 @@ impl LightDesc {
     pub fn is_delta(&self) -> bool {
         match self {
             LightDesc::Directional(d) => d.angular_radius.unwrap_or(0.0) == 0.0,
-            LightDesc::Point(_) | LightDesc::Spot(_) => true,
+            LightDesc::Point(_) | LightDesc::Spot(_) | LightDesc::Projector(_) => true,
         }
     }
 }
@@ -146,12 +153,17 @@ impl LightSource {
             LightSource::Point(l) => l.illuminate(from),
             LightSource::Spot(l) => l.illuminate(from, textures),
             LightSource::Directional(l) => l.illuminate(from, u),
+            LightSource::Projector(l) => l.illuminate(from, textures),
         }
     }
 
     /// Whether it looks textures up.
     pub fn is_textured(&self) -> bool {
-        matches!(self, LightSource::Spot(l) if l.is_textured())
+        match self {
+            LightSource::Spot(l) => l.is_textured(),
+            LightSource::Projector(l) => l.is_textured(),
+            LightSource::Point(_) | LightSource::Directional(_) => false,
+        }
     }
 
     /// The radiance an escaping ray sees looking along unit `direction`,
@@ -161,7 +173,7 @@ impl LightSource {
     pub fn seen_along(&self, direction: Vec3) -> Option<(Color, f32)> {
         match self {
             LightSource::Directional(l) => l.seen_along(direction),
-            LightSource::Point(_) | LightSource::Spot(_) => None,
+            LightSource::Point(_) | LightSource::Spot(_) | LightSource::Projector(_) => None,
         }
     }
 
@@ -178,6 +190,7 @@ impl LightSource {
             LightSource::Point(l) => l.power(),
             LightSource::Spot(l) => l.power(),
             LightSource::Directional(l) => l.power(scene_radius),
+            LightSource::Projector(l) => l.power(),
         }
     }
 }
@@ -226,4 +239,52 @@ fn check_vector(field: &str, v: [f64; 3]) -> Result<Vec3, Invalid> {
         ));
     }
     Ok(Vec3::new(unit.x as f32, unit.y as f32, unit.z as f32))
+}
+
+/// The unit axis of a light at `position` aimed along `direction` or at
+/// `target` (one of them); `field` is its path for messages.
+fn aim(
+    field: &str,
+    position: Point3,
+    direction: Option<Triple>,
+    target: Option<Triple>,
+) -> Result<Vec3, Invalid> {
+    match (direction, target) {
+        (Some(d), None) => check_vector(&format!("{field}.direction"), d),
+        (None, Some(t)) => {
+            let t = check_point(&format!("{field}.target"), t)?;
+            check_vector(
+                &format!("{field}.target"),
+                (t - position).as_dvec3().to_array(),
+            )
+            .map_err(|_| Invalid::new(format!("{field}.target"), "is the light's own position"))
+        }
+        (Some(_), Some(_)) => Err(Invalid::new(
+            format!("{field}.target"),
+            "give `direction` or `target`, not both",
+        )),
+        (None, None) => Err(Invalid::new(
+            format!("{field}.direction"),
+            "the light needs `direction` or `target`",
+        )),
+    }
+}
+
+/// The unit right and up directions, across `axis`, of an image a light
+/// projects: `up` as given (any direction not along the axis), or +y, or
+/// +z when the axis is vertical.
+fn image_frame(field: &str, axis: Vec3, up: Option<Triple>) -> Result<(Vec3, Vec3), Invalid> {
+    let up = match up {
+        Some(u) => check_vector(&format!("{field}.up"), u)?,
+        None if axis.y.abs() > 0.999 => Vec3::Z,
+        None => Vec3::Y,
+    };
+    let right = axis.cross(up).normalize_or_zero();
+    if right == Vec3::ZERO {
+        return Err(Invalid::new(
+            format!("{field}.up"),
+            "lies along the light's axis",
+        ));
+    }
+    Ok((right, right.cross(axis)))
 }

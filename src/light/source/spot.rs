@@ -2,7 +2,7 @@
 //! `beam_width` of its axis and falling off linearly in angle to nothing at
 //! `cutoff_angle` (Mitsuba's `spot`).
 
-use super::{check_color, check_point, check_vector, Incident};
+use super::{aim, check_color, check_point, image_frame, Incident};
 use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
@@ -92,31 +92,7 @@ impl SpotLightDesc {
     /// The light described; `field` is its path for messages.
     pub fn compile(&self, field: &str, textures: &mut dyn Textures) -> Result<SpotLight, Invalid> {
         let position = check_point(&format!("{field}.position"), self.position)?;
-        let axis = match (self.direction, self.target) {
-            (Some(d), None) => check_vector(&format!("{field}.direction"), d)?,
-            (None, Some(t)) => {
-                let t = check_point(&format!("{field}.target"), t)?;
-                check_vector(
-                    &format!("{field}.target"),
-                    (t - position).as_dvec3().to_array(),
-                )
-                .map_err(|_| {
-                    Invalid::new(format!("{field}.target"), "is the light's own position")
-                })?
-            }
-            (Some(_), Some(_)) => {
-                return Err(Invalid::new(
-                    format!("{field}.target"),
-                    "give `direction` or `target`, not both",
-                ))
-            }
-            (None, None) => {
-                return Err(Invalid::new(
-                    format!("{field}.direction"),
-                    "a spot light needs `direction` or `target`",
-                ))
-            }
-        };
+        let axis = aim(field, position, self.direction, self.target)?;
         let cutoff = self.cutoff_angle.unwrap_or(DEFAULT_CUTOFF);
         if !(cutoff > 0.0 && cutoff < 180.0) {
             return Err(Invalid::new(
@@ -152,23 +128,13 @@ impl SpotLightDesc {
                 else {
                     return Err(Invalid::new(at, "must name a texture"));
                 };
-                let up = match self.up {
-                    Some(u) => check_vector(&format!("{field}.up"), u)?,
-                    None if axis.y.abs() > 0.999 => Vec3::Z,
-                    None => Vec3::Y,
-                };
-                let right = axis.cross(up).normalize_or_zero();
-                if right == Vec3::ZERO || cutoff >= std::f32::consts::FRAC_PI_2 {
+                if cutoff >= std::f32::consts::FRAC_PI_2 {
                     return Err(Invalid::new(
-                        format!("{field}.up"),
-                        if cutoff >= std::f32::consts::FRAC_PI_2 {
-                            "a projected texture needs a cutoff_angle below 90 degrees"
-                        } else {
-                            "lies along the light's axis"
-                        },
+                        format!("{field}.cutoff_angle"),
+                        "a projected texture needs a cutoff_angle below 90 degrees",
                     ));
                 }
-                let up = right.cross(axis);
+                let (right, up) = image_frame(field, axis, self.up)?;
                 let tan = cutoff.tan();
                 Some((t, right / tan, up / tan))
             }

@@ -1653,6 +1653,14 @@ impl Textures for MaterialTextures<'_, '_> {
         self.textures.push(Texture::Scaled { texture: t, factor })
     }
 
+    fn aspect(&self, t: u32) -> Option<f64> {
+        match self.textures.textures.get(t as usize)? {
+            Texture::Map(map) => Some(map.image.width() as f64 / map.image.height() as f64),
+            Texture::Scaled { texture, .. } => self.aspect(*texture),
+            _ => None,
+        }
+    }
+
     fn material(&mut self, field: &str, name: &str) -> Result<Material, Invalid> {
         let Some((name, desc)) = self.materials.get_key_value(name) else {
             return Err(Invalid::new(

@@ -56,8 +56,8 @@ pub struct SceneDesc {
     /// The objects of the scene.
     #[serde(default)]
     pub objects: Vec<ObjectDesc>,
-    /// Lights that are no surface: point, spot and directional lights
-    /// (a surface shines by its material's emission).
+    /// Lights that are no surface: point, spot, directional lights and
+    /// projectors (a surface shines by its material's emission).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightDesc>,
     /// Participating media by name: materials name the medium inside and
@@ -214,8 +214,9 @@ impl SceneDesc {
             && self.lights.iter().any(LightDesc::is_delta)
         {
             warnings.push(
-                "point, spot and directional lights (without angular_radius) are found only by \
-                 the `path` integrator's light sampling: with `bsdf` they shed no light"
+                "point, spot and directional lights (without angular_radius) and projectors are \
+                 found only by the `path` integrator's light sampling: with `bsdf` they shed no \
+                 light"
                     .to_string(),
             );
         }

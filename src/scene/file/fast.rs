@@ -217,6 +217,7 @@ fn light(l: &LightDesc) -> bool {
                 && finite(&s.intensity)
                 && optional(&s.direction)
                 && optional(&s.target)
+                && optional(&s.up)
                 && s.cutoff_angle.is_none_or(f64::is_finite)
                 && s.beam_width.is_none_or(f64::is_finite)
         }
@@ -224,6 +225,15 @@ fn light(l: &LightDesc) -> bool {
             finite(&d.direction)
                 && finite(&d.irradiance)
                 && d.angular_radius.is_none_or(f64::is_finite)
+        }
+        LightDesc::Projector(p) => {
+            finite(&p.position)
+                && finite(&p.irradiance)
+                && optional(&p.direction)
+                && optional(&p.target)
+                && optional(&p.up)
+                && p.fov.is_finite()
+                && p.aspect.is_none_or(f64::is_finite)
         }
     }
 }

@@ -10,7 +10,9 @@ use super::transform::{self, Mat4, IDENTITY};
 use super::xml::{Document, Element};
 use super::{located, Failure, Imported, Options};
 use crate::hint;
-use crate::light::source::{DirectionalLightDesc, PointLightDesc, SpotLightDesc};
+use crate::light::source::{
+    DirectionalLightDesc, PointLightDesc, ProjectorLightDesc, SpotLightDesc,
+};
 use crate::material::dielectric::FresnelDesc;
 use crate::material::roughness::DistributionDesc;
 use crate::material::{
@@ -55,8 +57,23 @@ const BSDFS: &[&str] = &[
     "null",
     "blendbsdf",
 ];
-const EMITTERS: &[&str] = &["area", "constant", "envmap", "point", "spot", "directional"];
-const INTEGRATORS: &[&str] = &["path", "direct", "volpath", "volpathmis", "moment"];
+const EMITTERS: &[&str] = &[
+    "area",
+    "constant",
+    "envmap",
+    "point",
+    "spot",
+    "directional",
+    "projector",
+];
+const INTEGRATORS: &[&str] = &[
+    "path",
+    "direct",
+    "volpath",
+    "volpathmis",
+    "ptracer",
+    "moment",
+];
 const TEXTURES: &[&str] = &["bitmap", "checkerboard"];
 
 /// The parameters of a rough BSDF's microfacets.
@@ -353,7 +370,9 @@ impl<'d> Convert<'d> {
                     }
                 }
             }
-            t @ ("path" | "direct" | "volpath" | "volpathmis") => {
+            // The particle tracer's image is the path tracer's: lumen
+            // renders it by path tracing.
+            t @ ("path" | "direct" | "volpath" | "volpathmis" | "ptracer") => {
                 let depth = p.integer("max_depth", self)?;
                 let _rr = p.integer("rr_depth", self)?; // Roulette changes the noise only.
                 if p.boolean("hide_emitters", self)? == Some(true) {
@@ -545,6 +564,24 @@ impl<'d> Convert<'d> {
         self.desc.render.width = width;
         self.desc.render.height = Some(height);
         Ok(())
+    }
+
+    /// The width over the height of the image of texture `name` (1 for a
+    /// texture that is no image), from the image file's header.
+    fn image_aspect(&self, name: &str, e: &Element) -> Result<f64, Failure> {
+        let Some(TextureDesc::Image { file, .. }) = self.desc.textures.get(name) else {
+            return Ok(1.0);
+        };
+        let path = self.dir.join(file);
+        let size = ::image::ImageReader::open(&path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|err| err.to_string())
+            .and_then(|r| r.into_dimensions().map_err(|err| err.to_string()));
+        match size {
+            Ok((w, h)) if w > 0 && h > 0 => Ok(f64::from(w) / f64::from(h)),
+            Ok(_) => Err(self.fail(e, format!("image `{file}` is empty"))),
+            Err(err) => Err(self.fail(e, format!("image `{file}`: {err}"))),
+        }
     }
 
     /// A perspective sensor's vertical field of view in radians, from its
@@ -841,6 +878,65 @@ impl<'d> Convert<'d> {
                     texture,
                     falloff: None,
                 }));
+                Ok(())
+            }
+            "projector" => {
+                let m = p.transform("to_world", self)?.unwrap_or(IDENTITY);
+                let scale = p.float("scale", self)?.unwrap_or(1.0);
+                let (colour, texture) = match p.colour("irradiance", Use::Emission, self)? {
+                    None => return Err(self.fail(e, "a projector needs an `irradiance`".into())),
+                    Some(Colour::Rgb(c)) => (c, None),
+                    Some(Colour::Texture(t)) => ([1.0; 3], Some(self.texture(t, false)?)),
+                };
+                // Mitsuba frames the image as its perspective camera
+                // frames the film: the field of view's axis refers to
+                // the image's shape (a colour's is a single texel's).
+                let aspect = match &texture {
+                    Some(name) => self.image_aspect(name, e)?,
+                    None => 1.0,
+                };
+                let vfov = self.vertical_fov(e, &p, aspect)?;
+                let fov = 2.0 * ((vfov / 2.0).tan() * aspect).atan();
+                p.finish(
+                    &[
+                        "to_world",
+                        "scale",
+                        "irradiance",
+                        "fov",
+                        "fov_axis",
+                        "focal_length",
+                    ],
+                    self,
+                )?;
+                let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+                    .map(|v| transform::vector(&m, v));
+                let unit = axes.iter().all(|a| {
+                    ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt() - 1.0).abs() <= 1e-3
+                });
+                if !unit || transform::det3(&m) < 0.0 {
+                    return Err(self.fail(
+                        e,
+                        "a projector's to_world may only turn and move it (no scale or mirror)"
+                            .into(),
+                    ));
+                }
+                // Mitsuba's irradiance of 1 lights the plane at unit
+                // distance with π; its image's top lies towards the frame's
+                // +y and its u runs along −x, which is lumen's right for
+                // that up.
+                let irradiance = colour.map(|c| std::f64::consts::PI * scale * c);
+                self.desc
+                    .lights
+                    .push(LightDesc::Projector(ProjectorLightDesc {
+                        position: transform::point(&m, [0.0; 3]),
+                        direction: Some(axes[2]),
+                        target: None,
+                        up: Some(axes[1]),
+                        fov: fov.to_degrees(),
+                        irradiance,
+                        texture,
+                        aspect: None,
+                    }));
                 Ok(())
             }
             "directional" => {

@@ -1,0 +1,162 @@
+//! A projector: a point light that casts an image through a rectangular
+//! frustum, as a slide projector does (Mitsuba's `projector`). The image
+//! fills a rectangle across the axis at unit distance, `fov` wide and as
+//! high as the image's shape makes it; `irradiance` times the image is
+//! the irradiance that rectangle receives, so a plane across the axis is
+//! lit evenly by an even image. The intensity towards a point θ off the
+//! axis is therefore irradiance × image / cos³θ.
+
+use super::{aim, check_color, check_point, image_frame, Incident};
+use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
+use crate::material::Invalid;
+use crate::math::{Color, Point3, Vec3};
+use crate::scene::desc::Triple;
+use crate::texture::{TexCoords, Texture};
+
+/// A projector as a scene describes it.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProjectorLightDesc {
+    /// Where it is.
+    pub position: Triple,
+    /// The direction of its axis (any length but zero); give this or
+    /// `target`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<Triple>,
+    /// A point on its axis, instead of `direction`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<Triple>,
+    /// Which way is up in the projected image (any direction not along
+    /// the axis); +y when absent, or +z when the axis is vertical.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Triple>,
+    /// The angle the image spans across its width, in degrees, in (0, 180).
+    pub fov: f64,
+    /// The irradiance per channel, W/m², on the rectangle the image fills
+    /// at unit distance (times the image there).
+    pub irradiance: Triple,
+    /// The image (the name of a colour texture); when absent, an even
+    /// square of light.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<String>,
+    /// The image's width over its height; when absent, the texture's image
+    /// gives it (1 for a texture that is no image, and without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aspect: Option<f64>,
+}
+
+/// A projector, compiled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProjectorLight {
+    /// Where it is.
+    pub position: Point3,
+    /// The unit direction of its axis.
+    pub axis: Vec3,
+    /// The image's right and up directions (unit, across the axis) over
+    /// the half-width and half-height of its rectangle at unit distance.
+    right: Vec3,
+    up: Vec3,
+    /// Irradiance on that rectangle.
+    pub irradiance: Color,
+    /// The image's texture.
+    texture: Option<u32>,
+    /// The rectangle's area, for the light's power.
+    area: f32,
+}
+
+impl ProjectorLightDesc {
+    /// The light described; `field` is its path for messages.
+    pub fn compile(
+        &self,
+        field: &str,
+        textures: &mut dyn Textures,
+    ) -> Result<ProjectorLight, Invalid> {
+        let position = check_point(&format!("{field}.position"), self.position)?;
+        let axis = aim(field, position, self.direction, self.target)?;
+        let (right, up) = image_frame(field, axis, self.up)?;
+        if !(self.fov > 0.0 && self.fov < 180.0) {
+            return Err(Invalid::new(
+                format!("{field}.fov"),
+                format!("must be above 0 and below 180 degrees, got {}", self.fov),
+            ));
+        }
+        let texture = match &self.texture {
+            None => None,
+            Some(name) => {
+                let at = format!("{field}.texture");
+                match textures.color(
+                    &at,
+                    &ColorDesc::Texture(name.clone()),
+                    ColorRange::NonNegative,
+                )? {
+                    ColorParam::Texture(t) => Some(t),
+                    ColorParam::Const(_) => return Err(Invalid::new(at, "must name a texture")),
+                }
+            }
+        };
+        let aspect = match self.aspect {
+            Some(a) if a > 0.0 && a.is_finite() => a,
+            Some(a) => {
+                return Err(Invalid::new(
+                    format!("{field}.aspect"),
+                    format!("must be a positive number, got {a}"),
+                ))
+            }
+            None => texture.and_then(|t| textures.aspect(t)).unwrap_or(1.0),
+        };
+        let half_width = (self.fov.to_radians() / 2.0).tan();
+        let half_height = half_width / aspect;
+        if !(half_height > 1e-6 && half_width / half_height < 1e6) {
+            return Err(Invalid::new(
+                format!("{field}.aspect"),
+                format!("{aspect} makes the image too narrow to shed light"),
+            ));
+        }
+        Ok(ProjectorLight {
+            position,
+            axis,
+            right: right / half_width as f32,
+            up: up / half_height as f32,
+            irradiance: check_color(&format!("{field}.irradiance"), self.irradiance)?,
+            texture,
+            area: (4.0 * half_width * half_height) as f32,
+        })
+    }
+}
+
+impl ProjectorLight {
+    /// The light arriving at `from` (`textures` holding its image).
+    #[inline]
+    pub fn illuminate(&self, from: Point3, textures: &[Texture]) -> Option<Incident> {
+        let mut sample = Incident::from_point(from, self.position, self.irradiance)?;
+        // The direction the light leaves in, and where it crosses the
+        // image's rectangle at unit distance, in half-sizes from its centre.
+        let d = -sample.direction;
+        let cos = d.dot(self.axis);
+        if !(cos > 0.0) {
+            return None;
+        }
+        let (x, y) = (d.dot(self.right) / cos, d.dot(self.up) / cos);
+        if !(x.abs() <= 1.0 && y.abs() <= 1.0) {
+            return None;
+        }
+        sample.radiance /= cos * cos * cos;
+        if let Some(t) = self.texture {
+            let uv = [0.5 + 0.5 * x, 0.5 + 0.5 * y];
+            let c = textures[t as usize].value(textures, &TexCoords::new(uv, from));
+            sample.radiance *= c.max(Color::ZERO);
+        }
+        Some(sample)
+    }
+
+    /// Whether it looks textures up.
+    pub fn is_textured(&self) -> bool {
+        self.texture.is_some()
+    }
+
+    /// Its power's luminance for an even image: the irradiance over the
+    /// rectangle at unit distance, which catches all of it.
+    pub fn power(&self) -> f64 {
+        f64::from(self.area) * f64::from(super::super::luminance(self.irradiance))
+    }
+}
