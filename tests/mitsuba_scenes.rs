@@ -1251,7 +1251,11 @@ fn a_projector_frames_its_image_as_mitsubas_camera_frames_its_film() {
     // 40° up the image: across, 2 atan(tan 20° · 10/9) for the carrot, 40°
     // for a colour (a single texel).
     let across = |aspect: f64| (2.0 * (20f64.to_radians().tan() * aspect).atan()).to_degrees();
-    assert!((textured.fov - across(10.0 / 9.0)).abs() < 1e-9, "{}", textured.fov);
+    assert!(
+        (textured.fov - across(10.0 / 9.0)).abs() < 1e-9,
+        "{}",
+        textured.fov
+    );
     assert!((plain.fov - across(1.0)).abs() < 1e-9, "{}", plain.fov);
     for (body, wanted) in [
         (
@@ -1265,6 +1269,9 @@ fn a_projector_frames_its_image_as_mitsubas_camera_frames_its_film() {
         ),
     ] {
         let e = read("projector-bad.xml", body).unwrap_err().to_string();
-        assert!(e.contains("projector-bad.xml:2:") && e.contains(wanted), "{e}");
+        assert!(
+            e.contains("projector-bad.xml:2:") && e.contains(wanted),
+            "{e}"
+        );
     }
 }

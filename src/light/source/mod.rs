@@ -26,7 +26,7 @@ use crate::material::param::Textures;
 use crate::material::{Invalid, KindInfo};
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
-use crate::texture::Texture;
+use crate::texture::{TexCoords, Texture};
 
 /// Lists the kinds once: the description enum (tagged by `type` in scene
 /// files), the table of kinds and their fields, and compilation.
@@ -287,4 +287,16 @@ fn image_frame(field: &str, axis: Vec3, up: Option<Triple>) -> Result<(Vec3, Vec
         ));
     }
     Ok((right, right.cross(axis)))
+}
+
+/// The colour of the image (texture `t`) a light casts where a ray leaving
+/// it crosses the image's frame at unit distance, at (x, y) in half-sizes
+/// from its centre (the image spans [−1, 1]², its top at y = 1); `from` is
+/// the point lit.
+#[inline]
+fn slide(textures: &[Texture], t: u32, [x, y]: [f32; 2], from: Point3) -> Color {
+    let uv = [0.5 + 0.5 * x, 0.5 + 0.5 * y];
+    textures[t as usize]
+        .value(textures, &TexCoords::new(uv, from))
+        .max(Color::ZERO)
 }

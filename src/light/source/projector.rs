@@ -6,12 +6,12 @@
 //! lit evenly by an even image. The intensity towards a point θ off the
 //! axis is therefore irradiance × image / cos³θ.
 
-use super::{aim, check_color, check_point, image_frame, Incident};
+use super::{aim, check_color, check_point, image_frame, slide, Incident};
 use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
-use crate::texture::{TexCoords, Texture};
+use crate::texture::Texture;
 
 /// A projector as a scene describes it.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -142,9 +142,7 @@ impl ProjectorLight {
         }
         sample.radiance /= cos * cos * cos;
         if let Some(t) = self.texture {
-            let uv = [0.5 + 0.5 * x, 0.5 + 0.5 * y];
-            let c = textures[t as usize].value(textures, &TexCoords::new(uv, from));
-            sample.radiance *= c.max(Color::ZERO);
+            sample.radiance *= slide(textures, t, [x, y], from);
         }
         Some(sample)
     }

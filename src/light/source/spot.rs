@@ -2,12 +2,12 @@
 //! `beam_width` of its axis and falling off linearly in angle to nothing at
 //! `cutoff_angle` (Mitsuba's `spot`).
 
-use super::{aim, check_color, check_point, image_frame, Incident};
+use super::{aim, check_color, check_point, image_frame, slide, Incident};
 use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
-use crate::texture::{TexCoords, Texture};
+use crate::texture::Texture;
 use std::f64::consts::PI;
 
 /// A spot light as a scene describes it.
@@ -193,9 +193,7 @@ impl SpotLight {
             // The image's square spans ±tan(cutoff) across the axis at
             // unit distance along it.
             let z = d.dot(self.axis);
-            let uv = [0.5 + 0.5 * d.dot(right) / z, 0.5 + 0.5 * d.dot(up) / z];
-            let c = textures[t as usize].value(textures, &TexCoords::new(uv, from));
-            sample.radiance *= c.max(Color::ZERO);
+            sample.radiance *= slide(textures, t, [d.dot(right) / z, d.dot(up) / z], from);
         }
         Some(sample)
     }
