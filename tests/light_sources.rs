@@ -399,6 +399,16 @@ fn mistakes_in_lights_are_refused_with_the_field_and_a_hint() {
         ),
         (
             "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             fov = 40",
+            &["lights[0].irradiance", "`irradiance` or `intensity`"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             fov = 40\nirradiance = [1, 1, 1]\nintensity = [1, 1, 1]",
+            &["lights[0].intensity", "not both"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
              irradiance = [1, 1, 1]\nfov = 40\nup = [0, 2, 0]",
             &["lights[0].up", "along the light's axis"],
         ),
@@ -582,4 +592,29 @@ fn a_projector_casts_its_image_upright_and_of_its_shape() {
         }
     }
     assert!(counts.iter().all(|&n| n > 50), "{counts:?}");
+}
+
+/// A projector given its intensity (as pbrt's `projection` light) sheds
+/// that intensity in every direction of its frustum: a floor across its
+/// axis is lit by intensity · cos θ / d², dimmer towards the edges.
+#[test]
+fn a_projector_given_its_intensity_sheds_it_evenly_over_its_frustum() {
+    let scene = floor(
+        "projector-intensity",
+        CENTRE,
+        "[[lights]]\ntype = \"projector\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\n\
+         up = [0, 0, -1]\nfov = 100\naspect = 2\nintensity = [3, 2, 1]",
+        "",
+    );
+    let (half_x, half_z) = (2.0 * 50f64.to_radians().tan(), 50f64.to_radians().tan());
+    assert_floor("projector by intensity", &scene, |p| {
+        let (dx, dz) = (half_x - p[0].abs(), half_z - p[2].abs());
+        if dx.abs() < 0.05 || dz.abs() < 0.05 {
+            return None;
+        }
+        let d2 = p[0] * p[0] + 4.0 + p[2] * p[2];
+        let cos = 2.0 / d2.sqrt();
+        let inside = dx > 0.0 && dz > 0.0;
+        Some([3.0, 2.0, 1.0].map(|i: f64| if inside { i * cos / d2 } else { 0.0 }))
+    });
 }

@@ -217,6 +217,63 @@ fn orthographic_cameras_see_the_window_each_format_gives_them() {
     assert!(!mitsuba.mirror && window.mirror);
 }
 
+/// pbrt's `projection` light is a projector given its intensity (`scale`
+/// times the image, nearest texel), `fov` across the image's shorter side,
+/// the image's top towards the light frame's +y and its left towards −x:
+/// seen from above, a red-left, green-right slide lights the floor red
+/// at −x and green at +x.
+#[test]
+fn a_projection_light_casts_its_image_as_pbrt_casts_it() {
+    let dir = scratch_dir("pbrt_scenes_projection");
+    let mut img = image::RgbImage::new(2, 1);
+    img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
+    img.put_pixel(1, 0, image::Rgb([0, 255, 0]));
+    img.save(dir.join("slide.png")).unwrap();
+    let text = "LookAt 0 6 0  0 0 0  0 0 -1\nCamera \"perspective\" \"float fov\" 60\n\
+                Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 32\n\
+                Sampler \"independent\" \"integer pixelsamples\" 4\nWorldBegin\n\
+                AttributeBegin\nTranslate 0 2 0\nRotate 90 1 0 0\n\
+                LightSource \"projection\" \"string filename\" \"slide.png\" \"float fov\" 40 \
+                \"float scale\" 2\nAttributeEnd\n\
+                Material \"diffuse\" \"rgb reflectance\" [ 1 1 1 ]\n\
+                Shape \"bilinearmesh\" \"point3 P\" [ -4 0 -4  4 0 -4  -4 0 4  4 0 4 ]\n";
+    let file = read_in(&dir, text, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let [LightDesc::Projector(l)] = &file.desc.lights[..] else {
+        panic!("{:?}", file.desc.lights);
+    };
+    assert_eq!(l.intensity, Some([2.0; 3]));
+    assert!(close(l.position, [0.0, 2.0, 0.0]));
+    assert!(close(l.direction.unwrap(), [0.0, -1.0, 0.0]));
+    assert!(close(l.up.unwrap(), [0.0, 0.0, 1.0]));
+    // 40° up the image, which is twice as wide.
+    let across = 2.0 * (20f64.to_radians().tan() * 2.0).atan();
+    assert!((l.fov - across.to_degrees()).abs() < 1e-9, "{}", l.fov);
+    let scene = file.compile(&Overrides::default()).unwrap();
+    let film = lumen::render::render(&scene, &|_| {}).0;
+    let (mut red, mut green) = (0, 0);
+    for y in 0..32 {
+        for x in 0..32 {
+            let ray = scene.camera.central_ray(x, y);
+            let t = -ray.origin().y / ray.direction.y;
+            let at = ray.origin() + t * ray.direction;
+            let c = film.mean((y * 32 + x) as usize);
+            // Within the lit rectangle, away from its edges and middle.
+            if at.x.abs() < 0.2 || at.x.abs() > 1.2 || at.z.abs() > 0.5 {
+                continue;
+            }
+            if at.x < 0.0 {
+                assert!(c.x > 0.0 && c.y == 0.0, "({x}, {y}) at {at}: {c}");
+                red += 1;
+            } else {
+                assert!(c.y > 0.0 && c.x == 0.0, "({x}, {y}) at {at}: {c}");
+                green += 1;
+            }
+        }
+    }
+    assert!(red > 10 && green > 10, "{red} red, {green} green");
+    exported_renders_the_same(&dir.join("s.pbrt"));
+}
+
 #[test]
 fn transforms_instances_and_materials_are_placed_as_pbrt_places_them() {
     let mut d = read(

@@ -4,7 +4,10 @@
 //! high as the image's shape makes it; `irradiance` times the image is
 //! the irradiance that rectangle receives, so a plane across the axis is
 //! lit evenly by an even image. The intensity towards a point θ off the
-//! axis is therefore irradiance × image / cos³θ.
+//! axis is therefore irradiance × image / cos³θ. Given an `intensity`
+//! instead (pbrt's `projection` light), the intensity is intensity × image
+//! in every direction of the frustum, and the plane is lit less towards
+//! the rectangle's edges.
 
 use super::{aim, check_color, check_point, image_frame, slide, Incident};
 use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
@@ -33,8 +36,13 @@ pub struct ProjectorLightDesc {
     /// The angle the image spans across its width, in degrees, in (0, 180).
     pub fov: f64,
     /// The irradiance per channel, W/m², on the rectangle the image fills
-    /// at unit distance (times the image there).
-    pub irradiance: Triple,
+    /// at unit distance (times the image there); give this or `intensity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub irradiance: Option<Triple>,
+    /// The radiant intensity per channel, W/sr, in every direction of the
+    /// frustum (times the image there), instead of `irradiance`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intensity: Option<Triple>,
     /// The image (the name of a colour texture); when absent, an even
     /// square of light.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -56,12 +64,16 @@ pub struct ProjectorLight {
     /// the half-width and half-height of its rectangle at unit distance.
     right: Vec3,
     up: Vec3,
-    /// Irradiance on that rectangle.
-    pub irradiance: Color,
+    /// Irradiance on that rectangle, or intensity.
+    pub emitted: Color,
+    /// Whether `emitted` is the irradiance on the rectangle (the intensity
+    /// grows as 1 / cos³θ off the axis), not the intensity.
+    even_on_plane: bool,
     /// The image's texture.
     texture: Option<u32>,
-    /// The rectangle's area, for the light's power.
-    area: f32,
+    /// What a unit of `emitted` sends out: the rectangle's area, or the
+    /// frustum's solid angle.
+    spread: f32,
 }
 
 impl ProjectorLightDesc {
@@ -112,14 +124,39 @@ impl ProjectorLightDesc {
                 format!("{aspect} makes the image too narrow to shed light"),
             ));
         }
+        let (emitted, even_on_plane) = match (self.irradiance, self.intensity) {
+            (Some(e), None) => (check_color(&format!("{field}.irradiance"), e)?, true),
+            (None, Some(i)) => (check_color(&format!("{field}.intensity"), i)?, false),
+            (Some(_), Some(_)) => {
+                return Err(Invalid::new(
+                    format!("{field}.intensity"),
+                    "give `irradiance` or `intensity`, not both",
+                ))
+            }
+            (None, None) => {
+                return Err(Invalid::new(
+                    format!("{field}.irradiance"),
+                    "a projector needs `irradiance` or `intensity`",
+                ))
+            }
+        };
+        let (a, b) = (half_width, half_height);
+        let spread = if even_on_plane {
+            4.0 * a * b
+        } else {
+            // The solid angle of the rectangle [−a, a] × [−b, b] at unit
+            // distance.
+            4.0 * (a * b / ((1.0 + a * a) * (1.0 + b * b)).sqrt()).asin()
+        };
         Ok(ProjectorLight {
             position,
             axis,
-            right: right / half_width as f32,
-            up: up / half_height as f32,
-            irradiance: check_color(&format!("{field}.irradiance"), self.irradiance)?,
+            right: right / a as f32,
+            up: up / b as f32,
+            emitted,
+            even_on_plane,
             texture,
-            area: (4.0 * half_width * half_height) as f32,
+            spread: spread as f32,
         })
     }
 }
@@ -128,7 +165,7 @@ impl ProjectorLight {
     /// The light arriving at `from` (`textures` holding its image).
     #[inline]
     pub fn illuminate(&self, from: Point3, textures: &[Texture]) -> Option<Incident> {
-        let mut sample = Incident::from_point(from, self.position, self.irradiance)?;
+        let mut sample = Incident::from_point(from, self.position, self.emitted)?;
         // The direction the light leaves in, and where it crosses the
         // image's rectangle at unit distance, in half-sizes from its centre.
         let d = -sample.direction;
@@ -140,7 +177,9 @@ impl ProjectorLight {
         if !(x.abs() <= 1.0 && y.abs() <= 1.0) {
             return None;
         }
-        sample.radiance /= cos * cos * cos;
+        if self.even_on_plane {
+            sample.radiance /= cos * cos * cos;
+        }
         if let Some(t) = self.texture {
             sample.radiance *= slide(textures, t, [x, y], from);
         }
@@ -153,8 +192,9 @@ impl ProjectorLight {
     }
 
     /// Its power's luminance for an even image: the irradiance over the
-    /// rectangle at unit distance, which catches all of it.
+    /// rectangle at unit distance, which catches all of it, or the
+    /// intensity over the frustum's solid angle.
     pub fn power(&self) -> f64 {
-        f64::from(self.area) * f64::from(super::super::luminance(self.irradiance))
+        f64::from(self.spread) * f64::from(super::super::luminance(self.emitted))
     }
 }

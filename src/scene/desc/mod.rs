@@ -6,7 +6,9 @@
 //! people write them; the renderer converts them to `f32` when it compiles the
 //! scene.
 
-pub use crate::light::source::{DirectionalLightDesc, LightDesc, PointLightDesc, SpotLightDesc};
+pub use crate::light::source::{
+    DirectionalLightDesc, LightDesc, PointLightDesc, ProjectorLightDesc, SpotLightDesc,
+};
 pub use crate::light::LightSelection;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -228,7 +228,8 @@ fn light(l: &LightDesc) -> bool {
         }
         LightDesc::Projector(p) => {
             finite(&p.position)
-                && finite(&p.irradiance)
+                && optional(&p.irradiance)
+                && optional(&p.intensity)
                 && optional(&p.direction)
                 && optional(&p.target)
                 && optional(&p.up)

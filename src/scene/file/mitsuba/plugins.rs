@@ -933,7 +933,8 @@ impl<'d> Convert<'d> {
                         target: None,
                         up: Some(axes[1]),
                         fov: fov.to_degrees(),
-                        irradiance,
+                        irradiance: Some(irradiance),
+                        intensity: None,
                         texture,
                         aspect: None,
                     }));

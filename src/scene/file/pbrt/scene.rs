@@ -7,8 +7,8 @@ use super::params::{Param, Params, Problem, Spectral};
 use super::{spectra, Input};
 use crate::scene::desc::{
     BackgroundDesc, CameraDesc, ColorDesc, DirectionalLightDesc, EncodingDesc, IntegratorDesc,
-    LightDesc, LightSelection, ObjectDesc, PixelFilterDesc, PointLightDesc, SamplingDesc,
-    SceneDesc, SpotLightDesc, TransformDesc,
+    LightDesc, LightSelection, ObjectDesc, PixelFilterDesc, PointLightDesc, ProjectorLightDesc,
+    SamplingDesc, SceneDesc, SpotLightDesc, TextureDesc, TransformDesc,
 };
 use crate::scene::file::import::Imported;
 use crate::scene::file::matrix::{self, Mat4, IDENTITY};
@@ -962,6 +962,97 @@ impl Builder {
         Ok(())
     }
 
+    /// pbrt's `projection` light: an image cast through the frustum of a
+    /// perspective camera at the light's frame looking along +z, `fov`
+    /// across the image's shorter side, its top row towards the frame's +y
+    /// and its left column towards −x (pbrt turns the frame over in y
+    /// and runs its screen along +x), the intensity `scale` × the image,
+    /// its nearest texel.
+    fn projection_light(&mut self, at: At, p: &Params, input: &Input) -> Result<(), Problem> {
+        let scale = p.float("scale")?.unwrap_or(1.0);
+        if p.float("power")?.is_some_and(|v| v > 0.0) {
+            self.lacks(at, "a projection light given its `power`", "its `scale`")?;
+        }
+        let fov = p.float("fov")?.unwrap_or(90.0);
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err((
+                at,
+                format!("`fov` must lie between 0 and 180 degrees, got {fov}"),
+                None,
+            ));
+        }
+        let (name, fat) = p.string_of("filename", "string")?.ok_or((
+            at,
+            "a projection light needs a \"string filename\"".into(),
+            None,
+        ))?;
+        let file = input.file(name, fat)?;
+        let size = ::image::ImageReader::open(input.dir.join(&file))
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| e.to_string())
+            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+            .map_err(|e| (fat, format!("image `{file}`: {e}"), None))?;
+        let aspect = f64::from(size.0) / f64::from(size.1.max(1));
+        p.finish("a projection light", &["scale", "power", "fov", "filename"])?;
+        let m = self.state.ctm;
+        let axis = matrix::vector(&m, [0.0, 0.0, 1.0]);
+        let up = matrix::vector(&m, [0.0, 1.0, 0.0]);
+        let (Some(axis), Some(up)) = (matrix::normalize(axis), matrix::normalize(up)) else {
+            return Err((at, "the light's transform is singular".into(), None));
+        };
+        // lumen's image runs along axis × up, which is the frame's −x
+        // unless the frame mirrors: pbrt's runs along +x, so the image is
+        // read mirrored left to right where the two differ.
+        let along = matrix::vector(&m, [1.0, 0.0, 0.0]);
+        let right = matrix::cross(axis, up);
+        let mirrored = along[0] * right[0] + along[1] * right[1] + along[2] * right[2] < 0.0;
+        let texture = self.name("projection");
+        let mut image = super::materials::image(
+            file,
+            crate::scene::desc::EncodingDesc::Srgb,
+            None,
+            [1.0, 1.0, 0.0, 0.0],
+        );
+        if let TextureDesc::Image {
+            filter,
+            encoding,
+            uv_scale,
+            uv_offset,
+            ..
+        } = &mut image
+        {
+            *filter = Some(crate::scene::desc::FilterDesc::Nearest);
+            // As the file says: sRGB for 8-bit files, linear for
+            // floating-point ones.
+            *encoding = None;
+            if mirrored {
+                *uv_scale = Some([-1.0, 1.0]);
+                *uv_offset = Some([1.0, 0.0]);
+            }
+        }
+        self.desc.textures.insert(texture.clone(), image);
+        let half = (fov.to_radians() / 2.0).tan();
+        let across = if aspect > 1.0 {
+            2.0 * (half * aspect).atan()
+        } else {
+            fov.to_radians()
+        };
+        self.desc
+            .lights
+            .push(LightDesc::Projector(ProjectorLightDesc {
+                position: matrix::point(&m, [0.0; 3]),
+                direction: Some(axis),
+                target: None,
+                up: Some(up),
+                fov: across.to_degrees(),
+                irradiance: None,
+                intensity: Some([scale; 3]),
+                texture: Some(texture),
+                aspect: None,
+            }));
+        Ok(())
+    }
+
     /// A light's colour `name` (its default white) times `scale`.
     fn emitted(&self, p: &Params, name: &str) -> Result<[f64; 3], Problem> {
         let c = match p.spectral(name, false)? {
@@ -1018,6 +1109,7 @@ impl Builder {
                     ..SpotLightDesc::default()
                 }));
             }
+            "projection" => self.projection_light(at, p, input)?,
             "distant" => {
                 let mut irradiance = self.emitted(p, "L")?;
                 if let Some(e) = p.float("illuminance")?.filter(|v| *v > 0.0) {
@@ -1096,15 +1188,15 @@ impl Builder {
                 };
                 self.desc.background = BackgroundDesc::Solid { color };
             }
-            "goniometric" | "projection" => {
+            "goniometric" => {
                 p.ignore_all();
                 self.lacks(at, &format!("`{ty}` light"), "no light")?;
             }
             other => {
                 return Err((
                     at,
-                    format!("light `{other}` is not one lumen reads; it reads point, spot, distant, infinite"),
-                    crate::hint::closest(other, ["point", "spot", "distant", "infinite"])
+                    format!("light `{other}` is not one lumen reads; it reads point, spot, distant, infinite, projection"),
+                    crate::hint::closest(other, ["point", "spot", "distant", "infinite", "projection"])
                         .map(|k| format!("did you mean `{k}`?")),
                 ))
             }
