@@ -147,7 +147,7 @@ pub enum CameraError {
     /// A far clipping distance not beyond the near one.
     FarClip(f32, f32),
     /// An orthographic view's height is not positive and finite.
-    #[error("ortho_height must be positive, got {0}")]
+    #[error("ortho_height must be a positive finite number, got {0}")]
     OrthoHeight(f32),
     /// An orthographic camera given a lens.
     #[error("an orthographic camera has no lens: defocus_angle must be 0, got {0}")]
@@ -238,7 +238,7 @@ impl Camera {
             }
             _ => {}
         }
-        if !(s.focus_dist > 0.0) {
+        if ortho_height.is_none() && !(s.focus_dist > 0.0) {
             return Err(CameraError::FocusDistance(s.focus_dist));
         }
         if !(s.defocus_angle >= 0.0 && s.defocus_angle < 180.0) {

@@ -388,6 +388,16 @@ fn mistakes_in_lights_are_refused_with_the_field_and_a_hint() {
             &["lights[0].aspect", "positive"],
         ),
         (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 40\naspect = 1e-9",
+            &["lights[0].aspect", "from 1e-6"],
+        ),
+        (
+            "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
+             irradiance = [1, 1, 1]\nfov = 1e-12",
+            &["lights[0].fov", "too small or too large"],
+        ),
+        (
             "[[lights]]\ntype = \"projector\"\nposition = [0, 1, 0]\ntarget = [0, 1, 0]\n\
              irradiance = [1, 1, 1]\nfov = 40",
             &["lights[0].target", "own position"],

@@ -1267,6 +1267,12 @@ fn a_projector_frames_its_image_as_mitsubas_camera_frames_its_film() {
              <transform name=\"to_world\"><scale value=\"2\"/></transform></emitter>",
             "may only turn and move it",
         ),
+        (
+            "<emitter type=\"projector\"><rgb name=\"irradiance\" value=\"1\"/>\
+             <transform name=\"to_world\"><matrix value=\"1 0.6 0 0  0 0.8 0 0  0 0 1 0  0 0 0 1\"/>\
+             </transform></emitter>",
+            "no scale, shear or mirror",
+        ),
     ] {
         let e = read("projector-bad.xml", body).unwrap_err().to_string();
         assert!(

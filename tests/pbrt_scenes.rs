@@ -201,7 +201,7 @@ fn orthographic_cameras_see_the_window_each_format_gives_them() {
         &xml,
         "<scene version=\"3.0.0\"><sensor type=\"orthographic\"><transform name=\"to_world\">\
          <scale x=\"3\" y=\"3\"/><lookat origin=\"1, 2, 3\" target=\"1, 2, 0\" up=\"0, 1, 0\"/>\
-         </transform><float name=\"near_clip\" value=\"0\"/>\
+         </transform><float name=\"near_clip\" value=\"0.01\"/>\
          <film type=\"hdrfilm\"><integer name=\"width\" value=\"200\"/>\
          <integer name=\"height\" value=\"100\"/></film></sensor></scene>",
     )
@@ -220,17 +220,26 @@ fn orthographic_cameras_see_the_window_each_format_gives_them() {
 /// pbrt's `projection` light is a projector given its intensity (`scale`
 /// times the image, nearest texel), `fov` across the image's shorter side,
 /// the image's top towards the light frame's +y and its left towards −x:
-/// seen from above, a red-left, green-right slide lights the floor red
-/// at −x and green at +x.
+/// a slide of red and green above blue and white, cast down from a frame
+/// whose +y is the world's +z, lights the floor red at (−x, +z), green at
+/// (+x, +z), blue at (−x, −z) and white at (+x, −z).
 #[test]
 fn a_projection_light_casts_its_image_as_pbrt_casts_it() {
     let dir = scratch_dir("pbrt_scenes_projection");
-    let mut img = image::RgbImage::new(2, 1);
-    img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
-    img.put_pixel(1, 0, image::Rgb([0, 255, 0]));
+    let mut img = image::RgbImage::new(4, 2);
+    for (x, y, c) in [
+        (0, 0, [255, 0, 0]),
+        (1, 0, [0, 255, 0]),
+        (0, 1, [0, 0, 255]),
+        (1, 1, [255; 3]),
+    ] {
+        for dx in 0..2 {
+            img.put_pixel(2 * x + dx, y, image::Rgb(c));
+        }
+    }
     img.save(dir.join("slide.png")).unwrap();
     let text = "LookAt 0 6 0  0 0 0  0 0 -1\nCamera \"perspective\" \"float fov\" 60\n\
-                Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 32\n\
+                Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 64\n\
                 Sampler \"independent\" \"integer pixelsamples\" 4\nWorldBegin\n\
                 AttributeBegin\nTranslate 0 2 0\nRotate 90 1 0 0\n\
                 LightSource \"projection\" \"string filename\" \"slide.png\" \"float fov\" 40 \
@@ -250,28 +259,38 @@ fn a_projection_light_casts_its_image_as_pbrt_casts_it() {
     assert!((l.fov - across.to_degrees()).abs() < 1e-9, "{}", l.fov);
     let scene = file.compile(&Overrides::default()).unwrap();
     let film = lumen::render::render(&scene, &|_| {}).0;
-    let (mut red, mut green) = (0, 0);
-    for y in 0..32 {
-        for x in 0..32 {
+    let mut seen = [0; 4];
+    for y in 0..64 {
+        for x in 0..64 {
             let ray = scene.camera.central_ray(x, y);
             let t = -ray.origin().y / ray.direction.y;
             let at = ray.origin() + t * ray.direction;
-            let c = film.mean((y * 32 + x) as usize);
+            let c = film.mean((y * 64 + x) as usize);
             // Within the lit rectangle, away from its edges and middle.
-            if at.x.abs() < 0.2 || at.x.abs() > 1.2 || at.z.abs() > 0.5 {
+            if at.x.abs() < 0.25 || at.x.abs() > 1.2 || at.z.abs() < 0.25 || at.z.abs() > 0.5 {
                 continue;
             }
-            if at.x < 0.0 {
-                assert!(c.x > 0.0 && c.y == 0.0, "({x}, {y}) at {at}: {c}");
-                red += 1;
-            } else {
-                assert!(c.y > 0.0 && c.x == 0.0, "({x}, {y}) at {at}: {c}");
-                green += 1;
+            let (quarter, lit) = match (at.x < 0.0, at.z > 0.0) {
+                (true, true) => (0, [true, false, false]),
+                (false, true) => (1, [false, true, false]),
+                (true, false) => (2, [false, false, true]),
+                (false, false) => (3, [true, true, true]),
+            };
+            for (k, on) in lit.into_iter().enumerate() {
+                assert_eq!(c[k] > 0.0, on, "({x}, {y}) at {at}: {c}");
             }
+            seen[quarter] += 1;
         }
     }
-    assert!(red > 10 && green > 10, "{red} red, {green} green");
+    assert!(seen.iter().all(|&n| n > 15), "{seen:?}");
     exported_renders_the_same(&dir.join("s.pbrt"));
+    let stretched =
+        "WorldBegin\nScale 1 2 1\nLightSource \"projection\" \"string filename\" \"slide.png\"\n";
+    let e = read_in(&dir, stretched, &Options::default()).unwrap_err();
+    assert!(
+        e.contains("s.pbrt:3:1") && e.contains("stretches or shears"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -556,6 +575,7 @@ fn bad_scenes_are_refused_with_the_place_and_what_to_do() {
         ("Camera \"orthographic\" \"float screenwindow\" [ 0 2 -1 1 ]\nFilm \"rgb\" \"integer xresolution\" 10 \"integer yresolution\" 10\nWorldBegin\n", "s.pbrt:1:8: lumen has no `screenwindow` shifted off centre"),
         ("Scale 1 2 1\nCamera \"orthographic\"\nWorldBegin\n", "s.pbrt:2:8: the camera's transform scales x by 1 and y by 0.5"),
         ("Camera \"orthographic\" \"float lensradius\" 0.1\n", "an orthographic camera's lens"),
+        ("Camera \"orthographic\" \"float fov\" 30\n", "`fov`"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogenous\"\n", "no medium kind is called `homogenous`; pbrt has homogeneous"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1\n", "s.pbrt:1:49: `g` must lie between −0.999 and 0.999"),
         ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n", "s.pbrt:1:49: `sigma_a` must be finite and ≥ 0"),

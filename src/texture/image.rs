@@ -66,7 +66,7 @@ fn kept_bytes(color: ::image::ColorType) -> u64 {
 }
 
 /// The file extensions [`Image::read`] accepts.
-pub const IMAGE_EXTENSIONS: &[&str] = &["exr", "hdr", "png", "jpg", "jpeg"];
+pub const IMAGE_EXTENSIONS: &[&str] = &["exr", "hdr", "png", "jpg", "jpeg", "bmp"];
 
 impl Image {
     /// A floating-point image of `width × height` linear texels, row by
@@ -99,8 +99,23 @@ impl Image {
         }
     }
 
-    /// Reads an image file (`.exr`, `.hdr`, `.png`, `.jpg`/`.jpeg`, by its
-    /// content); see [`Image::decode`].
+    /// The width and height an image file declares in its header (the
+    /// texels are not read); an error says why it cannot be read or that
+    /// it is empty.
+    pub fn dimensions(path: &Path) -> Result<(u32, u32), String> {
+        let (w, h) = ::image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| e.to_string())?
+            .into_dimensions()
+            .map_err(|e| e.to_string())?;
+        if w == 0 || h == 0 {
+            return Err("the image is empty".into());
+        }
+        Ok((w, h))
+    }
+
+    /// Reads an image file (`.exr`, `.hdr`, `.png`, `.jpg`/`.jpeg`, `.bmp`,
+    /// by its content); see [`Image::decode`].
     pub fn read(path: &Path) -> Result<Image, ImageError> {
         let bytes = crate::input::read(path, crate::input::MAX_IMAGE_BYTES).map_err(|e| {
             ImageError::Read {

@@ -22,7 +22,7 @@ pub use point::{PointLight, PointLightDesc};
 pub use projector::{ProjectorLight, ProjectorLightDesc};
 pub use spot::{SpotFalloffDesc, SpotLight, SpotLightDesc, DEFAULT_CUTOFF};
 
-use crate::material::param::Textures;
+use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
 use crate::material::{Invalid, KindInfo};
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
@@ -299,4 +299,17 @@ fn slide(textures: &[Texture], t: u32, [x, y]: [f32; 2], from: Point3) -> Color 
     textures[t as usize]
         .value(textures, &TexCoords::new(uv, from))
         .max(Color::ZERO)
+}
+
+/// The colour texture `name` a light of path `field` casts.
+fn light_texture(field: &str, name: &str, textures: &mut dyn Textures) -> Result<u32, Invalid> {
+    let at = format!("{field}.texture");
+    match textures.color(
+        &at,
+        &ColorDesc::Texture(name.to_string()),
+        ColorRange::NonNegative,
+    )? {
+        ColorParam::Texture(t) => Ok(t),
+        ColorParam::Const(_) => Err(Invalid::new(at, "must name a texture")),
+    }
 }

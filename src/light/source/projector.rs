@@ -9,12 +9,16 @@
 //! in every direction of the frustum, and the plane is lit less towards
 //! the rectangle's edges.
 
-use super::{aim, check_color, check_point, image_frame, slide, Incident};
-use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
+use super::{aim, check_color, check_point, image_frame, light_texture, slide, Incident};
+use crate::material::param::Textures;
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
 use crate::texture::Texture;
+
+/// The narrowest image a projector takes, width over height (and the
+/// widest, its inverse).
+const MIN_ASPECT: f64 = 1e-6;
 
 /// A projector as a scene describes it.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -94,34 +98,33 @@ impl ProjectorLightDesc {
         }
         let texture = match &self.texture {
             None => None,
-            Some(name) => {
-                let at = format!("{field}.texture");
-                match textures.color(
-                    &at,
-                    &ColorDesc::Texture(name.clone()),
-                    ColorRange::NonNegative,
-                )? {
-                    ColorParam::Texture(t) => Some(t),
-                    ColorParam::Const(_) => return Err(Invalid::new(at, "must name a texture")),
-                }
-            }
+            Some(name) => Some(light_texture(field, name, textures)?),
         };
         let aspect = match self.aspect {
-            Some(a) if a > 0.0 && a.is_finite() => a,
+            Some(a) if (MIN_ASPECT..=1.0 / MIN_ASPECT).contains(&a) => a,
             Some(a) => {
                 return Err(Invalid::new(
                     format!("{field}.aspect"),
-                    format!("must be a positive number, got {a}"),
+                    format!(
+                        "must be a positive number from {MIN_ASPECT:e} to {:e}, got {a}",
+                        1.0 / MIN_ASPECT
+                    ),
                 ))
             }
             None => texture.and_then(|t| textures.aspect(t)).unwrap_or(1.0),
         };
         let half_width = (self.fov.to_radians() / 2.0).tan();
         let half_height = half_width / aspect;
-        if !(half_height > 1e-6 && half_width / half_height < 1e6) {
+        // Both sizes, and their product, must be ordinary f32 numbers.
+        let usable = |v: f64| v > 1e-12 && v < 1e30;
+        if !(usable(half_width) && usable(half_height)) {
             return Err(Invalid::new(
-                format!("{field}.aspect"),
-                format!("{aspect} makes the image too narrow to shed light"),
+                format!("{field}.fov"),
+                format!(
+                    "{} degrees with an image {aspect} times as wide as high makes its frame too \
+                     small or too large to light anything",
+                    self.fov
+                ),
             ));
         }
         let (emitted, even_on_plane) = match (self.irradiance, self.intensity) {

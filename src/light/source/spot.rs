@@ -2,8 +2,8 @@
 //! `beam_width` of its axis and falling off linearly in angle to nothing at
 //! `cutoff_angle` (Mitsuba's `spot`).
 
-use super::{aim, check_color, check_point, image_frame, slide, Incident};
-use crate::material::param::{ColorDesc, ColorParam, ColorRange, Textures};
+use super::{aim, check_color, check_point, image_frame, light_texture, slide, Incident};
+use crate::material::param::Textures;
 use crate::material::Invalid;
 use crate::math::{Color, Point3, Vec3};
 use crate::scene::desc::Triple;
@@ -119,15 +119,7 @@ impl SpotLightDesc {
                 None
             }
             Some(name) => {
-                let at = format!("{field}.texture");
-                let ColorParam::Texture(t) = textures.color(
-                    &at,
-                    &ColorDesc::Texture(name.clone()),
-                    ColorRange::NonNegative,
-                )?
-                else {
-                    return Err(Invalid::new(at, "must name a texture"));
-                };
+                let t = light_texture(field, name, textures)?;
                 if cutoff >= std::f32::consts::FRAC_PI_2 {
                     return Err(Invalid::new(
                         format!("{field}.cutoff_angle"),

@@ -509,7 +509,7 @@ pub enum BackgroundDesc {
     /// An equirectangular image around the scene (see
     /// [`EnvironmentMap`](crate::light::EnvironmentMap) for its layout).
     Image {
-        /// The image file (`.exr`, `.hdr`, `.png`, `.jpg`), relative to
+        /// The image file (`.exr`, `.hdr`, `.png`, `.jpg`, `.bmp`), relative to
         /// the scene file.
         file: String,
         /// Turn about +y, in degrees (counter-clockwise seen from above).

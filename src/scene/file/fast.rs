@@ -262,6 +262,8 @@ fn camera(c: &CameraDesc) -> bool {
         && finite(&[c.vfov, c.defocus_angle])
         && c.focus_dist.is_none_or(f64::is_finite)
         && c.ortho_height.is_none_or(f64::is_finite)
+        && c.near_clip.is_finite()
+        && c.far_clip.is_none_or(f64::is_finite)
 }
 
 fn background(b: &BackgroundDesc) -> bool {

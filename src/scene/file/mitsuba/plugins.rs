@@ -379,6 +379,11 @@ impl<'d> Convert<'d> {
                     self.lacks(e, "hide_emitters", "the emitters shown")?;
                 }
                 let mut known = vec!["max_depth", "rr_depth", "hide_emitters"];
+                if t == "ptracer" {
+                    // How the particles are split into passes: not the image.
+                    let _ = p.integer("samples_per_pass", self)?;
+                    known.push("samples_per_pass");
+                }
                 if t == "direct" {
                     for n in ["emitter_samples", "bsdf_samples", "shading_samples"] {
                         if let Some(v) = p.integer(n, self)? {
@@ -434,7 +439,7 @@ impl<'d> Convert<'d> {
                 "principal_point_offset_y",
             ]);
         }
-        if t == "perspective" {
+        if t != "thinlens" {
             // Every Mitsuba camera has one; a pinhole is in focus
             // everywhere.
             let _ = p.float("focus_distance", self)?;
@@ -492,7 +497,13 @@ impl<'d> Convert<'d> {
             // The sensor's plane is [−1, 1] × [−1/aspect, 1/aspect] of its
             // frame, at near_clip along its z: the frame's scale sizes it
             // (and the near distance), and it must keep pixels square.
-            if !(x_scale > 0.0 && depth_scale > 0.0 && (y_scale / x_scale - 1.0).abs() <= 1e-3) {
+            if !(depth_scale > 0.0) {
+                return Err(self.fail(
+                    e,
+                    "the sensor's to_world flattens its view direction to nothing".into(),
+                ));
+            }
+            if !(x_scale > 0.0 && (y_scale / x_scale - 1.0).abs() <= 1e-3) {
                 return Err(self.fail(
                     e,
                     format!(
@@ -572,14 +583,8 @@ impl<'d> Convert<'d> {
         let Some(TextureDesc::Image { file, .. }) = self.desc.textures.get(name) else {
             return Ok(1.0);
         };
-        let path = self.dir.join(file);
-        let size = ::image::ImageReader::open(&path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|err| err.to_string())
-            .and_then(|r| r.into_dimensions().map_err(|err| err.to_string()));
-        match size {
-            Ok((w, h)) if w > 0 && h > 0 => Ok(f64::from(w) / f64::from(h)),
-            Ok(_) => Err(self.fail(e, format!("image `{file}` is empty"))),
+        match crate::texture::image::Image::dimensions(&self.dir.join(file)) {
+            Ok((w, h)) => Ok(f64::from(w) / f64::from(h)),
             Err(err) => Err(self.fail(e, format!("image `{file}`: {err}"))),
         }
     }
@@ -910,13 +915,17 @@ impl<'d> Convert<'d> {
                 )?;
                 let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
                     .map(|v| transform::vector(&m, v));
-                let unit = axes.iter().all(|a| {
-                    ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt() - 1.0).abs() <= 1e-3
+                let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                let turns = (0..3).all(|i| {
+                    (0..3).all(|j| {
+                        (dot(axes[i], axes[j]) - f64::from(u8::from(i == j))).abs() <= 1e-3
+                    })
                 });
-                if !unit || transform::det3(&m) < 0.0 {
+                if !turns || transform::det3(&m) < 0.0 {
                     return Err(self.fail(
                         e,
-                        "a projector's to_world may only turn and move it (no scale or mirror)"
+                        "a projector's to_world may only turn and move it (no scale, shear or \
+                         mirror)"
                             .into(),
                     ));
                 }

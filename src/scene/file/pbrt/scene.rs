@@ -624,7 +624,12 @@ impl Builder {
                 "a perspective or orthographic camera",
             )?;
         }
-        let fov = p.float("fov")?.unwrap_or(90.0);
+        // An orthographic camera has no field of view: pbrt refuses one.
+        let fov = if orthographic {
+            90.0
+        } else {
+            p.float("fov")?.unwrap_or(90.0)
+        };
         if !(fov > 0.0 && fov < 180.0) {
             return Err((
                 at,
@@ -682,18 +687,20 @@ impl Builder {
                 )?;
             }
         }
-        p.finish(
-            "a perspective or orthographic camera",
-            &[
-                "fov",
-                "lensradius",
-                "focaldistance",
-                "shutteropen",
-                "shutterclose",
-                "screenwindow",
-                "frameaspectratio",
-            ],
-        )?;
+        let known = [
+            "lensradius",
+            "focaldistance",
+            "shutteropen",
+            "shutterclose",
+            "screenwindow",
+            "frameaspectratio",
+            "fov",
+        ];
+        if orthographic {
+            p.finish("an orthographic camera", &known[..6])?;
+        } else {
+            p.finish("a perspective camera", &known)?;
+        }
         let camera_from_world = self.state.ctm;
         let world_from_camera = matrix::inverse(&camera_from_world).ok_or((
             at,
@@ -987,25 +994,39 @@ impl Builder {
             None,
         ))?;
         let file = input.file(name, fat)?;
-        let size = ::image::ImageReader::open(input.dir.join(&file))
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| e.to_string())
-            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+        let (w, h) = crate::texture::image::Image::dimensions(&input.dir.join(&file))
             .map_err(|e| (fat, format!("image `{file}`: {e}"), None))?;
-        let aspect = f64::from(size.0) / f64::from(size.1.max(1));
+        let aspect = f64::from(w) / f64::from(h);
         p.finish("a projection light", &["scale", "power", "fov", "filename"])?;
         let m = self.state.ctm;
-        let axis = matrix::vector(&m, [0.0, 0.0, 1.0]);
-        let up = matrix::vector(&m, [0.0, 1.0, 0.0]);
-        let (Some(axis), Some(up)) = (matrix::normalize(axis), matrix::normalize(up)) else {
+        // The frustum keeps its shape only under a turn, a move and a
+        // uniform scale.
+        let [x, y, z] =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|v| matrix::vector(&m, v));
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (lx, ly, lz) = (dot(x, x).sqrt(), dot(y, y).sqrt(), dot(z, z).sqrt());
+        let similar = lx > 0.0
+            && ((ly / lx - 1.0).abs() < 1e-6)
+            && ((lz / lx - 1.0).abs() < 1e-6)
+            && [dot(x, y), dot(y, z), dot(x, z)]
+                .iter()
+                .all(|d| d.abs() <= 1e-6 * lx * lx);
+        if !similar {
+            return Err((
+                at,
+                "the light's transform stretches or shears its frustum: a projection light may \
+                 only be turned, moved and scaled alike along every axis"
+                    .into(),
+                None,
+            ));
+        }
+        let (Some(axis), Some(up)) = (matrix::normalize(z), matrix::normalize(y)) else {
             return Err((at, "the light's transform is singular".into(), None));
         };
         // lumen's image runs along axis × up, which is the frame's −x
         // unless the frame mirrors: pbrt's runs along +x, so the image is
         // read mirrored left to right where the two differ.
-        let along = matrix::vector(&m, [1.0, 0.0, 0.0]);
-        let right = matrix::cross(axis, up);
-        let mirrored = along[0] * right[0] + along[1] * right[1] + along[2] * right[2] < 0.0;
+        let mirrored = dot(x, matrix::cross(axis, up)) < 0.0;
         let texture = self.name("projection");
         let mut image = super::materials::image(
             file,
