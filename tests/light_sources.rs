@@ -628,3 +628,21 @@ fn a_projector_given_its_intensity_sheds_it_evenly_over_its_frustum() {
         Some([3.0, 2.0, 1.0].map(|i: f64| if inside { i * cos / d2 } else { 0.0 }))
     });
 }
+
+/// A projector of a field near 180° and the narrowest image lumen takes
+/// still lights what it covers, with the irradiance asked: its power stays
+/// finite (an image of unbounded shape once made it infinite, which
+/// emptied the scene of lights).
+#[test]
+fn a_projector_of_extreme_shape_still_lights_the_floor() {
+    let scene = floor(
+        "projector-extreme",
+        CENTRE,
+        "[[lights]]\ntype = \"projector\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\n\
+         fov = 179.9999\naspect = 1e-6\nirradiance = [3, 2, 1]",
+        "",
+    );
+    assert_floor("extreme projector", &scene, |_| {
+        Some([3.0, 2.0, 1.0].map(|e: f64| e / 4.0))
+    });
+}

@@ -76,8 +76,9 @@ pub struct ProjectorLight {
     /// The image's texture.
     texture: Option<u32>,
     /// What a unit of `emitted` sends out: the rectangle's area, or the
-    /// frustum's solid angle.
-    spread: f32,
+    /// frustum's solid angle (in f64: the area of a wide frustum's
+    /// rectangle can pass f32's range).
+    spread: f64,
 }
 
 impl ProjectorLightDesc {
@@ -159,7 +160,7 @@ impl ProjectorLightDesc {
             emitted,
             even_on_plane,
             texture,
-            spread: spread as f32,
+            spread,
         })
     }
 }
@@ -198,6 +199,6 @@ impl ProjectorLight {
     /// rectangle at unit distance, which catches all of it, or the
     /// intensity over the frustum's solid angle.
     pub fn power(&self) -> f64 {
-        f64::from(self.spread) * f64::from(super::super::luminance(self.emitted))
+        self.spread * f64::from(super::super::luminance(self.emitted))
     }
 }
