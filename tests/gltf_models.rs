@@ -215,8 +215,8 @@ fn gltf_cameras_frame_the_view_perspective_and_orthographic() {
 "cameras":[{{"name":"wide","type":"perspective","perspective":{{"yfov":0.5,"znear":0.1}}}},
            {{"name":"plan","type":"orthographic","orthographic":{{"xmag":3,"ymag":2,"znear":0.1,"zfar":100}}}}],
 "nodes":[{{"mesh":0}},{{"camera":0,"translation":[0,0,5]}},
-         {{"camera":1,"translation":[1,2,6]}}],
-"scenes":[{{"nodes":[0,1,2]}}],"scene":0}}"#
+         {{"camera":1,"translation":[1,2,6]}},{{"camera":1,"scale":[1,2,1]}}],
+"scenes":[{{"nodes":[0,1,2,3]}}],"scene":0}}"#
     );
     std::fs::write(dir.join("cams.gltf"), gltf).unwrap();
     let scene = |camera: &str| {
@@ -253,4 +253,18 @@ fn gltf_cameras_frame_the_view_perspective_and_orthographic() {
         let centre = 0.5 * (a.origin() + b.origin());
         assert!((centre - lumen::math::Vec3::new(2.0, 4.0, 12.0)).length() < 1e-4);
     }
+    // A node stretching the view (pixels that would not be square).
+    let e = common::scene_file(
+        &dir,
+        "stretched.toml",
+        "[render]\nwidth = 20\nheight = 10\n[camera]\ngltf = 2\n\
+         [[objects]]\ntype = \"mesh\"\nfile = \"cams.gltf\"\n",
+    )
+    .compile(&lumen::scene::Overrides::default())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("camera.gltf") && e.contains("scales its x by 1 and its y by 2"),
+        "{e}"
+    );
 }

@@ -100,11 +100,13 @@ impl Image {
     }
 
     /// The width and height an image file declares in its header (the
-    /// texels are not read); an error says why it cannot be read or that
+    /// texels are not decoded); an error says why it cannot be read or that
     /// it is empty.
     pub fn dimensions(path: &Path) -> Result<(u32, u32), String> {
-        let (w, h) = ::image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
+        let bytes =
+            crate::input::read(path, crate::input::MAX_IMAGE_BYTES).map_err(|e| e.to_string())?;
+        let (w, h) = ::image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
             .map_err(|e| e.to_string())?
             .into_dimensions()
             .map_err(|e| e.to_string())?;

@@ -1161,11 +1161,26 @@ impl Objects<'_> {
         let triple = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
         let (vfov, ortho_height) = match c.view {
             ModelView::Perspective { yfov } => (f64::from(yfov).to_degrees(), None),
-            // ±ymag up its frame, which the transforms may scale.
-            ModelView::Orthographic { ymag } => (
-                self.desc.camera.vfov,
-                Some(2.0 * f64::from(ymag) * f64::from(up.length())),
-            ),
+            // ±ymag up its frame, which the transforms may scale, alike
+            // across for square pixels.
+            ModelView::Orthographic { ymag } => {
+                let across = t.vector(Vec3::from(m.transform_vector3(glam::Vec3::X)));
+                if (across.length() / up.length() - 1.0).abs() > 1e-3 {
+                    return Err(invalid(
+                        "camera.gltf",
+                        format!(
+                            "the orthographic camera's node scales its x by {} and its y by {}: \
+                             lumen's pixels are square",
+                            across.length(),
+                            up.length()
+                        ),
+                    ));
+                }
+                (
+                    self.desc.camera.vfov,
+                    Some(2.0 * f64::from(ymag) * f64::from(up.length())),
+                )
+            }
         };
         Ok(Some(CameraDesc {
             lookfrom: triple(eye),
