@@ -326,28 +326,29 @@ impl Camera {
             .max_element()
             .min(pixel_dv.abs().max_element());
         let resolution = 2.0 * f32::EPSILON * scale;
-        if let (Some(height), false) = (ortho_height, step > resolution) {
-            return Err(CameraError::OrthographicUnresolved {
-                height,
-                step,
-                scale,
-            });
-        }
         if !(step > resolution) {
-            return Err(CameraError::Unresolved {
-                focus_dist: s.focus_dist,
-                vfov: s.vfov,
-                step,
-                scale,
-                // The step grows with the focus distance; where it has
-                // vanished, pixels are 2h / height apart per unit of focus
-                // distance, the largest component at least 1/√3 of that.
-                needed: 1.01
-                    * if step > 1e-30 {
-                        s.focus_dist * (resolution / step)
-                    } else {
-                        resolution * 3f32.sqrt() / (2.0 * h / height as f32)
-                    },
+            return Err(match ortho_height {
+                Some(height) => CameraError::OrthographicUnresolved {
+                    height,
+                    step,
+                    scale,
+                },
+                None => CameraError::Unresolved {
+                    focus_dist: s.focus_dist,
+                    vfov: s.vfov,
+                    step,
+                    scale,
+                    // The step grows with the focus distance; where it has
+                    // vanished, pixels are 2h / height apart per unit of
+                    // focus distance, the largest component at least 1/√3
+                    // of that.
+                    needed: 1.01
+                        * if step > 1e-30 {
+                            s.focus_dist * (resolution / step)
+                        } else {
+                            resolution * 3f32.sqrt() / (2.0 * h / height as f32)
+                        },
+                },
             });
         }
         Ok(Camera {

@@ -31,7 +31,7 @@
 //! varies.
 
 use crate::geometry::bvh_build::Aabb;
-use crate::geometry::transform::Transform;
+use crate::geometry::transform::{Transform, TransformStep};
 use crate::math::{Color, Point3};
 use crate::medium::Boundary;
 use crate::phase::Phase;
@@ -90,8 +90,9 @@ pub struct Grid {
     max: f32,
     /// Grid space (the unit cube) to world.
     transform: Transform,
-    /// Beyond the outer voxels: their values (clamped), or 0.
-    zero_outside: bool,
+    /// The part of grid space its own voxels fill: the unit cube, or less
+    /// where a border of zeros was added ([`Grid::zero_outside`]).
+    own: Aabb,
 }
 
 /// The largest grid [`Grid::read`] accepts, in voxels (a 1024³ grid of
@@ -141,19 +142,61 @@ impl Grid {
             values,
             max,
             transform,
-            zero_outside: false,
+            own: Aabb {
+                min: Point3::ZERO,
+                max: Point3::ONE,
+            },
         })
     }
 
     /// The grid read as 0 outside its voxels (pbrt's `uniformgrid`), so
     /// that values fall towards 0 beyond the outer centres (to half the
     /// outer voxels' at the faces), rather than stay the outer voxels'
-    /// (Mitsuba's).
-    pub fn zero_outside(self) -> Grid {
-        Grid {
-            zero_outside: true,
-            ..self
+    /// (Mitsuba's). It is the grid with a border of zero voxels around
+    /// it, placed so that its own voxels stay where they were: the edge
+    /// clamping then reads 0 beyond them, with no test per voxel.
+    pub fn zero_outside(self) -> Result<Grid, String> {
+        let [nx, ny, nz] = self.size;
+        let padded = [nx + 2, ny + 2, nz + 2];
+        let c = self.channels;
+        let voxels = padded.iter().try_fold(1usize, |n, &s| n.checked_mul(s));
+        let Some(count) = voxels.filter(|&n| n <= MAX_VOXELS) else {
+            return Err(format!(
+                "has {}×{}×{} voxels with its border of zeros: at most {MAX_VOXELS} are read",
+                padded[0], padded[1], padded[2]
+            ));
+        };
+        let mut values = vec![0.0; count * c];
+        for z in 0..nz {
+            for y in 0..ny {
+                let from = (z * ny + y) * nx * c;
+                let to = (((z + 1) * padded[1] + y + 1) * padded[0] + 1) * c;
+                values[to..to + nx * c].copy_from_slice(&self.values[from..from + nx * c]);
+            }
         }
+        // Padded grid space q' to the grid's own: q = (q'·(n + 2) − 1) / n.
+        let axis = |n: usize| (n as f64 + 2.0) / n as f64;
+        let inner = Transform::from_steps(&[
+            TransformStep::Scale([axis(nx), axis(ny), axis(nz)]),
+            TransformStep::Translate([-1.0 / nx as f64, -1.0 / ny as f64, -1.0 / nz as f64]),
+        ])
+        .map_err(|e| e.to_string())?;
+        let transform = self
+            .transform
+            .compose(&inner)
+            .ok_or("is placed too far or too small to take a border of zeros")?;
+        let border = |n: usize| 1.0 / (n as f32 + 2.0);
+        let low = Point3::new(border(nx), border(ny), border(nz));
+        Ok(Grid {
+            size: padded,
+            values,
+            transform,
+            own: Aabb {
+                min: low,
+                max: Point3::ONE - low,
+            },
+            ..self
+        })
     }
 
     /// Reads a grid from a Mitsuba `.vol` file (version 3, float32 values),
@@ -207,24 +250,14 @@ impl Grid {
         self.max
     }
 
-    /// The world box of the grid's unit cube.
+    /// The world box of the grid's own voxels.
     pub fn bounds(&self) -> Aabb {
-        self.transform.bounds(&Aabb {
-            min: Point3::ZERO,
-            max: Point3::ONE,
-        })
+        self.transform.bounds(&self.own)
     }
 
-    /// The value of voxel (x, y, z), clamped to the grid (or 0 outside
-    /// it).
+    /// The value of voxel (x, y, z), clamped to the grid.
     #[inline]
     fn voxel(&self, x: isize, y: isize, z: isize) -> Color {
-        if self.zero_outside {
-            let inside = |v: isize, n: usize| (0..n as isize).contains(&v);
-            if !(inside(x, self.size[0]) && inside(y, self.size[1]) && inside(z, self.size[2])) {
-                return Color::ZERO;
-            }
-        }
         let clamp = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
         let (x, y, z) = (
             clamp(x, self.size[0]),
@@ -608,7 +641,8 @@ mod tests {
     fn grids_zero_outside_fall_to_zero_at_their_faces() {
         let grid = Grid::new([2, 1, 1], 1, vec![1.0, 3.0], 1.0, Transform::IDENTITY)
             .unwrap()
-            .zero_outside();
+            .zero_outside()
+            .unwrap();
         let at = |x: f32| grid.at(Vec3::new(x, 0.5, 0.5)).x;
         for (x, want) in [
             (0.0, 0.5),

@@ -116,7 +116,7 @@ impl ProjectorLightDesc {
         };
         let half_width = (self.fov.to_radians() / 2.0).tan();
         let half_height = half_width / aspect;
-        // Both sizes, and their product, must be ordinary f32 numbers.
+        // Both sizes must be ordinary f32 numbers.
         let usable = |v: f64| v > 1e-12 && v < 1e30;
         if !(usable(half_width) && usable(half_height)) {
             return Err(Invalid::new(

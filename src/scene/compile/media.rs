@@ -165,7 +165,9 @@ fn quantity(
             let grid = Grid::new(size, channels, values, factor, transform)
                 .map_err(|e| invalid(format!("{field}.values"), format!("the grid {e}")))?;
             let grid = match v.edge {
-                Some(EdgeDesc::Zero) => grid.zero_outside(),
+                Some(EdgeDesc::Zero) => grid
+                    .zero_outside()
+                    .map_err(|e| invalid(format!("{field}.values"), format!("the grid {e}")))?,
                 _ => grid,
             };
             checked(field, "values", "the grid", grid, is_albedo)
