@@ -346,13 +346,18 @@ impl Bvh {
         let n = primitives.count();
         // Below this, asking the system what it has free costs more than
         // the tree.
+        let what = || format!("building the tree of {n} shapes");
         if n >= 1 << 16 {
-            crate::memory::check(
-                Self::build_bytes(n),
-                &format!("building the tree of {n} shapes"),
-            )?;
+            crate::memory::check(Self::build_bytes(n), &what())?;
         }
-        Ok(Self::over(primitives, instances))
+        // The count is the least the build takes; the system may still
+        // refuse what the build reserves beyond it (under `ulimit -v`,
+        // reservations count in full).
+        Self::build(primitives, instances).map_err(|_| MemoryError {
+            what: what(),
+            bytes: Self::build_bytes(n),
+            available: None,
+        })
     }
 
     /// The least memory building a tree over `items` items takes at its
@@ -366,8 +371,18 @@ impl Bvh {
     /// (see [`PrimitiveSet`]).
     ///
     /// # Panics
-    /// As [`Bvh::with_instances`].
+    /// As [`Bvh::with_instances`], and when the system refuses the memory
+    /// of the build.
     pub fn over<P: PrimitiveSet + ?Sized>(primitives: &P, instances: Vec<Instance>) -> Self {
+        Self::build(primitives, instances)
+            .unwrap_or_else(|e| panic!("building a tree of {} shapes: {e}", primitives.count()))
+    }
+
+    /// [`Bvh::over`], or the system's refusal of the build's memory.
+    fn build<P: PrimitiveSet + ?Sized>(
+        primitives: &P,
+        instances: Vec<Instance>,
+    ) -> Result<Self, std::collections::TryReserveError> {
         assert!(
             instances.iter().all(|i| i.bvh.instances.is_empty()),
             "instances hold no instances"
@@ -376,7 +391,7 @@ impl Bvh {
             nodes: binary,
             order,
             leaves,
-        } = build_binary(primitives);
+        } = build_binary(primitives)?;
         let mut bvh = Bvh {
             nodes: Nodes::Four(Vec::new()),
             spheres: Vec::new(),
@@ -389,7 +404,7 @@ impl Bvh {
             avx2: crate::isa::Isa::detect() == crate::isa::Isa::Avx2,
         };
         if binary.is_empty() {
-            return bvh;
+            return Ok(bvh);
         }
         let collapse = Collapse {
             binary: &binary,
@@ -424,7 +439,7 @@ impl Bvh {
         bvh.quads.shrink_to_fit();
         bvh.quadrics.shrink_to_fit();
         bvh.instance_packets.shrink_to_fit();
-        bvh
+        Ok(bvh)
     }
 
     /// The box around everything in the tree.

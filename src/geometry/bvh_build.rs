@@ -7,6 +7,7 @@
 
 use crate::geometry::primitive::{Kind, PrimitiveSet, KINDS};
 use crate::math::{Point3, Vec3};
+use std::collections::TryReserveError;
 
 /// Leaves hold at most this many primitives, all of one kind: one packet,
 /// tested as one 8-lane vector with AVX2 or as two 4-lane halves otherwise.
@@ -146,28 +147,33 @@ pub struct BinaryTree {
 ///
 /// Large trees are built on several threads; the tree is the same, node
 /// for node, as the one built on one thread.
-pub fn build_binary<P: PrimitiveSet + ?Sized>(primitives: &P) -> BinaryTree {
+///
+/// Its large vectors are reserved fallibly: where the system refuses one
+/// (a limit on the address space), the build ends with the error rather
+/// than the process.
+pub fn build_binary<P: PrimitiveSet + ?Sized>(
+    primitives: &P,
+) -> Result<BinaryTree, TryReserveError> {
     use rayon::prelude::*;
     let n = primitives.count();
-    let mut items: Vec<BuildItem> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let p = primitives.primitive(i);
-            let bounds = p.bounds();
-            BuildItem {
-                min: bounds.min.to_array(),
-                max: bounds.max.to_array(),
-                centroid: p.centroid().to_array(),
-                index: i as u32,
-                kind: p.kind(),
-            }
-        })
-        .collect();
+    let mut items: Vec<BuildItem> = Vec::new();
+    items.try_reserve_exact(n)?;
+    items.par_extend((0..n).into_par_iter().map(|i| {
+        let p = primitives.primitive(i);
+        let bounds = p.bounds();
+        BuildItem {
+            min: bounds.min.to_array(),
+            max: bounds.max.to_array(),
+            centroid: p.centroid().to_array(),
+            index: i as u32,
+            kind: p.kind(),
+        }
+    }));
     let nodes = if items.is_empty() {
         Vec::new()
     } else {
         // As for the halves below.
-        let mut nodes = build_parallel(&mut items, 0, 0, Vec::with_capacity(n));
+        let mut nodes = build_parallel(&mut items, 0, 0, reserved(n)?)?;
         nodes.shrink_to_fit();
         nodes
     };
@@ -176,11 +182,18 @@ pub fn build_binary<P: PrimitiveSet + ?Sized>(primitives: &P) -> BinaryTree {
         leaves[items[n.offset as usize].kind as usize] += 1;
     }
     let order = items.iter().map(|it| it.index).collect();
-    BinaryTree {
+    Ok(BinaryTree {
         nodes,
         order,
         leaves,
-    }
+    })
+}
+
+/// An empty node vector with room for `n` nodes, or the system's refusal.
+fn reserved(n: usize) -> Result<Vec<BinaryNode>, TryReserveError> {
+    let mut nodes = Vec::new();
+    nodes.try_reserve_exact(n)?;
+    Ok(nodes)
 }
 
 /// [`build`] of the subtree over `items` appended to `nodes`, its two
@@ -192,33 +205,27 @@ fn build_parallel(
     first: usize,
     depth: usize,
     mut nodes: Vec<BinaryNode>,
-) -> Vec<BinaryNode> {
+) -> Result<Vec<BinaryNode>, TryReserveError> {
     if items.len() < PARALLEL_ITEMS {
         build(items, first, depth, &mut nodes);
-        return nodes;
+        return Ok(nodes);
     }
     let node_index = nodes.len();
     let (bounds, mid) = split(items, depth);
     nodes.push(BinaryNode::new(bounds, first, items.len()));
     let Some(mid) = mid else {
-        return nodes;
+        return Ok(nodes);
     };
     let (left, right) = items.split_at_mut(mid);
-    let (mut nodes, right) = rayon::join(
+    let (nodes, right) = rayon::join(
         move || build_parallel(left, first, depth + 1, nodes),
         // Reserved at a node an item, more than the tree usually takes
         // (about 0.3 for triangles: its leaves hold several), and only the
         // pages written take memory: grown by doubling from nothing, each
         // subtree left its freed copies behind.
-        || {
-            build_parallel(
-                right,
-                first + mid,
-                depth + 1,
-                Vec::with_capacity(right.len()),
-            )
-        },
+        || build_parallel(right, first + mid, depth + 1, reserved(right.len())?),
     );
+    let (mut nodes, right) = (nodes?, right?);
     let right_index = nodes.len();
     nodes.extend(right.iter().map(|n| {
         let mut n = *n;
@@ -229,7 +236,7 @@ fn build_parallel(
     }));
     nodes[node_index].offset = right_index as u32;
     nodes[node_index].count = 0;
-    nodes
+    Ok(nodes)
 }
 
 /// Builds the subtree over `items` into `nodes`, returning its node index.
@@ -497,7 +504,7 @@ mod tests {
         let mut rng = Rng::new(7);
         for n in [1, 2, 9, 1000, 3 * PARALLEL_ITEMS + 17, 3 * PARALLEL_PASS] {
             let prims = primitives(&mut rng, n);
-            let tree = build_binary(prims.as_slice());
+            let tree = build_binary(prims.as_slice()).unwrap();
             // The same items, one thread, one node after another.
             let mut items: Vec<BuildItem> = prims
                 .iter()
