@@ -1,7 +1,8 @@
 //! The film: where samples accumulate, and how the accumulated light becomes
 //! displayable pixels.
 
-use crate::math::Color;
+use crate::aov::{Features, Layer, Layers, LAYERS};
+use crate::math::{Color, Vec3};
 
 /// The sum of some samples of a pixel, a number per channel, in 64.64 fixed
 /// point: integers counting 2⁻⁶⁴.
@@ -123,6 +124,10 @@ pub struct Film {
     /// its noise (see [`crate::adaptive`]).
     odd_sums: Vec<Sum>,
     odd_counts: Vec<u32>,
+    /// The sums of the samples' features (see [`crate::aov`]), a vector a
+    /// layer kept (empty for the others), in [`Layer::ALL`]'s order; their
+    /// counts are the image's.
+    layer_sums: [Vec<Sum>; LAYERS],
 }
 
 /// One row of a film, to add samples to (see [`Film::rows_mut`]).
@@ -136,6 +141,11 @@ pub struct RowMut<'a> {
     pub odd_sums: &'a mut [Sum],
     /// Numbers of finite samples of odd index (empty likewise).
     pub odd_counts: &'a mut [u32],
+    /// The sums of the samples' features, a slice a layer the film keeps
+    /// (empty for the others), in [`Layer::ALL`]'s order.
+    pub layer_sums: [&'a mut [Sum]; LAYERS],
+    /// The layers the film keeps.
+    pub layers: Layers,
 }
 
 impl RowMut<'_> {
@@ -162,6 +172,26 @@ impl RowMut<'_> {
         self.counts[x] += 1;
         true
     }
+
+    /// [`RowMut::add`], and the sample's `features` to the layers the film
+    /// keeps when the sample is added. A feature beyond what a [`Sum`]
+    /// holds, or that would take its pixel's sum past it, counts as 0.
+    #[inline(always)]
+    pub fn add_with(&mut self, x: usize, index: u32, c: Color, features: &Features) -> bool {
+        if !self.add(x, index, c) {
+            return false;
+        }
+        for layer in Layer::ALL {
+            if self.layers.has(layer) {
+                let sum = &mut self.layer_sums[layer as usize][x];
+                let value = Sum::of_color(features.layer(layer, c));
+                if let Some(added) = value.and_then(|v| sum.checked_plus(v)) {
+                    *sum = added;
+                }
+            }
+        }
+        true
+    }
 }
 
 impl Film {
@@ -175,7 +205,89 @@ impl Film {
             counts: vec![0; n],
             odd_sums: Vec::new(),
             odd_counts: Vec::new(),
+            layer_sums: Default::default(),
         }
+    }
+
+    /// This film with room for the sums of `layers` (zero), or `None` if
+    /// this machine's memory cannot hold them.
+    pub fn try_with_layers(mut self, layers: Layers) -> Option<Self> {
+        let n = self.len();
+        for layer in Layer::ALL {
+            let sums = &mut self.layer_sums[layer as usize];
+            sums.clear();
+            if layers.has(layer) {
+                sums.try_reserve_exact(n).ok()?;
+                sums.resize(n, Sum::ZERO);
+            }
+        }
+        Some(self)
+    }
+
+    /// [`Film::try_with_layers`], aborting where the memory is refused.
+    pub fn with_layers(self, layers: Layers) -> Self {
+        self.try_with_layers(layers)
+            .expect("memory for the film's feature layers")
+    }
+
+    /// The layers of features the film keeps.
+    pub fn layers(&self) -> Layers {
+        Layer::ALL
+            .into_iter()
+            .filter(|&l| !self.layer_sums[l as usize].is_empty())
+            .fold(Layers::NONE, |all, l| all.with(Layers::of(l)))
+    }
+
+    /// The raw per-pixel sums of `layer` (empty if the film does not keep
+    /// it).
+    pub fn raw_layer(&self, layer: Layer) -> &[Sum] {
+        &self.layer_sums[layer as usize]
+    }
+
+    /// This film with `sums` as the sums of `layer`; `None` if their number
+    /// is not the film's pixels'.
+    pub fn with_layer(mut self, layer: Layer, sums: Vec<Sum>) -> Option<Self> {
+        (sums.len() == self.len()).then(|| {
+            self.layer_sums[layer as usize] = sums;
+            self
+        })
+    }
+
+    /// The mean of `layer` over pixel `i`'s samples (0 without samples or
+    /// without the layer).
+    pub fn feature(&self, layer: Layer, i: usize) -> Vec3 {
+        match self.layer_sums[layer as usize].get(i) {
+            Some(&sum) => mean(sum, self.counts[i]),
+            None => Vec3::ZERO,
+        }
+    }
+
+    /// The variance of pixel `i`'s estimate, per channel: the unbiased
+    /// variance of its samples divided by their number, from the sum of
+    /// their squares (0 with fewer than two samples or without
+    /// [`Layer::Moment`]).
+    pub fn variance(&self, i: usize) -> Color {
+        let (Some(moment), n) = (
+            self.layer_sums[Layer::Moment as usize].get(i),
+            self.counts[i],
+        ) else {
+            return Color::ZERO;
+        };
+        if n < 2 {
+            return Color::ZERO;
+        }
+        let n = f64::from(n);
+        let (sum, squares) = (self.sums[i].to_f64(), moment.to_f64());
+        let v = |c: usize| {
+            let m = sum[c] / n;
+            ((squares[c] / n - m * m).max(0.0) / (n - 1.0)) as f32
+        };
+        Color::new(v(0), v(1), v(2))
+    }
+
+    /// The number of samples pixel `i` holds.
+    pub fn count(&self, i: usize) -> u32 {
+        self.counts[i]
     }
 
     /// [`Film::new`], or `None` if this machine's memory cannot hold it.
@@ -194,6 +306,13 @@ impl Film {
     pub fn bytes(width: u32, height: u32, halves: bool) -> u64 {
         let per_pixel = (std::mem::size_of::<Sum>() + std::mem::size_of::<u32>()) as u64;
         u64::from(width) * u64::from(height) * per_pixel * if halves { 2 } else { 1 }
+    }
+
+    /// Bytes of the sums of `layers` in a `width`×`height` film: 48 a pixel
+    /// a layer.
+    pub fn layer_bytes(width: u32, height: u32, layers: Layers) -> u64 {
+        let kept = Layer::ALL.iter().filter(|&&l| layers.has(l)).count() as u64;
+        u64::from(width) * u64::from(height) * kept * std::mem::size_of::<Sum>() as u64
     }
 
     /// [`Film::with_halves`], or `None` if this machine's memory cannot
@@ -236,43 +355,53 @@ impl Film {
 
     /// Mutable access to the rows, for parallel rendering.
     pub fn rows_mut(&mut self) -> impl rayon::iter::IndexedParallelIterator<Item = RowMut<'_>> {
-        use rayon::iter::Either;
         use rayon::prelude::*;
-        let w = self.width as usize;
-        let whole = self
-            .sums
-            .par_chunks_mut(w)
-            .zip(self.counts.par_chunks_mut(w));
-        if self.odd_counts.is_empty() {
-            return Either::Left(whole.map(|(sums, counts)| RowMut {
-                sums,
-                counts,
-                odd_sums: &mut [],
-                odd_counts: &mut [],
-            }));
+        let w = (self.width as usize).max(1);
+        let layers = self.layers();
+        // What only some films keep, row by row (empty slices elsewhere).
+        type Kept<'a> = (&'a mut [Sum], &'a mut [u32], [&'a mut [Sum]; LAYERS]);
+        let mut kept: Vec<Kept> = (0..self.sums.len() / w)
+            .map(|_| (&mut [][..], &mut [][..], Default::default()))
+            .collect();
+        let halves = self
+            .odd_sums
+            .chunks_mut(w)
+            .zip(self.odd_counts.chunks_mut(w));
+        for (row, (sums, counts)) in kept.iter_mut().zip(halves) {
+            (row.0, row.1) = (sums, counts);
         }
-        Either::Right(
-            whole
-                .zip(self.odd_sums.par_chunks_mut(w))
-                .zip(self.odd_counts.par_chunks_mut(w))
-                .map(|(((sums, counts), odd_sums), odd_counts)| RowMut {
+        for (l, sums) in self.layer_sums.iter_mut().enumerate() {
+            for (row, sums) in kept.iter_mut().zip(sums.chunks_mut(w)) {
+                row.2[l] = sums;
+            }
+        }
+        self.sums
+            .par_chunks_mut(w)
+            .zip(self.counts.par_chunks_mut(w))
+            .zip(kept)
+            .map(
+                move |((sums, counts), (odd_sums, odd_counts, layer_sums))| RowMut {
                     sums,
                     counts,
                     odd_sums,
                     odd_counts,
-                }),
-        )
+                    layer_sums,
+                    layers,
+                },
+            )
     }
 
     /// Adds the samples of `other`, a film of the same size: its pixels'
-    /// sums and counts are added to this film's (exactly, see [`Sum`]).
-    /// `false`, and nothing added, if the sizes differ, either film keeps
-    /// the halves of adaptive sampling, or a pixel's sum or count would pass
+    /// sums and counts are added to this film's (exactly, see [`Sum`]),
+    /// and so are the sums of its feature layers. `false`, and nothing
+    /// added, if the sizes or the layers differ, either film keeps the
+    /// halves of adaptive sampling, or a pixel's sum or count would pass
     /// what it holds.
     pub fn add_film(&mut self, other: &Film) -> bool {
         if (self.width, self.height) != (other.width, other.height)
             || self.has_halves()
             || other.has_halves()
+            || self.layers() != other.layers()
         {
             return false;
         }
@@ -286,6 +415,15 @@ impl Film {
         for (i, (sum, count)) in added.into_iter().enumerate() {
             self.sums[i] = sum;
             self.counts[i] = count;
+        }
+        // A feature that would pass what a sum holds counts as 0, as when
+        // it is rendered.
+        for (mine, theirs) in self.layer_sums.iter_mut().zip(&other.layer_sums) {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                if let Some(sum) = a.checked_plus(*b) {
+                    *a = sum;
+                }
+            }
         }
         true
     }
@@ -304,6 +442,9 @@ impl Film {
         self.counts.clone_from(&other.counts);
         self.odd_sums.clone_from(&other.odd_sums);
         self.odd_counts.clone_from(&other.odd_counts);
+        for (mine, theirs) in self.layer_sums.iter_mut().zip(&other.layer_sums) {
+            mine.clone_from(theirs);
+        }
     }
 
     /// The raw per-pixel sums and counts (for checkpoints).
@@ -328,6 +469,7 @@ impl Film {
             counts,
             odd_sums: Vec::new(),
             odd_counts: Vec::new(),
+            layer_sums: Default::default(),
         })
     }
 

@@ -71,7 +71,7 @@ pub fn make_gallery(
         }
         let (film, stats) = render(scene, &|_| {});
         let file = format!("{}.png", b.name);
-        output::write_image(&dir.join(&file), &film, scene.settings.gamma)?;
+        output::write_image(&dir.join(&file), &film, scene.settings.gamma, &[])?;
         on_scene(b.name, stats);
         let _ = writeln!(
             html,

@@ -2,6 +2,7 @@
 //! ([`trace_path`]), and the same for a group of camera rays of one pixel
 //! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
+use crate::aov::Features;
 use crate::bsdf::{Bsdf, LobeFlags};
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
@@ -68,6 +69,22 @@ struct PathState {
     medium: Option<u32>,
 }
 
+/// A camera path's search for what the feature buffers hold (see
+/// [`crate::aov`]), kept beside the path only in a render that keeps them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FeatureSearch {
+    /// What the path found so far.
+    pub features: Features,
+    /// Whether it still looks for the albedo and normal: until it meets a
+    /// surface that is not a delta.
+    seeking: bool,
+    /// Whether it still looks for the first visible surface (its depth and
+    /// position).
+    placing: bool,
+    /// The tint of the delta surfaces followed while seeking.
+    tint: Color,
+}
+
 impl PathState {
     /// A path leaving the camera of `scene`.
     #[inline(always)]
@@ -79,6 +96,39 @@ impl PathState {
             shadow_rays: 0,
             medium: scene.camera_medium,
         }
+    }
+}
+
+impl FeatureSearch {
+    /// The search of a path leaving the camera.
+    pub fn start() -> FeatureSearch {
+        FeatureSearch {
+            features: Features::default(),
+            seeking: true,
+            placing: true,
+            tint: Color::ONE,
+        }
+    }
+
+    /// The features are those of a surface of albedo `albedo` (before the
+    /// tint of the deltas followed) and shading normal `normal`, on the
+    /// side the path came from.
+    #[cold]
+    #[inline(never)]
+    fn seen(&mut self, albedo: Color, normal: Vec3) {
+        self.features.albedo = (self.tint * albedo).clamp(Color::ZERO, Color::ONE);
+        self.features.normal = normal;
+        self.seeking = false;
+    }
+
+    /// The first visible surface is at `point`, the end of a segment of
+    /// `length` (adding to those of the invisible ones crossed before).
+    #[cold]
+    #[inline(never)]
+    fn placed(&mut self, point: Point3, length: f32) {
+        self.features.position = point;
+        self.features.depth += length;
+        self.placing = false;
     }
 }
 
@@ -124,15 +174,30 @@ fn step(
     depth: u32,
     path: &mut PathState,
     sampler: &mut impl Sampler,
+    mut search: Option<&mut FeatureSearch>,
 ) -> Step {
     let (mut ray, mut hit) = (*ray, hit);
     for _ in 0..MAX_CROSSINGS {
         if !scene.media.is_empty() || path.medium.is_some() {
             if let Some(step) = through_media(scene, &ray, hit, depth, path, sampler) {
+                if let (Some(s), Step::Continue(_, None)) = (&mut search, &step) {
+                    // Scattered by a particle before any surface.
+                    if s.seeking {
+                        s.seen(Color::ONE, Vec3::ZERO);
+                    }
+                }
                 return step;
             }
         }
-        match bounce(scene, &ray, hit, depth, path, sampler) {
+        match bounce(
+            scene,
+            &ray,
+            hit,
+            depth,
+            path,
+            sampler,
+            search.as_deref_mut(),
+        ) {
             Bounce::Step(step) => return step,
             Bounce::Cross(next, left) => {
                 path.shadow_rays += 1;
@@ -211,9 +276,13 @@ fn bounce(
     depth: u32,
     path: &mut PathState,
     sampler: &mut impl Sampler,
+    search: Option<&mut FeatureSearch>,
 ) -> Bounce {
     let done = |c| Bounce::Step(Step::Done(c));
     let Some(hit) = hit else {
+        if let Some(s) = search.filter(|s| s.seeking) {
+            s.seen(scene.background.color(ray.direction), Vec3::ZERO);
+        }
         let mut sky = path.throughput * scene.background.color(ray.direction);
         if let Some((_, bsdf_pdf)) = path.sampled_from {
             sky *= power_heuristic(bsdf_pdf, scene.lights.environment_pdf(ray.direction));
@@ -234,19 +303,40 @@ fn bounce(
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }
+    let mut search = search.filter(|s| s.seeking || s.placing);
     if material.is_interface() {
+        if let Some(s) = search.filter(|s| s.placing) {
+            s.features.depth += hit.t * ray.direction.length();
+        }
         return cross(ray, &record, hit, material, path);
     }
+    if let Some(s) = search.as_deref_mut().filter(|s| s.placing) {
+        s.placed(record.point, hit.t * ray.direction.length());
+    }
+    let mut search = search.filter(|s| s.seeking);
     // The last segment's bounce could only start a ray that is never
     // traced; in a scene with media it may still cross a sheet of glass.
     let last = depth + 1 >= scene.settings.max_depth;
-    if last && !scene.volumetric {
+    if last && !scene.volumetric && search.is_none() {
         return done(path.radiance);
     }
     let wo = -ray.direction;
     let Some(bsdf) = material.bsdf(&record, wo, &scene.textures) else {
+        if let Some(s) = search {
+            // A light without a surface.
+            let n = record.shading_normal;
+            s.seen(Color::ONE, if n.dot(wo) < 0.0 { -n } else { n });
+        }
         return done(path.radiance);
     };
+    if bsdf.lobe.flags().is_spread() {
+        if let Some(s) = search.take() {
+            s.seen(bsdf.lobe.feature_albedo(), bsdf.frame.n);
+        }
+    }
+    if last && !scene.volumetric {
+        return done(path.radiance);
+    }
     sampler.start_bounce(depth);
     let nee = samples_lights(scene, depth) && bsdf.has_density();
     if nee {
@@ -267,6 +357,9 @@ fn bounce(
     }
     path.sampled_from = (nee && !sample.flags.is_specular()).then_some((record.point, sample.pdf));
     path.throughput *= sample.value;
+    if let Some(s) = search {
+        s.tint *= sample.value;
+    }
     path.medium = material.medium_beyond(&record, sample.wi, path.medium);
     if !goes_on(scene, depth, path, sampler) {
         return done(path.radiance);
@@ -541,13 +634,22 @@ fn direct_light(
 /// found light in time). With the `path` integrator each diffuse bounce
 /// also looks for light directly (next-event estimation, in the private `step`).
 #[inline(always)]
-pub fn trace_path(
+pub fn trace_path(scene: &Scene, ray: Ray, sampler: &mut impl Sampler, rays: &mut u64) -> Color {
+    trace_path_features(scene, ray, sampler, rays).0
+}
+
+/// [`trace_path`], and what the path found for the feature buffers (see
+/// [`crate::aov`]; all 0 unless the scene's render keeps them).
+#[inline(always)]
+pub fn trace_path_features(
     scene: &Scene,
     mut ray: Ray,
     sampler: &mut impl Sampler,
     rays: &mut u64,
-) -> Color {
+) -> (Color, Features) {
     let mut path = PathState::start(scene);
+    let mut search = FeatureSearch::start();
+    let searching = scene.settings.layers.need_features();
     let mut from = None;
     // A path still going after `max_depth` segments keeps what it gathered.
     let mut colour = None;
@@ -557,7 +659,8 @@ pub fn trace_path(
         if depth == 0 && scene.camera.clips_far() {
             clip_far(scene, &ray, &mut hit);
         }
-        match step(scene, &ray, hit, depth, &mut path, sampler) {
+        let s = searching.then_some(&mut search);
+        match step(scene, &ray, hit, depth, &mut path, sampler, s) {
             Step::Continue(next, left) => (ray, from) = (next, left),
             Step::Done(c) => {
                 colour = Some(c);
@@ -566,7 +669,12 @@ pub fn trace_path(
         }
     }
     *rays += path.shadow_rays;
-    colour.unwrap_or(path.radiance)
+    let features = if searching {
+        search.features
+    } else {
+        Features::default()
+    };
+    (colour.unwrap_or(path.radiance), features)
 }
 
 /// How many rounds of bounces [`trace_paths`] runs between looks at its
@@ -587,7 +695,10 @@ fn clip_far(scene: &Scene, ray: &Ray, hit: &mut Option<Hit>) {
 
 /// [`trace_path`] for up to [`PATHS`] camera rays of one pixel at once,
 /// each with its own sampler: `colours[i]` gets exactly what
-/// `trace_path(scene, rays[i], &mut samplers[i], ..)` returns.
+/// `trace_path(scene, rays[i], &mut samplers[i], ..)` returns, and
+/// `searches[i]`, where `searches` is not empty (the render keeps feature
+/// buffers), what the path found for them ([`trace_path_features`]): each
+/// search starts as [`FeatureSearch::start`].
 ///
 /// The paths advance together, one segment each per round, so that the rays
 /// of a round can be traced as bundles (see
@@ -601,17 +712,41 @@ fn clip_far(scene: &Scene, ray: &Ray, hit: &mut Option<Hit>) {
 /// says to stop, the paths are left where they are within a few hundred
 /// bounces, and `colours` are not to be used.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn trace_paths<S: Sampler>(
     scene: &Scene,
     rays: &mut [Ray],
     samplers: &mut [S],
     reference: &Ray,
     colours: &mut [Color],
+    searches: &mut [FeatureSearch],
     traced: &mut u64,
     halt: &Halt,
 ) {
     let n = rays.len();
     assert!(n <= PATHS && samplers.len() == n && colours.len() == n);
+    assert!(searches.is_empty() || searches.len() == n);
+    // Two versions: one without a search compiles the search away.
+    let out = (colours, searches, traced);
+    if out.1.is_empty() {
+        rounds::<S, false>(scene, rays, samplers, reference, out, halt);
+    } else {
+        rounds::<S, true>(scene, rays, samplers, reference, out, halt);
+    }
+}
+
+/// The rounds of [`trace_paths`], with the features searched for if
+/// `FEATURES`.
+#[inline(always)]
+fn rounds<S: Sampler, const FEATURES: bool>(
+    scene: &Scene,
+    rays: &mut [Ray],
+    samplers: &mut [S],
+    reference: &Ray,
+    (colours, searches, traced): (&mut [Color], &mut [FeatureSearch], &mut u64),
+    halt: &Halt,
+) {
+    let n = rays.len();
     let mut paths = [PathState::start(scene); PATHS];
     let mut hits = [None; PATHS];
     // The surface each path's ray leaves.
@@ -627,7 +762,16 @@ pub fn trace_paths<S: Sampler>(
         for k in 0..n_live {
             let i = live[k] as usize;
             let sampler = &mut samplers[i];
-            match step(scene, &rays[i], hits[i], round, &mut paths[i], sampler) {
+            let search = if FEATURES { searches.get_mut(i) } else { None };
+            match step(
+                scene,
+                &rays[i],
+                hits[i],
+                round,
+                &mut paths[i],
+                sampler,
+                search,
+            ) {
                 Step::Continue(next, left) => {
                     (rays[i], from[i]) = (next, left);
                     live[still] = i as u8;
@@ -722,6 +866,11 @@ mod tests {
     /// sampler.
     #[test]
     fn paths_side_by_side_equal_paths_one_at_a_time() {
+        let bits = |c: &[Color]| {
+            c.iter()
+                .map(|c| c.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
         // bouncing-spheres: moving instances, whose hits depend on each
         // ray's time.
         let names = [
@@ -741,11 +890,19 @@ mod tests {
         bunny.render.height = Some(24);
         descs.push(bunny);
         let kinds = [SamplerKind::Independent, SamplerKind::Sobol];
+        let all = crate::aov::Aov::ALL.to_vec();
         for (desc, kind) in descs.iter().flat_map(|d| kinds.map(|k| (d, k))) {
             let mut desc = desc.clone();
             desc.render.width = 24;
-            for max_depth in [1, 2, 3, 50] {
+            // Features found or not, the paths are the same.
+            let mut without_features = Vec::new();
+            for (max_depth, aovs) in [1, 2, 3, 50]
+                .into_iter()
+                .flat_map(|d| [(d, vec![]), (d, all.clone())])
+            {
                 desc.render.max_depth = max_depth;
+                let with_features = !aovs.is_empty();
+                desc.render.aovs = aovs;
                 let scene = Scene::from_desc(&desc).expect("compiles");
                 let height = scene.settings.height;
                 for (pixel, n) in [(0u32, 1usize), (5, 3), (100, 8), (200, 13), (300, PATHS)] {
@@ -759,12 +916,16 @@ mod tests {
                         samplers.push(sampler);
                     }
                     let mut alone_rays = 0;
-                    let alone: Vec<Color> = rays
+                    let (alone, alone_features): (Vec<Color>, Vec<Features>) = rays
                         .iter()
                         .zip(samplers.clone())
-                        .map(|(&ray, mut s)| trace_path(&scene, ray, &mut s, &mut alone_rays))
-                        .collect();
+                        .map(|(&ray, mut s)| {
+                            trace_path_features(&scene, ray, &mut s, &mut alone_rays)
+                        })
+                        .unzip();
                     let mut together = vec![Color::ZERO; n];
+                    let mut searches =
+                        vec![FeatureSearch::start(); if with_features { n } else { 0 }];
                     let mut together_rays = 0;
                     let reference = scene.camera.central_ray(x, y);
                     trace_paths(
@@ -773,14 +934,29 @@ mod tests {
                         &mut samplers,
                         &reference,
                         &mut together,
+                        &mut searches,
                         &mut together_rays,
                         &Halt::never(),
                     );
-                    let bits = |c: &[Color]| {
-                        c.iter()
-                            .map(|c| c.to_array().map(f32::to_bits))
-                            .collect::<Vec<_>>()
+                    let features: Vec<Features> = match with_features {
+                        true => searches.iter().map(|s| s.features).collect(),
+                        false => vec![Features::default(); n],
                     };
+                    assert_eq!(features, alone_features, "{}: features", desc.caption);
+                    if with_features {
+                        assert_eq!(
+                            Some(without_features.remove(0)),
+                            Some(bits(&together)),
+                            "{}: features change the image",
+                            desc.caption
+                        );
+                        // Every path found its albedo (the sky's, at least),
+                        // but one that ended on glass.
+                        let found = features.iter().all(|f| f.albedo != Color::ZERO);
+                        assert!(found || max_depth < 50, "{}: no features", desc.caption);
+                    } else {
+                        without_features.push(bits(&together));
+                    }
                     assert_eq!(
                         bits(&together),
                         bits(&alone),

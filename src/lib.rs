@@ -55,6 +55,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod adaptive;
+pub mod aov;
 pub mod bench;
 pub mod bsdf;
 pub mod camera;

@@ -2,7 +2,13 @@
 //! floating-point PFM and OpenEXR. Every file is written to a temporary name
 //! beside its destination and renamed into place, so a reader never sees a
 //! half-written file.
+//!
+//! Feature buffers ([`crate::aov`]) are written as layers of an EXR image
+//! (channels `albedo.R`, `normal.X`, `depth.Z`, … beside the image's `R`,
+//! `G`, `B`), or beside an image of another format as PFM files named after
+//! it (`out.png` → `out.albedo.pfm`).
 
+use crate::aov::{Aov, Layer};
 use crate::film::Film;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -147,9 +153,109 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> 
     write_atomic(path, |tmp| fs::write(tmp, bytes).map_err(|e| e.to_string()))
 }
 
-/// Writes the film to `path` in the format its extension names.
-pub fn write_image(path: &Path, film: &Film, gamma: f32) -> Result<(), OutputError> {
+/// Writes the film to `path` in the format its extension names, with its
+/// feature buffers `aovs` (see the module's documentation).
+pub fn write_image(path: &Path, film: &Film, gamma: f32, aovs: &[Aov]) -> Result<(), OutputError> {
     let format = ImageFormat::from_path(path)?;
+    if aovs.is_empty() {
+        return write_beauty(path, film, gamma, format);
+    }
+    if format == ImageFormat::Exr {
+        return write_layered_exr(path, film, aovs);
+    }
+    write_beauty(path, film, gamma, format)?;
+    for &aov in aovs {
+        write_bytes_atomic(&aov_path(path, aov), &encode_aov_pfm(film, aov))?;
+    }
+    Ok(())
+}
+
+/// Where feature buffer `aov` of an image written to `path` (not an EXR
+/// file) goes: `NAME.AOV.pfm` beside it.
+pub fn aov_path(path: &Path, aov: Aov) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}.{}.pfm", aov.name()))
+}
+
+/// Feature buffer `aov` of `film`: a vector of values a channel (of
+/// [`Aov::channels`]), each row-major, top row first.
+pub fn aov_values(film: &Film, aov: Aov) -> Vec<Vec<f32>> {
+    let n = film.len();
+    let vectors = |f: &dyn Fn(usize) -> crate::math::Vec3| {
+        let v: Vec<_> = (0..n).map(f).collect();
+        (0..3)
+            .map(|c| v.iter().map(|p| p[c]).collect())
+            .collect::<Vec<Vec<f32>>>()
+    };
+    match aov {
+        Aov::Albedo => vectors(&|i| film.feature(Layer::Albedo, i)),
+        Aov::Normal => vectors(&|i| film.feature(Layer::Normal, i)),
+        Aov::Position => vectors(&|i| film.feature(Layer::Position, i)),
+        Aov::Variance => vectors(&|i| film.variance(i)),
+        Aov::Depth => vec![(0..n).map(|i| film.feature(Layer::Depth, i).x).collect()],
+        Aov::Spp => vec![(0..n).map(|i| film.count(i) as f32).collect()],
+    }
+}
+
+/// The film's image as channels `R`, `G`, `B` and its feature buffers as
+/// `NAME.C`, in one EXR file.
+fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), OutputError> {
+    use exr::prelude::*;
+    let (w, h) = (film.width() as usize, film.height() as usize);
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+        let values = film.pixels().map(|p| p[c]).collect();
+        channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
+    }
+    for &aov in aovs {
+        for (name, values) in aov.channels().iter().zip(aov_values(film, aov)) {
+            let name = format!("{}.{name}", aov.name());
+            channels.push(AnyChannel::new(name.as_str(), FlatSamples::F32(values)));
+        }
+    }
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::default()
+    };
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(channels),
+    );
+    write_atomic(path, |tmp| {
+        Image::from_layer(layer)
+            .write()
+            .to_file(tmp)
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Feature buffer `aov` of `film` as a PFM file: colour (`PF`) for three
+/// channels, grey (`Pf`) for one.
+pub fn encode_aov_pfm(film: &Film, aov: Aov) -> Vec<u8> {
+    let (w, h) = (film.width() as usize, film.height() as usize);
+    let values = aov_values(film, aov);
+    let kind = if values.len() == 3 { "PF" } else { "Pf" };
+    let mut out = format!("{kind}\n{w} {h}\n-1.0\n").into_bytes();
+    out.reserve(w * h * 4 * values.len());
+    for y in (0..h).rev() {
+        for x in 0..w {
+            for channel in &values {
+                out.extend_from_slice(&channel[y * w + x].to_le_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// Writes the film's image alone to `path` in `format`.
+fn write_beauty(
+    path: &Path,
+    film: &Film,
+    gamma: f32,
+    format: ImageFormat,
+) -> Result<(), OutputError> {
     let (w, h) = (film.width(), film.height());
     match format {
         ImageFormat::Ppm => write_bytes_atomic(path, &encode_ppm(film, gamma)),

@@ -235,17 +235,20 @@ impl Session {
     ) -> Result<Self, SessionError> {
         let (w, h) = (tile.width(), tile.height());
         let halves = scene.settings.noise_target.is_some();
+        let layers = scene.settings.layers;
+        let bytes = Film::bytes(w, h, halves) + Film::layer_bytes(w, h, layers);
         crate::memory::check(
-            2 * Film::bytes(w, h, halves),
+            2 * bytes,
             &format!("the {w}x{h} film (with the copy a pass keeps)"),
         )?;
         let film = match halves {
             true => Film::try_with_halves(w, h),
             false => Film::try_new(w, h),
         }
+        .and_then(|film| film.try_with_layers(layers))
         .ok_or_else(|| crate::memory::MemoryError {
             what: format!("the {w}x{h} film"),
-            bytes: Film::bytes(w, h, halves),
+            bytes,
             available: None,
         })?;
         let active = scene.settings.noise_target.map(|_| vec![true; film.len()]);
@@ -377,6 +380,11 @@ impl Session {
                 checkpoint.spp_done, s.samples_per_pixel
             ))
             .into());
+        }
+        if checkpoint.film.layers() != s.layers {
+            return Err(
+                malformed("its feature layers (AOVs) do not match the render's".into()).into(),
+            );
         }
         if checkpoint.active.is_some() != self.active.is_some() {
             return Err(malformed(

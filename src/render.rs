@@ -1,8 +1,9 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
+use crate::aov::Features;
 use crate::film::{Film, RowMut};
 use crate::halt::Halt;
-use crate::integrator::{first_hit_view, trace_paths, PATHS};
+use crate::integrator::{first_hit_view, trace_paths, FeatureSearch, PATHS};
 use crate::isa::Isa;
 use crate::math::{Color, Vec3};
 use crate::ray::Ray;
@@ -234,7 +235,7 @@ fn render_row_generic(
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
-                add_sample(&mut row, &mut stats, x, index, c);
+                add_sample(&mut row, &mut stats, x, index, c, &Features::default());
             }
         }
         return stats;
@@ -282,11 +283,12 @@ fn pixel_sampler(scene: &Scene, column: u32, y: u32) -> PixelSampler {
 }
 
 /// Room for up to [`PATHS`] camera rays traced side by side
-/// ([`trace_paths`]), with their samplers and colours.
+/// ([`trace_paths`]), with their samplers, colours and features.
 struct SideBySide {
     rays: [Ray; PATHS],
     samplers: [PixelSample; PATHS],
     colours: [Color; PATHS],
+    searches: [FeatureSearch; PATHS],
 }
 
 impl SideBySide {
@@ -296,6 +298,7 @@ impl SideBySide {
             rays: [Ray::new(Vec3::ZERO, Vec3::X); PATHS],
             samplers: [const { PixelSample::placeholder() }; PATHS],
             colours: [Color::ZERO; PATHS],
+            searches: [FeatureSearch::start(); PATHS],
         }
     }
 
@@ -323,31 +326,54 @@ impl SideBySide {
                 n += 1;
             }
         }
+        let searches = if scene.settings.layers.need_features() {
+            let searches = &mut self.searches[..n];
+            searches.fill(FeatureSearch::start());
+            searches
+        } else {
+            &mut []
+        };
         trace_paths(
             scene,
             &mut self.rays[..n],
             &mut self.samplers[..n],
             reference,
             &mut self.colours[..n],
+            searches,
             &mut stats.rays,
             halt,
         );
-        let colours = self.colours[..n].chunks(samples.len().max(1));
-        for (&(x, _), colours) in pixels.iter().zip(colours) {
-            for (index, &c) in samples.clone().zip(colours) {
-                add_sample(row, stats, x, index, c);
+        let per_pixel = samples.len().max(1);
+        let colours = self.colours[..n].chunks(per_pixel);
+        let searches = self.searches[..n].chunks(per_pixel);
+        for ((&(x, _), colours), searches) in pixels.iter().zip(colours).zip(searches) {
+            for ((index, &c), s) in samples.clone().zip(colours).zip(searches) {
+                add_sample(row, stats, x, index, c, &s.features);
             }
         }
     }
 }
 
-/// Adds sample `index` of pixel `x` to `row` and counts it in `stats`, as
-/// dropped if the film leaves it out. A function marked to be inlined
-/// rather than a closure, which the compiler may call out of line.
+/// Adds sample `index` of pixel `x`, of colour `c` and features `f`, to
+/// `row` and counts it in `stats`, as dropped if the film leaves it out. A
+/// function marked to be inlined rather than a closure, which the compiler
+/// may call out of line.
 #[inline(always)]
-fn add_sample(row: &mut RowMut, stats: &mut RenderStats, x: usize, index: u32, c: Color) {
+fn add_sample(
+    row: &mut RowMut,
+    stats: &mut RenderStats,
+    x: usize,
+    index: u32,
+    c: Color,
+    f: &Features,
+) {
     stats.samples += 1;
-    if !row.add(x, index, c) {
+    let added = if row.layers.is_empty() {
+        row.add(x, index, c)
+    } else {
+        row.add_with(x, index, c, f)
+    };
+    if !added {
         stats.dropped += 1;
     }
 }
@@ -370,7 +396,7 @@ pub(crate) fn camera_sample(
 /// Renders the whole image at the scene's samples per pixel.
 pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> (Film, RenderStats) {
     let s = &scene.settings;
-    let mut film = Film::new(s.width, s.height);
+    let mut film = Film::new(s.width, s.height).with_layers(s.layers);
     let stats = render_samples(scene, &mut film, 0..s.samples_per_pixel, progress);
     (film, stats)
 }
@@ -474,13 +500,13 @@ mod tests {
                         let ps = pixel_sampler(&scene, x as u32, y);
                         for index in samples.clone() {
                             let (ray, mut sampler) = camera_sample(&scene, x as u32, y, &ps, index);
-                            let c = crate::integrator::trace_path(
+                            let (c, f) = crate::integrator::trace_path_features(
                                 &scene,
                                 ray,
                                 &mut sampler,
                                 &mut expected.rays,
                             );
-                            add_sample(&mut row, &mut expected, x, index, c);
+                            add_sample(&mut row, &mut expected, x, index, c, &f);
                         }
                     }
                     assert_eq!(stats, expected, "{}: {samples:?}, row {y}", desc.caption);

@@ -154,13 +154,13 @@ fn every_format_round_trips_through_its_file() {
     let film = film_of(w, h, &pixels);
 
     let png = dir.join("a.png");
-    write_image(&png, &film, 2.0).unwrap();
+    write_image(&png, &film, 2.0, &[]).unwrap();
     let decoded = image::open(&png).unwrap().into_rgb8();
     assert_eq!(decoded.dimensions(), (w, h));
     assert_eq!(decoded.into_raw(), film.to_rgb8(2.0));
 
     let exr_path = dir.join("a.exr");
-    write_image(&exr_path, &film, 2.0).unwrap();
+    write_image(&exr_path, &film, 2.0, &[]).unwrap();
     let (size, exr_pixels) = common::read_exr_rgb(&exr_path);
     assert_eq!(size, (w as usize, h as usize));
     let linear: Vec<[f32; 3]> = film.linear().iter().map(|c| [c.x, c.y, c.z]).collect();
@@ -168,7 +168,7 @@ fn every_format_round_trips_through_its_file() {
 
     for (ext, bytes) in [("ppm", encode_ppm(&film, 2.0)), ("pfm", encode_pfm(&film))] {
         let path = dir.join(format!("a.{ext}"));
-        write_image(&path, &film, 2.0).unwrap();
+        write_image(&path, &film, 2.0, &[]).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), bytes, "{ext}");
     }
     // Only the four images are left: no temporary files.
@@ -181,7 +181,7 @@ fn unknown_extensions_and_bad_destinations_are_refused_without_a_file() {
     let film = film_of(1, 1, &[Some([0.5; 3])]);
     for name in ["a.jpg", "noextension", "a.PNG.txt"] {
         assert!(ImageFormat::from_path(Path::new(name)).is_err(), "{name}");
-        let err = write_image(&dir.join(name), &film, 2.0).unwrap_err();
+        let err = write_image(&dir.join(name), &film, 2.0, &[]).unwrap_err();
         assert!(err.to_string().contains(name), "{err}");
     }
     assert_eq!(
@@ -189,7 +189,7 @@ fn unknown_extensions_and_bad_destinations_are_refused_without_a_file() {
         ImageFormat::Png
     );
     let missing = dir.join("no-such-dir").join("a.png");
-    assert!(write_image(&missing, &film, 2.0).is_err());
+    assert!(write_image(&missing, &film, 2.0, &[]).is_err());
     assert_eq!(
         std::fs::read_dir(&dir).unwrap().count(),
         0,
@@ -235,11 +235,11 @@ fn the_same_film_gives_the_same_exr_file_every_time() {
         .collect();
     let film = film_of(w, h, &pixels);
     let first = dir.join("first.exr");
-    write_image(&first, &film, 2.0).unwrap();
+    write_image(&first, &film, 2.0, &[]).unwrap();
     let bytes = std::fs::read(&first).unwrap();
     for i in 0..6 {
         let again = dir.join(format!("again-{i}.exr"));
-        write_image(&again, &film, 2.0).unwrap();
+        write_image(&again, &film, 2.0, &[]).unwrap();
         assert!(std::fs::read(&again).unwrap() == bytes, "write {i} differs");
     }
 }

@@ -31,12 +31,16 @@ fn one_machine(desc: &SceneDesc) -> lumen::film::Film {
 #[test]
 fn merged_parts_are_the_one_machine_film_for_any_count_and_order() {
     let dir = temp_dir("parts-counts");
-    // 5 spp and 7 parts: more parts than samples, some parts empty.
-    for (name, spp, counts) in [
-        ("cover", 13, &[1, 2, 3, 7][..]),
-        ("cornell-box", 5, &[2, 7][..]),
+    // 5 spp and 7 parts: more parts than samples, some parts empty. The
+    // feature buffers merge to the bit as the image does.
+    let all = lumen::aov::Aov::ALL.to_vec();
+    for (name, spp, counts, aovs) in [
+        ("cover", 13, &[1, 2, 3, 7][..], vec![]),
+        ("cornell-box", 5, &[2, 7][..], vec![]),
+        ("cornell-box", 5, &[3][..], all),
     ] {
-        let d = desc(name, 24, spp, 11);
+        let mut d = desc(name, 24, spp, 11);
+        d.render.aovs = aovs;
         let whole = one_machine(&d);
         for &count in counts {
             let sub = dir.join(format!("{name}-{count}"));
@@ -52,6 +56,8 @@ fn merged_parts_are_the_one_machine_film_for_any_count_and_order() {
                 }
                 let merged = part::merge(&paths, false).unwrap();
                 assert!(merged.is_complete());
+                assert_eq!(merged.aovs, d.render.aovs);
+                assert_eq!(merged.film.layers(), whole.layers());
                 assert!(
                     merged.film == whole,
                     "{name}: {count} parts, order {turn}: film differs"
@@ -68,7 +74,9 @@ fn merged_parts_are_the_one_machine_film_for_any_count_and_order() {
 #[test]
 fn a_part_stopped_and_resumed_merges_exactly() {
     let dir = temp_dir("parts-resume");
-    let d = desc("cover", 24, 32, 2);
+    let mut d = desc("cover", 24, 32, 2);
+    // With every feature buffer: they are in the part files too.
+    d.render.aovs = lumen::aov::Aov::ALL.to_vec();
     let (a, b) = (Part { index: 0, count: 2 }, Part { index: 1, count: 2 });
     let first = write_part(&d, a, &dir, None);
     // Part 1 stopped after two passes, as a killed task leaves it.

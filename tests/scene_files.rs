@@ -157,6 +157,7 @@ fn overrides_replace_the_files_settings() {
         integrator: Some(Integrator::Bsdf),
         light_selection: Some(LightSelection::Uniform),
         noise_target: Some(0.25),
+        aovs: Some(vec![lumen::aov::Aov::Normal, lumen::aov::Aov::Spp]),
         allow_outside: false,
     };
     let s = file.compile(&o).unwrap().settings;
@@ -174,6 +175,8 @@ fn overrides_replace_the_files_settings() {
         (own.settings.light_selection, s.light_selection),
         (LightSelection::Power, LightSelection::Uniform)
     );
+    assert_eq!(own.settings.aovs, []);
+    assert_eq!(s.aovs, [lumen::aov::Aov::Normal, lumen::aov::Aov::Spp]);
 }
 
 /// `SceneDesc` also derives serde's `Deserialize` for library users; it must

@@ -235,7 +235,9 @@ fn a_tile_must_lie_in_the_image_and_bands_must_hold_rows() {
 #[test]
 fn a_tile_stopped_and_resumed_merges_exactly_and_only_as_that_tile() {
     let dir = temp_dir("tiles-resume");
-    let d = desc("cover", 24, 32, 2);
+    let mut d = desc("cover", 24, 32, 2);
+    // Feature buffers go into tiles and merge as the image does.
+    d.render.aovs = vec![lumen::aov::Aov::Albedo, lumen::aov::Aov::Depth];
     let top = write(&d, band(0, 2), &dir, "part-0");
     let path = dir.join("part-1.lumen-part");
     write_share(&d, band(1, 2), &path, Some(2));

@@ -249,6 +249,21 @@ impl Lobe {
         }
     }
 
+    /// Its colour for the albedo feature buffer (see [`crate::aov`]), as
+    /// Open Image Denoise asks: a diffuse surface's reflectance, a metal's
+    /// reflectance at normal incidence, glass white, a coated or glTF
+    /// surface its base's colour.
+    pub fn feature_albedo(&self) -> Color {
+        match self {
+            Lobe::Diffuse(d) => d.albedo,
+            Lobe::Metal(m) => m.albedo,
+            Lobe::Conductor(c) => fresnel::conductor(1.0, c.eta, c.k) * c.tint,
+            Lobe::Dielectric(_) | Lobe::ExactDielectric(_) | Lobe::ThinDielectric(_) => Color::ONE,
+            Lobe::Plastic(p) => p.albedo,
+            Lobe::Principled(p) => p.base_color,
+        }
+    }
+
     /// A direction for light leaving along local `wo`, from `uc` (a
     /// discrete choice) and `u`, uniform in [0, 1); the local lobes only.
     #[inline(always)]

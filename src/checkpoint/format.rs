@@ -5,6 +5,7 @@
 
 use super::pixels::{write_pixels, Pixels};
 use super::{Checkpoint, CheckpointView, MAGIC, VERSION};
+use crate::aov::{Layer, Layers};
 use crate::film::Film;
 use crate::render::RenderStats;
 use crate::tile::Tile;
@@ -42,10 +43,21 @@ impl CheckpointView<'_> {
                 sink(&[1])?;
                 write_pixels(self.film.raw_odd(), width, sink)?;
                 let flags: Vec<u8> = active.iter().map(|&a| u8::from(a)).collect();
-                sink(&flags)
+                sink(&flags)?;
             }
-            _ => sink(&[0]),
+            _ => sink(&[0])?,
         }
+        // The feature layers, when the film keeps any (a checkpoint
+        // without them ends above).
+        let layers = self.film.layers();
+        if !layers.is_empty() {
+            sink(&[layers.bits()])?;
+            let counts = self.film.raw().1;
+            for layer in Layer::ALL.into_iter().filter(|&l| layers.has(l)) {
+                write_pixels((self.film.raw_layer(layer), counts), width, sink)?;
+            }
+        }
+        Ok(())
     }
 
     /// Writes the checkpoint, header included, to `out`: one pass over the
@@ -85,6 +97,8 @@ pub(crate) struct Unpacked<'a> {
     /// With adaptive sampling: the sums and counts of the samples of odd
     /// index, and a flag a pixel.
     pub(crate) odd: Option<(Pixels<'a>, &'a [u8])>,
+    /// The sums of the feature layers the film keeps, each with its layer.
+    pub(crate) layers: Vec<(Layer, Pixels<'a>)>,
 }
 
 impl Checkpoint {
@@ -115,18 +129,35 @@ impl Checkpoint {
             dropped: stat()?,
         };
         let (pixels, rest) = Pixels::split(r.0, width, height)?;
-        let odd = match rest {
-            [0] => None,
+        let (odd, rest) = match rest {
+            [0, rest @ ..] => (None, rest),
             [1, rest @ ..] => {
-                let (odd, flags) = Pixels::split(rest, width, height)?;
-                if flags.len() as u64 != u64::from(width) * u64::from(height) {
+                let (odd, rest) = Pixels::split(rest, width, height)?;
+                let n = u64::from(width) * u64::from(height);
+                if (rest.len() as u64) < n {
                     return Err("pixel data does not match the image size");
                 }
-                Some((odd, flags))
+                let (flags, rest) = rest.split_at(n as usize);
+                (Some((odd, flags)), rest)
             }
-            [] | [0, ..] => return Err("pixel data does not match the image size"),
+            [] => return Err("pixel data does not match the image size"),
             _ => return Err("bad adaptive sampling flags"),
         };
+        let mut layers = Vec::new();
+        if let [bits, after @ ..] = rest {
+            let mut rest = after;
+            let kept = Layers::from_bits(*bits)
+                .filter(|l| !l.is_empty())
+                .ok_or("bad feature layers")?;
+            for layer in Layer::ALL.into_iter().filter(|&l| kept.has(l)) {
+                let (sums, after) = Pixels::split(rest, width, height)?;
+                layers.push((layer, sums));
+                rest = after;
+            }
+            if !rest.is_empty() {
+                return Err("pixel data does not match the image size");
+            }
+        }
         let head = Self {
             renderer_id,
             description,
@@ -139,14 +170,26 @@ impl Checkpoint {
             film: Film::new(0, 0),
             active: None,
         };
-        Ok(Unpacked { head, pixels, odd })
+        Ok(Unpacked {
+            head,
+            pixels,
+            odd,
+            layers,
+        })
     }
 
     pub(super) fn decode_payload(payload: &[u8]) -> Result<Self, &'static str> {
         let u = Self::unpack(payload)?;
         let (sums, counts) = u.pixels.decode()?;
         let (w, h) = (u.head.tile.width(), u.head.tile.height());
-        let film = Film::from_raw(w, h, sums, counts).ok_or("bad pixel data")?;
+        let mut film = Film::from_raw(w, h, sums, counts).ok_or("bad pixel data")?;
+        for (layer, pixels) in &u.layers {
+            let (sums, layer_counts) = pixels.decode()?;
+            if layer_counts != film.raw().1 {
+                return Err("bad pixel data of a feature layer");
+            }
+            film = film.with_layer(*layer, sums).ok_or("bad pixel data")?;
+        }
         let (film, active) = match u.odd {
             None => (film, None),
             Some((odd, flags)) => {

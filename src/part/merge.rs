@@ -158,6 +158,8 @@ pub struct Merged {
     pub stats: RenderStats,
     /// The display gamma of the render (the first part's).
     pub gamma: f32,
+    /// The feature buffers the render writes (see [`crate::aov`]).
+    pub aovs: Vec<crate::aov::Aov>,
     /// [`crate::checkpoint::RENDERER_ID`] of the lumen that rendered the
     /// parts.
     pub renderer_id: String,
@@ -265,6 +267,16 @@ impl Merger {
                 "it holds samples {}..{} of a {} spp render",
                 part.share.start, part.share.end, m.spp
             ))
+            .into());
+        }
+        let layers = unpacked.layers.iter().map(|(l, _)| *l);
+        if !layers.eq(crate::aov::Layer::ALL
+            .into_iter()
+            .filter(|&l| m.film.layers().has(l)))
+        {
+            return Err(malformed(
+                "its feature layers (AOVs) are not those its scene description asks for".into(),
+            )
             .into());
         }
         self.seen.push((part.tile, held, path.to_path_buf()));
@@ -419,8 +431,12 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         path: path.to_path_buf(),
         image: part.image,
     };
-    crate::memory::check(Film::bytes(w, h, false), "the film").map_err(|_| too_large())?;
-    let film = Film::try_new(w, h).ok_or_else(too_large)?;
+    let layers = crate::aov::Layers::for_aovs(&render.aovs);
+    let bytes = Film::bytes(w, h, false) + Film::layer_bytes(w, h, layers);
+    crate::memory::check(bytes, "the film").map_err(|_| too_large())?;
+    let film = Film::try_new(w, h)
+        .and_then(|f| f.try_with_layers(layers))
+        .ok_or_else(too_large)?;
     Ok(Merged {
         film,
         spp,
@@ -429,6 +445,7 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         tiles: Vec::new(),
         stats: RenderStats::default(),
         gamma: part.gamma,
+        aovs: render.aovs,
         renderer_id: part.renderer_id.clone(),
         description: part.description.clone(),
     })
@@ -448,6 +465,25 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
     use rayon::prelude::*;
     let tile = part.head.tile;
     let (x0, x1) = (tile.x0 as usize, tile.x1 as usize);
+    // The layers' counts are the image's: added into a scratch row.
+    let mut scratch = vec![0u32; (x1 - x0) * tile.height() as usize];
+    for (layer, pixels) in &part.layers {
+        scratch.fill(0);
+        let rows = (film.rows_mut())
+            .skip(tile.y0 as usize)
+            .take(tile.height() as usize)
+            .zip(scratch.par_chunks_mut((x1 - x0).max(1)))
+            .map(|(row, counts)| (&mut row.layer_sums[*layer as usize][x0..x1], counts));
+        pixels.add_rows(rows, None).map_err(|(y, e)| match e {
+            PixelError::Malformed(m) => m.to_string(),
+            PixelError::Pixel { x, message } => format!(
+                "pixel ({}, {}) of its {} layer {message}",
+                tile.x0 as usize + x,
+                tile.y0 as usize + y,
+                layer.name()
+            ),
+        })?;
+    }
     let rows = (film.rows_mut())
         .skip(tile.y0 as usize)
         .take(tile.height() as usize)

@@ -163,6 +163,10 @@ pub struct Settings {
     pub noise_target: Option<f32>,
     /// Display gamma.
     pub gamma: f32,
+    /// Feature buffers written beside the image (see [`crate::aov`]).
+    pub aovs: Vec<crate::aov::Aov>,
+    /// The sums of features the film keeps for them.
+    pub layers: crate::aov::Layers,
     /// Shadow-acne epsilon: how far along a ray leaving a surface that
     /// surface is not met again (0 when the scene gives none); see
     /// [`Scene::intersect_leaving`].
@@ -653,6 +657,8 @@ pub struct Overrides {
     pub light_selection: Option<LightSelection>,
     /// The noise target of adaptive sampling.
     pub noise_target: Option<f64>,
+    /// Feature buffers written beside the image, in place of the scene's.
+    pub aovs: Option<Vec<crate::aov::Aov>>,
     /// Lets every mesh object's files lie outside its folder, as
     /// `allow_outside = true` on each would.
     pub allow_outside: bool,
@@ -690,6 +696,9 @@ impl Overrides {
         }
         if let Some(t) = self.noise_target {
             r.noise_target = Some(t);
+        }
+        if let Some(aovs) = &self.aovs {
+            r.aovs.clone_from(aovs);
         }
         if self.allow_outside {
             for object in &mut desc.objects {

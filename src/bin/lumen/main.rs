@@ -311,6 +311,11 @@ struct SettingArgs {
     /// error is at most this (e.g. 0.01); --spp stays the upper bound.
     #[arg(long, value_name = "ERROR")]
     noise_target: Option<f64>,
+    /// Feature buffers to write beside the image, comma-separated: albedo,
+    /// normal, depth, position, variance, spp (layers of an EXR image,
+    /// NAME.AOV.pfm files beside any other).
+    #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
+    aov: Option<AovList>,
     /// Let mesh files read files outside their folder (glTF buffers and
     /// images, MTL files and maps), as `allow_outside = true` on every mesh
     /// object does, and a Mitsuba scene include files from outside its
@@ -359,6 +364,15 @@ struct ProgressiveArgs {
     time_limit: Option<Duration>,
 }
 
+/// The feature buffers of `--aov` (a type of its own: clap would read a
+/// `Vec` as an option given several times).
+#[derive(Clone, Debug)]
+struct AovList(Vec<lumen::aov::Aov>);
+
+fn parse_aovs(list: &str) -> Result<AovList, String> {
+    lumen::aov::Aov::parse_list(list).map(AovList)
+}
+
 impl SettingArgs {
     fn overrides(&self) -> Overrides {
         Overrides {
@@ -370,6 +384,7 @@ impl SettingArgs {
             integrator: self.integrator.map(Integrator::from),
             light_selection: self.light_selection.map(LightSelection::from),
             noise_target: self.noise_target,
+            aovs: self.aov.clone().map(|l| l.0),
             allow_outside: self.allow_outside,
         }
     }

@@ -28,7 +28,12 @@ pub(crate) fn merge_command(
     if merged.samples_held == 0 {
         bail!("the parts hold no samples yet: nothing to merge");
     }
-    output::write_image(out, &merged.film, gamma.unwrap_or(merged.gamma))?;
+    output::write_image(
+        out,
+        &merged.film,
+        gamma.unwrap_or(merged.gamma),
+        &merged.aovs,
+    )?;
     if merged.is_complete() {
         errln!(
             "merged {} part{} ({} spp) into {}",

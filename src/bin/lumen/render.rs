@@ -203,7 +203,7 @@ pub(crate) fn render_command(
         }
         let _saving = saving();
         if let Some(image) = image {
-            output::write_image(image, session.film(), s.gamma)?;
+            output::write_image(image, session.film(), s.gamma, &s.aovs)?;
         }
         if image.is_none() || !session.is_complete() {
             session

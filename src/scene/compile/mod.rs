@@ -1558,6 +1558,8 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         integrator: r.integrator,
         light_selection: r.light_selection,
         gamma: r.gamma as f32,
+        aovs: r.aovs.clone(),
+        layers: crate::aov::Layers::for_aovs(&r.aovs),
         epsilon: r.epsilon.map_or(0.0, |e| e as f32),
         offset: r.epsilon != Some(0.0),
         shading: r.shading,

@@ -283,6 +283,9 @@ pub struct RenderDesc {
     /// is four times it); ½ when absent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub filter_stddev: Option<f64>,
+    /// Feature buffers written beside the image (see [`crate::aov`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub aovs: Vec<crate::aov::Aov>,
 }
 
 /// A pixel filter (see [`crate::filter`]).
@@ -339,6 +342,7 @@ impl Default for RenderDesc {
             shading: ShadingDesc::Path,
             pixel_filter: PixelFilterDesc::Box,
             filter_stddev: None,
+            aovs: Vec::new(),
         }
     }
 }

@@ -554,6 +554,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "pixel_filter",
             "filter_stddev",
             "crop",
+            "aovs",
         ],
         &[],
     )?;
@@ -589,7 +590,33 @@ fn render(node: &Node) -> Result<RenderDesc> {
             .optional("pixel_filter", |n, p| keyword(n, p, PIXEL_FILTERS))?
             .unwrap_or(d.pixel_filter),
         filter_stddev: t.optional("filter_stddev", float)?,
+        aovs: t.optional("aovs", aovs)?.unwrap_or_default(),
     })
+}
+
+/// The feature buffers of `render.aovs`: an array of their names, each
+/// once, kept in [`Aov::ALL`](crate::aov::Aov::ALL)'s order.
+fn aovs(node: &Node, path: &str) -> Result<Vec<crate::aov::Aov>> {
+    use crate::aov::Aov;
+    let Value::Array(items) = &node.value else {
+        return Err(error(
+            path,
+            &node.span,
+            format!(
+                "expected an array of AOV names, got {}",
+                node.value.describe()
+            ),
+        ));
+    };
+    let options = Aov::ALL.map(|a| (a.name(), a));
+    let mut list = items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| keyword(item, &format!("{path}[{i}]"), &options))
+        .collect::<Result<Vec<_>>>()?;
+    list.sort();
+    list.dedup();
+    Ok(list)
 }
 
 const PIXEL_FILTERS: &[(&str, PixelFilterDesc)] = &[
