@@ -363,6 +363,7 @@ impl Checkpoint {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aov::Layer;
     use crate::film::Sum;
     use crate::scene::builtin;
 
@@ -404,6 +405,22 @@ mod tests {
         let back = Checkpoint::decode(&ckpt.encode(), p).unwrap();
         assert_eq!(back, ckpt);
         back.check_matches(&desc, p).unwrap();
+        // With feature layers (after the adaptive section when there is
+        // one, below).
+        let layered = |film: Film| {
+            let n = film.len();
+            let moment = (0..n).map(|i| Sum([i as i128, 0, -1])).collect();
+            film.with_layer(Layer::Albedo, vec![Sum([5, 6, 7]); n])
+                .and_then(|f| f.with_layer(Layer::Moment, moment))
+                .unwrap()
+        };
+        let with_layers = Checkpoint {
+            film: layered(ckpt.film.clone()),
+            ..ckpt.clone()
+        };
+        let decoded = Checkpoint::decode(&with_layers.encode(), p).unwrap();
+        assert_eq!(decoded, with_layers);
+        assert_ne!(decoded, ckpt, "the layers were read");
         // With adaptive sampling's flags too.
         let n = ckpt.film.len();
         let adaptive = Checkpoint {
@@ -417,6 +434,11 @@ mod tests {
         };
         let bytes = adaptive.encode();
         assert_eq!(Checkpoint::decode(&bytes, p).unwrap(), adaptive);
+        let both = Checkpoint {
+            film: layered(adaptive.film.clone()),
+            ..adaptive.clone()
+        };
+        assert_eq!(Checkpoint::decode(&both.encode(), p).unwrap(), both);
         // A flag other than 0 or 1 is refused, even with a valid checksum.
         let mut bad = Checkpoint::decode(&bytes, p).unwrap().encode();
         *bad.last_mut().unwrap() = 2;
