@@ -25,8 +25,9 @@
 //!
 //! Each is averaged over the pixel's samples, the beauty's own, so it is
 //! filtered as the image is; its sums are fixed-point like the image's
-//! ([`crate::film::Sum`]), so an image split into passes, threads, parts or
-//! resumed runs has bit-identical features.
+//! ([`crate::film::Sum`]; features to 2⁻³², within ±2³¹, see
+//! [`Sum::of_feature`](crate::film::Sum::of_feature)), so an image split
+//! into passes, threads, parts or resumed runs has bit-identical features.
 
 use crate::math::{Color, Vec3};
 

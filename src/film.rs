@@ -44,6 +44,17 @@ impl Sum {
         Some(Sum([fixed(c.x)?, fixed(c.y)?, fixed(c.z)?]))
     }
 
+    /// The fixed-point value of a feature (see [`crate::aov`]) to 2⁻³²: a
+    /// conversion of an instruction or so a channel, where
+    /// [`Sum::of_color`] keeps every bit of a colour at ten times the cost.
+    /// A channel beyond ±2³¹ saturates there; NaN is 0.
+    #[inline(always)]
+    pub fn of_feature(v: Vec3) -> Sum {
+        // Saturating, as `as` converts.
+        let fixed = |x: f32| i128::from((f64::from(x) * 4_294_967_296.0) as i64) << 32;
+        Sum([fixed(v.x), fixed(v.y), fixed(v.z)])
+    }
+
     /// This sum plus `other`, channel by channel.
     #[inline]
     pub fn plus(self, other: Sum) -> Sum {
@@ -174,8 +185,10 @@ impl RowMut<'_> {
     }
 
     /// [`RowMut::add`], and the sample's `features` to the layers the film
-    /// keeps when the sample is added. A feature beyond what a [`Sum`]
-    /// holds, or that would take its pixel's sum past it, counts as 0.
+    /// keeps when the sample is added: each feature to 2⁻³² and within
+    /// ±2³¹ ([`Sum::of_feature`]), the squared colour exactly. A squared
+    /// colour beyond what a [`Sum`] holds, or a value that would take its
+    /// pixel's sum past it, counts as 0.
     #[inline(always)]
     pub fn add_with(&mut self, x: usize, index: u32, c: Color, features: &Features) -> bool {
         if !self.add(x, index, c) {
@@ -184,7 +197,11 @@ impl RowMut<'_> {
         for layer in Layer::ALL {
             if self.layers.has(layer) {
                 let sum = &mut self.layer_sums[layer as usize][x];
-                let value = Sum::of_color(features.layer(layer, c));
+                let v = features.layer(layer, c);
+                let value = match layer {
+                    Layer::Moment => Sum::of_color(v),
+                    _ => Some(Sum::of_feature(v)),
+                };
                 if let Some(added) = value.and_then(|v| sum.checked_plus(v)) {
                     *sum = added;
                 }
