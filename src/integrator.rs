@@ -121,14 +121,17 @@ impl FeatureSearch {
         self.seeking = false;
     }
 
-    /// The first visible surface is at `point`, the end of a segment of
-    /// `length` (adding to those of the invisible ones crossed before).
+    /// The path's segment of `length` ends at `point`, on a surface that is
+    /// the first visible one if `visible` (the length then completes the
+    /// depth, adding to those of the invisible ones crossed before).
     #[cold]
     #[inline(never)]
-    fn placed(&mut self, point: Point3, length: f32) {
-        self.features.position = point;
+    fn placed(&mut self, point: Point3, length: f32, visible: bool) {
         self.features.depth += length;
-        self.placing = false;
+        if visible {
+            self.features.position = point;
+            self.placing = false;
+        }
     }
 }
 
@@ -280,10 +283,11 @@ fn bounce(
 ) -> Bounce {
     let done = |c| Bounce::Step(Step::Done(c));
     let Some(hit) = hit else {
+        let background = scene.background.color(ray.direction);
         if let Some(s) = search.filter(|s| s.seeking) {
-            s.seen(scene.background.color(ray.direction), Vec3::ZERO);
+            s.seen(background, Vec3::ZERO);
         }
-        let mut sky = path.throughput * scene.background.color(ray.direction);
+        let mut sky = path.throughput * background;
         if let Some((_, bsdf_pdf)) = path.sampled_from {
             sky *= power_heuristic(bsdf_pdf, scene.lights.environment_pdf(ray.direction));
         }
@@ -303,15 +307,17 @@ fn bounce(
     if material.emission.is_some() {
         path.radiance += emission(scene, &record, &hit, material, path);
     }
-    let mut search = search.filter(|s| s.seeking || s.placing);
-    if material.is_interface() {
-        if let Some(s) = search.filter(|s| s.placing) {
-            s.features.depth += hit.t * ray.direction.length();
-        }
-        return cross(ray, &record, hit, material, path);
-    }
+    let mut search = search;
     if let Some(s) = search.as_deref_mut().filter(|s| s.placing) {
-        s.placed(record.point, hit.t * ray.direction.length());
+        // Interfaces are invisible: their segments add to the depth.
+        s.placed(
+            record.point,
+            hit.t * ray.direction.length(),
+            !material.is_interface(),
+        );
+    }
+    if material.is_interface() {
+        return cross(ray, &record, hit, material, path);
     }
     let mut search = search.filter(|s| s.seeking);
     // The last segment's bounce could only start a ray that is never
@@ -669,12 +675,8 @@ pub fn trace_path_features(
         }
     }
     *rays += path.shadow_rays;
-    let features = if searching {
-        search.features
-    } else {
-        Features::default()
-    };
-    (colour.unwrap_or(path.radiance), features)
+    // Untouched (all 0) unless searched.
+    (colour.unwrap_or(path.radiance), search.features)
 }
 
 /// How many rounds of bounces [`trace_paths`] runs between looks at its

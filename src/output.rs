@@ -10,6 +10,7 @@
 
 use crate::aov::{Aov, Layer};
 use crate::film::Film;
+use crate::math::Vec3;
 use std::fs;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -177,24 +178,38 @@ pub fn aov_path(path: &Path, aov: Aov) -> PathBuf {
     path.with_file_name(format!("{stem}.{}.pfm", aov.name()))
 }
 
+/// Feature buffer `aov` of pixel `i` (row-major) of `film`: its channels
+/// (of [`Aov::channels`]) first.
+fn aov_pixel(film: &Film, aov: Aov, i: usize) -> Vec3 {
+    match aov {
+        Aov::Albedo => film.feature(Layer::Albedo, i),
+        Aov::Normal => film.feature(Layer::Normal, i),
+        Aov::Position => film.feature(Layer::Position, i),
+        Aov::Depth => film.feature(Layer::Depth, i),
+        Aov::Variance => film.variance(i),
+        Aov::Spp => Vec3::new(film.count(i) as f32, 0.0, 0.0),
+    }
+}
+
+/// The first `channels` channels of `value` over `n` pixels: a vector a
+/// channel, each pixel's value computed once.
+fn channel_vectors(n: usize, channels: usize, value: impl Fn(usize) -> Vec3) -> Vec<Vec<f32>> {
+    let mut out = vec![Vec::with_capacity(n); channels];
+    for i in 0..n {
+        let v = value(i);
+        for (c, channel) in out.iter_mut().enumerate() {
+            channel.push(v[c]);
+        }
+    }
+    out
+}
+
 /// Feature buffer `aov` of `film`: a vector of values a channel (of
 /// [`Aov::channels`]), each row-major, top row first.
 pub fn aov_values(film: &Film, aov: Aov) -> Vec<Vec<f32>> {
-    let n = film.len();
-    let vectors = |f: &dyn Fn(usize) -> crate::math::Vec3| {
-        let v: Vec<_> = (0..n).map(f).collect();
-        (0..3)
-            .map(|c| v.iter().map(|p| p[c]).collect())
-            .collect::<Vec<Vec<f32>>>()
-    };
-    match aov {
-        Aov::Albedo => vectors(&|i| film.feature(Layer::Albedo, i)),
-        Aov::Normal => vectors(&|i| film.feature(Layer::Normal, i)),
-        Aov::Position => vectors(&|i| film.feature(Layer::Position, i)),
-        Aov::Variance => vectors(&|i| film.variance(i)),
-        Aov::Depth => vec![(0..n).map(|i| film.feature(Layer::Depth, i).x).collect()],
-        Aov::Spp => vec![(0..n).map(|i| film.count(i) as f32).collect()],
-    }
+    channel_vectors(film.len(), aov.channels().len(), |i| {
+        aov_pixel(film, aov, i)
+    })
 }
 
 /// The film's image as channels `R`, `G`, `B` and its feature buffers as
@@ -203,8 +218,8 @@ fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), Outpu
     use exr::prelude::*;
     let (w, h) = (film.width() as usize, film.height() as usize);
     let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
-        let values = film.pixels().map(|p| p[c]).collect();
+    let rgb = channel_vectors(film.len(), 3, |i| film.mean(i));
+    for (name, values) in ["R", "G", "B"].into_iter().zip(rgb) {
         channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
     }
     for &aov in aovs {
@@ -213,14 +228,10 @@ fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), Outpu
             channels.push(AnyChannel::new(name.as_str(), FlatSamples::F32(values)));
         }
     }
-    let encoding = Encoding {
-        line_order: LineOrder::Increasing,
-        ..Encoding::default()
-    };
     let layer = Layer::new(
         (w, h),
         LayerAttributes::default(),
-        encoding,
+        exr_encoding(),
         AnyChannels::sort(channels),
     );
     write_atomic(path, |tmp| {
@@ -234,19 +245,37 @@ fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), Outpu
 /// Feature buffer `aov` of `film` as a PFM file: colour (`PF`) for three
 /// channels, grey (`Pf`) for one.
 pub fn encode_aov_pfm(film: &Film, aov: Aov) -> Vec<u8> {
+    let grey = aov.channels().len() == 1;
+    pfm(film, grey, |i| aov_pixel(film, aov, i))
+}
+
+/// A PFM file of `film`'s size, of `value` at each pixel (row-major
+/// index): its first channel if `grey`, else all three; little-endian,
+/// bottom row first.
+fn pfm(film: &Film, grey: bool, value: impl Fn(usize) -> Vec3) -> Vec<u8> {
     let (w, h) = (film.width() as usize, film.height() as usize);
-    let values = aov_values(film, aov);
-    let kind = if values.len() == 3 { "PF" } else { "Pf" };
+    let (kind, channels) = if grey { ("Pf", 1) } else { ("PF", 3) };
     let mut out = format!("{kind}\n{w} {h}\n-1.0\n").into_bytes();
-    out.reserve(w * h * 4 * values.len());
+    out.reserve(w * h * 4 * channels);
     for y in (0..h).rev() {
         for x in 0..w {
-            for channel in &values {
-                out.extend_from_slice(&channel[y * w + x].to_le_bytes());
+            let v = value(y * w + x);
+            for c in 0..channels {
+                out.extend_from_slice(&v[c].to_le_bytes());
             }
         }
     }
     out
+}
+
+/// How lumen writes EXR files: blocks in increasing order, so that they
+/// are also written in order (compressed in parallel) and the same image
+/// gives the same file.
+fn exr_encoding() -> exr::prelude::Encoding {
+    exr::prelude::Encoding {
+        line_order: exr::prelude::LineOrder::Increasing,
+        ..exr::prelude::Encoding::default()
+    }
 }
 
 /// Writes the film's image alone to `path` in `format`.
@@ -280,14 +309,7 @@ fn write_beauty(
                 let c = film.pixel(x as u32, y as u32);
                 (c.x, c.y, c.z)
             });
-            // Blocks are compressed in parallel; in increasing order they
-            // are also written in order, so the same image gives the same
-            // file.
-            let encoding = Encoding {
-                line_order: LineOrder::Increasing,
-                ..Encoding::default()
-            };
-            Image::from_encoded_channels((w as usize, h as usize), encoding, channels)
+            Image::from_encoded_channels((w as usize, h as usize), exr_encoding(), channels)
                 .write()
                 .to_file(tmp)
                 .map_err(|e| e.to_string())
@@ -310,16 +332,5 @@ pub fn encode_ppm(film: &Film, gamma: f32) -> Vec<u8> {
 
 /// Portable float map: linear RGB, little-endian, bottom row first.
 pub fn encode_pfm(film: &Film) -> Vec<u8> {
-    let (w, h) = (film.width(), film.height());
-    let mut out = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
-    out.reserve(w as usize * h as usize * 12);
-    for y in (0..h).rev() {
-        for x in 0..w {
-            let c = film.pixel(x, y);
-            for v in [c.x, c.y, c.z] {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
-        }
-    }
-    out
+    pfm(film, false, |i| film.mean(i))
 }
