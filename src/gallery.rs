@@ -23,6 +23,9 @@ pub enum GalleryError {
     /// A file could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// `--denoise` was asked for, and the denoiser failed.
+    #[error("--denoise: {0}")]
+    Denoise(#[from] crate::denoise::DenoiseError),
     /// The folder could not be created.
     #[error("{path}: cannot create the gallery folder: {message}")]
     Folder {
@@ -44,6 +47,9 @@ pub fn make_gallery(
         path: dir.display().to_string(),
         message: e.to_string(),
     })?;
+    if overrides.denoise {
+        crate::denoise::check_available()?;
+    }
     // Compile everything first so that a bad override fails before any render.
     let mut scenes = Vec::with_capacity(BUILTINS.len());
     for b in BUILTINS {
@@ -71,7 +77,19 @@ pub fn make_gallery(
         }
         let (film, stats) = render(scene, &|_| {});
         let file = format!("{}.png", b.name);
-        output::write_image(&dir.join(&file), &film, scene.settings.gamma, &[])?;
+        let path = dir.join(&file);
+        let gamma = scene.settings.gamma;
+        if scene.settings.denoise {
+            let clean = crate::denoise::denoise_film(&film, rayon::current_num_threads())?;
+            let beauty = output::Beauty::Colors {
+                width: film.width(),
+                height: film.height(),
+                colors: &clean,
+            };
+            output::write_image_as(&path, beauty, &film, gamma, &[])?;
+        } else {
+            output::write_image(&path, &film, gamma, &[])?;
+        }
         on_scene(b.name, stats);
         let _ = writeln!(
             html,

@@ -60,6 +60,7 @@ pub mod bench;
 pub mod bsdf;
 pub mod camera;
 pub mod checkpoint;
+pub mod denoise;
 pub mod distribution;
 pub mod files;
 pub mod film;

@@ -9,8 +9,8 @@
 //! it (`out.png` → `out.albedo.pfm`).
 
 use crate::aov::{Aov, Layer};
-use crate::film::Film;
-use crate::math::Vec3;
+use crate::film::{to_display, Film};
+use crate::math::{Color, Vec3};
 use std::fs;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -154,21 +154,109 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> 
     write_atomic(path, |tmp| fs::write(tmp, bytes).map_err(|e| e.to_string()))
 }
 
+/// The colours an image file shows: a film's means, or colours of a
+/// film's size computed from them (a denoised image).
+#[derive(Clone, Copy)]
+pub enum Beauty<'a> {
+    /// Each pixel's mean.
+    Film(&'a Film),
+    /// Given colours, row-major, top row first.
+    Colors {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// `width × height` colours.
+        colors: &'a [Color],
+    },
+}
+
+impl Beauty<'_> {
+    fn size(&self) -> (u32, u32) {
+        match self {
+            Beauty::Film(film) => (film.width(), film.height()),
+            Beauty::Colors { width, height, .. } => (*width, *height),
+        }
+    }
+
+    fn len(&self) -> usize {
+        let (w, h) = self.size();
+        w as usize * h as usize
+    }
+
+    /// Pixel `i`'s colour (row-major).
+    fn at(&self, i: usize) -> Color {
+        match self {
+            Beauty::Film(film) => film.mean(i),
+            Beauty::Colors { colors, .. } => colors[i],
+        }
+    }
+
+    /// 8-bit bytes, three a pixel, as [`Film::to_rgb8`] makes them.
+    fn rgb8(&self, gamma: f32) -> Vec<u8> {
+        match self {
+            Beauty::Film(film) => film.to_rgb8(gamma),
+            Beauty::Colors { colors, .. } => colors
+                .iter()
+                .flat_map(|c| [c.x, c.y, c.z])
+                .map(|v| (256.0 * to_display(v, gamma).clamp(0.0, 0.999)) as u8)
+                .collect(),
+        }
+    }
+}
+
 /// Writes the film to `path` in the format its extension names, with its
 /// feature buffers `aovs` (see the module's documentation).
 pub fn write_image(path: &Path, film: &Film, gamma: f32, aovs: &[Aov]) -> Result<(), OutputError> {
+    write_image_as(path, Beauty::Film(film), film, gamma, aovs)
+}
+
+/// [`write_image`], showing `beauty` (of the film's size) as its image.
+pub fn write_image_as(
+    path: &Path,
+    beauty: Beauty,
+    film: &Film,
+    gamma: f32,
+    aovs: &[Aov],
+) -> Result<(), OutputError> {
+    assert_eq!(
+        beauty.size(),
+        (film.width(), film.height()),
+        "an image of the film's size"
+    );
     let format = ImageFormat::from_path(path)?;
     if aovs.is_empty() {
-        return write_beauty(path, film, gamma, format);
+        return write_beauty(path, beauty, gamma, format);
     }
     if format == ImageFormat::Exr {
-        return write_layered_exr(path, film, aovs);
+        let mut channels = beauty_channels(beauty);
+        for &aov in aovs {
+            for (name, values) in aov.channels().iter().zip(aov_values(film, aov)) {
+                channels.push((format!("{}.{name}", aov.name()), values));
+            }
+        }
+        return write_exr(path, beauty.size(), channels);
     }
-    write_beauty(path, film, gamma, format)?;
+    write_beauty(path, beauty, gamma, format)?;
     for &aov in aovs {
         write_bytes_atomic(&aov_path(path, aov), &encode_aov_pfm(film, aov))?;
     }
     Ok(())
+}
+
+/// Writes `beauty` alone to `path`, in the format its extension names.
+pub fn write_colors(path: &Path, beauty: Beauty, gamma: f32) -> Result<(), OutputError> {
+    write_beauty(path, beauty, gamma, ImageFormat::from_path(path)?)
+}
+
+/// Where the noisy image of a denoised render written to `path` goes:
+/// `NAME.noisy.EXT` beside it.
+pub fn noisy_path(path: &Path) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    match path.extension() {
+        Some(ext) => path.with_file_name(format!("{stem}.noisy.{}", ext.to_string_lossy())),
+        None => path.with_file_name(format!("{stem}.noisy")),
+    }
 }
 
 /// Where feature buffer `aov` of an image written to `path` (not an EXR
@@ -212,24 +300,30 @@ pub fn aov_values(film: &Film, aov: Aov) -> Vec<Vec<f32>> {
     })
 }
 
-/// The film's image as channels `R`, `G`, `B` and its feature buffers as
-/// `NAME.C`, in one EXR file.
-fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), OutputError> {
+/// The image as channels `R`, `G`, `B`.
+fn beauty_channels(beauty: Beauty) -> Vec<(String, Vec<f32>)> {
+    let rgb = channel_vectors(beauty.len(), 3, |i| beauty.at(i));
+    ["R", "G", "B"]
+        .into_iter()
+        .map(String::from)
+        .zip(rgb)
+        .collect()
+}
+
+/// Named channels of `size` pixels (each row-major, top row first) as
+/// one EXR image of 32-bit floats, in the order EXR sorts them.
+pub fn write_exr(
+    path: &Path,
+    (w, h): (u32, u32),
+    channels: Vec<(String, Vec<f32>)>,
+) -> Result<(), OutputError> {
     use exr::prelude::*;
-    let (w, h) = (film.width() as usize, film.height() as usize);
-    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    let rgb = channel_vectors(film.len(), 3, |i| film.mean(i));
-    for (name, values) in ["R", "G", "B"].into_iter().zip(rgb) {
-        channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
-    }
-    for &aov in aovs {
-        for (name, values) in aov.channels().iter().zip(aov_values(film, aov)) {
-            let name = format!("{}.{name}", aov.name());
-            channels.push(AnyChannel::new(name.as_str(), FlatSamples::F32(values)));
-        }
-    }
+    let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::F32(values)))
+        .collect();
     let layer = Layer::new(
-        (w, h),
+        (w as usize, h as usize),
         LayerAttributes::default(),
         exr_encoding(),
         AnyChannels::sort(channels),
@@ -246,14 +340,16 @@ fn write_layered_exr(path: &Path, film: &Film, aovs: &[Aov]) -> Result<(), Outpu
 /// channels, grey (`Pf`) for one.
 pub fn encode_aov_pfm(film: &Film, aov: Aov) -> Vec<u8> {
     let grey = aov.channels().len() == 1;
-    pfm(film, grey, |i| aov_pixel(film, aov, i))
+    pfm((film.width(), film.height()), grey, |i| {
+        aov_pixel(film, aov, i)
+    })
 }
 
-/// A PFM file of `film`'s size, of `value` at each pixel (row-major
-/// index): its first channel if `grey`, else all three; little-endian,
-/// bottom row first.
-fn pfm(film: &Film, grey: bool, value: impl Fn(usize) -> Vec3) -> Vec<u8> {
-    let (w, h) = (film.width() as usize, film.height() as usize);
+/// A PFM file of `size`, of `value` at each pixel (row-major index): its
+/// first channel if `grey`, else all three; little-endian, bottom row
+/// first.
+fn pfm((w, h): (u32, u32), grey: bool, value: impl Fn(usize) -> Vec3) -> Vec<u8> {
+    let (w, h) = (w as usize, h as usize);
     let (kind, channels) = if grey { ("Pf", 1) } else { ("PF", 3) };
     let mut out = format!("{kind}\n{w} {h}\n-1.0\n").into_bytes();
     out.reserve(w * h * 4 * channels);
@@ -278,19 +374,19 @@ fn exr_encoding() -> exr::prelude::Encoding {
     }
 }
 
-/// Writes the film's image alone to `path` in `format`.
+/// Writes `beauty` alone to `path` in `format`.
 fn write_beauty(
     path: &Path,
-    film: &Film,
+    beauty: Beauty,
     gamma: f32,
     format: ImageFormat,
 ) -> Result<(), OutputError> {
-    let (w, h) = (film.width(), film.height());
+    let (w, h) = beauty.size();
     match format {
-        ImageFormat::Ppm => write_bytes_atomic(path, &encode_ppm(film, gamma)),
-        ImageFormat::Pfm => write_bytes_atomic(path, &encode_pfm(film)),
+        ImageFormat::Ppm => write_bytes_atomic(path, &ppm(beauty, gamma)),
+        ImageFormat::Pfm => write_bytes_atomic(path, &pfm((w, h), false, |i| beauty.at(i))),
         ImageFormat::Png => {
-            let rgb = film.to_rgb8(gamma);
+            let rgb = beauty.rgb8(gamma);
             write_atomic(path, |tmp| {
                 image::save_buffer_with_format(
                     tmp,
@@ -306,7 +402,7 @@ fn write_beauty(
         ImageFormat::Exr => write_atomic(path, |tmp| {
             use exr::prelude::*;
             let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-                let c = film.pixel(x as u32, y as u32);
+                let c = beauty.at(y * w as usize + x);
                 (c.x, c.y, c.z)
             });
             Image::from_encoded_channels((w as usize, h as usize), exr_encoding(), channels)
@@ -319,11 +415,16 @@ fn write_beauty(
 
 /// Plain-text P3 PPM: a header, then one "r g b" line a pixel, top row first.
 pub fn encode_ppm(film: &Film, gamma: f32) -> Vec<u8> {
+    ppm(Beauty::Film(film), gamma)
+}
+
+fn ppm(beauty: Beauty, gamma: f32) -> Vec<u8> {
     use std::fmt::Write as _;
     const IN_MEMORY: &str = "writing to a String cannot fail";
-    let bytes = film.to_rgb8(gamma);
+    let bytes = beauty.rgb8(gamma);
+    let (w, h) = beauty.size();
     let mut out = String::with_capacity(bytes.len() * 4 + 32);
-    writeln!(out, "P3\n{} {}\n255", film.width(), film.height()).expect(IN_MEMORY);
+    writeln!(out, "P3\n{w} {h}\n255").expect(IN_MEMORY);
     for p in bytes.chunks_exact(3) {
         writeln!(out, "{} {} {}", p[0], p[1], p[2]).expect(IN_MEMORY);
     }
@@ -332,5 +433,5 @@ pub fn encode_ppm(film: &Film, gamma: f32) -> Vec<u8> {
 
 /// Portable float map: linear RGB, little-endian, bottom row first.
 pub fn encode_pfm(film: &Film) -> Vec<u8> {
-    pfm(film, false, |i| film.mean(i))
+    pfm((film.width(), film.height()), false, |i| film.mean(i))
 }

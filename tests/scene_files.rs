@@ -158,6 +158,7 @@ fn overrides_replace_the_files_settings() {
         light_selection: Some(LightSelection::Uniform),
         noise_target: Some(0.25),
         aovs: Some(vec![lumen::aov::Aov::Normal, lumen::aov::Aov::Spp]),
+        denoise: true,
         allow_outside: false,
     };
     let s = file.compile(&o).unwrap().settings;
@@ -176,7 +177,16 @@ fn overrides_replace_the_files_settings() {
         (LightSelection::Power, LightSelection::Uniform)
     );
     assert_eq!(own.settings.aovs, []);
-    assert_eq!(s.aovs, [lumen::aov::Aov::Normal, lumen::aov::Aov::Spp]);
+    // Denoising keeps the albedo and normal it needs beside those asked for.
+    assert!(!own.settings.denoise && s.denoise);
+    assert_eq!(
+        s.aovs,
+        [
+            lumen::aov::Aov::Albedo,
+            lumen::aov::Aov::Normal,
+            lumen::aov::Aov::Spp
+        ]
+    );
 }
 
 /// `SceneDesc` also derives serde's `Deserialize` for library users; it must

@@ -160,6 +160,8 @@ pub struct Merged {
     pub gamma: f32,
     /// The feature buffers the render writes (see [`crate::aov`]).
     pub aovs: Vec<crate::aov::Aov>,
+    /// Whether the render's description asks for its image denoised.
+    pub denoise: bool,
     /// [`crate::checkpoint::RENDERER_ID`] of the lumen that rendered the
     /// parts.
     pub renderer_id: String,
@@ -431,7 +433,8 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         path: path.to_path_buf(),
         image: part.image,
     };
-    let layers = crate::aov::Layers::for_aovs(&render.aovs);
+    let aovs = render.written_aovs();
+    let layers = crate::aov::Layers::for_aovs(&aovs);
     let bytes = Film::bytes(w, h, false) + Film::layer_bytes(w, h, layers);
     crate::memory::check(bytes, "the film").map_err(|_| too_large())?;
     let film = Film::try_new(w, h)
@@ -445,7 +448,8 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         tiles: Vec::new(),
         stats: RenderStats::default(),
         gamma: part.gamma,
-        aovs: render.aovs,
+        aovs,
+        denoise: render.denoise,
         renderer_id: part.renderer_id.clone(),
         description: part.description.clone(),
     })

@@ -167,6 +167,8 @@ pub struct Settings {
     pub aovs: Vec<crate::aov::Aov>,
     /// The sums of features the film keeps for them.
     pub layers: crate::aov::Layers,
+    /// Whether the finished image is denoised (see [`crate::denoise`]).
+    pub denoise: bool,
     /// Shadow-acne epsilon: how far along a ray leaving a surface that
     /// surface is not met again (0 when the scene gives none); see
     /// [`Scene::intersect_leaving`].
@@ -659,6 +661,8 @@ pub struct Overrides {
     pub noise_target: Option<f64>,
     /// Feature buffers written beside the image, in place of the scene's.
     pub aovs: Option<Vec<crate::aov::Aov>>,
+    /// Denoise the finished image, whatever the scene says.
+    pub denoise: bool,
     /// Lets every mesh object's files lie outside its folder, as
     /// `allow_outside = true` on each would.
     pub allow_outside: bool,
@@ -699,6 +703,9 @@ impl Overrides {
         }
         if let Some(aovs) = &self.aovs {
             r.aovs.clone_from(aovs);
+        }
+        if self.denoise {
+            r.denoise = true;
         }
         if self.allow_outside {
             for object in &mut desc.objects {

@@ -88,6 +88,26 @@ enum Command {
         #[arg(long, value_parser = parse_gamma)]
         gamma: Option<f32>,
     },
+    /// Denoise an OpenEXR image that has albedo and normal layers (as
+    /// `render --aov albedo,normal` or `--denoise` writes them) with Open
+    /// Image Denoise: for split renders, merged first and denoised once.
+    /// See docs/denoising.md.
+    Denoise {
+        /// The noisy image: channels R, G, B, albedo.R/G/B and
+        /// normal.X/Y/Z.
+        input: PathBuf,
+        /// The denoised image; the extension chooses the format. An EXR
+        /// keeps the input's other channels.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Display gamma of a PNG or PPM output.
+        #[arg(long, default_value_t = 2.0, value_parser = parse_gamma)]
+        gamma: f32,
+        /// Threads of the denoiser (default: one per core); the output is
+        /// the same bits for the same input and number of threads.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
+        threads: Option<u32>,
+    },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
         #[command(subcommand)]
@@ -316,6 +336,12 @@ struct SettingArgs {
     /// NAME.AOV.pfm files beside any other).
     #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
     aov: Option<AovList>,
+    /// Denoise the finished image with Open Image Denoise (builds with the
+    /// `oidn` feature; see docs/denoising.md). The albedo and normal
+    /// buffers are kept and written, and the noisy image is written beside
+    /// it as NAME.noisy.EXT.
+    #[arg(long)]
+    denoise: bool,
     /// Let mesh files read files outside their folder (glTF buffers and
     /// images, MTL files and maps), as `allow_outside = true` on every mesh
     /// object does, and a Mitsuba scene include files from outside its
@@ -362,6 +388,10 @@ struct ProgressiveArgs {
     /// 2h) and write the image; --spp stays the upper bound.
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
     time_limit: Option<Duration>,
+    /// With --denoise (or `denoise = true` in the scene), denoise the
+    /// image saved after every pass too, not only the finished one.
+    #[arg(long)]
+    denoise_previews: bool,
 }
 
 /// The feature buffers of `--aov` (a type of its own: clap would read a
@@ -385,6 +415,7 @@ impl SettingArgs {
             light_selection: self.light_selection.map(LightSelection::from),
             noise_target: self.noise_target,
             aovs: self.aov.clone().map(|l| l.0),
+            denoise: self.denoise,
             allow_outside: self.allow_outside,
         }
     }
@@ -430,6 +461,7 @@ macro_rules! errln {
 }
 
 mod commands;
+mod denoise;
 mod merge;
 mod render;
 mod scenes;
@@ -518,6 +550,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             partial,
             gamma,
         } => merge::merge_command(&parts, &output, partial, gamma),
+        Command::Denoise {
+            input,
+            output,
+            gamma,
+            threads,
+        } => with_threads(threads, || denoise::denoise_command(&input, &output, gamma)),
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {

@@ -28,11 +28,17 @@ pub(crate) fn merge_command(
     if merged.samples_held == 0 {
         bail!("the parts hold no samples yet: nothing to merge");
     }
-    output::write_image(
+    // A partial merge is a preview: denoised only once complete.
+    let denoise = merged.denoise && merged.is_complete();
+    if denoise {
+        crate::denoise::announce()?;
+    }
+    crate::denoise::write_image(
         out,
         &merged.film,
         gamma.unwrap_or(merged.gamma),
         &merged.aovs,
+        denoise,
     )?;
     if merged.is_complete() {
         errln!(

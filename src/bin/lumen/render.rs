@@ -119,10 +119,26 @@ pub(crate) fn render_command(
             ckpt_path
         }
     };
-    let targets: Vec<&Path> = match image {
+    let denoise = scene.settings.denoise && image.is_some();
+    if scene.settings.denoise && image.is_none() {
+        errln!("lumen: note: a part is not denoised; `lumen merge` denoises the merged image");
+    } else if !denoise && prog.denoise_previews {
+        return Err(
+            Usage("--denoise-previews: the render is not denoised; add --denoise".into()).into(),
+        );
+    }
+    let noisy = output::noisy_path(out);
+    let mut targets: Vec<&Path> = match image {
         Some(image) => vec![image, &ckpt_path],
         None => vec![&ckpt_path],
     };
+    if denoise {
+        // Refused before the render, not after it: a build or a machine
+        // without the denoiser.
+        crate::denoise::announce()?;
+        output::check_writable(&noisy)?;
+        targets.push(&noisy);
+    }
     // Refuse unwritable destinations now, not after a long render.
     output::check_writable(out)?;
     if image.is_some() {
@@ -195,7 +211,9 @@ pub(crate) fn render_command(
     );
     // Saves the image, and the checkpoint unless the render is complete, as
     // one step that a second interrupt lets finish (see `signals`).
-    let save = |session: &Session| -> Result<()> {
+    // `last`: the render's final image (denoised, when asked), not a
+    // preview after a pass.
+    let save = |session: &Session, last: bool| -> Result<()> {
         // An image of nothing but dropped samples is black, and replacing the
         // file there with it would lose what it held for no image at all.
         if session.stats().all_dropped() {
@@ -203,7 +221,8 @@ pub(crate) fn render_command(
         }
         let _saving = saving();
         if let Some(image) = image {
-            output::write_image(image, session.film(), s.gamma, &s.aovs)?;
+            let denoised = denoise && (last || prog.denoise_previews);
+            crate::denoise::write_image(image, session.film(), s.gamma, &s.aovs, denoised)?;
         }
         if image.is_none() || !session.is_complete() {
             session
@@ -248,7 +267,7 @@ pub(crate) fn render_command(
             .checkpoint_interval
             .is_none_or(|every| last_save.elapsed() >= every);
         if !session.is_complete() && due {
-            save(session)?;
+            save(session, false)?;
             last_save = Instant::now();
         }
         Ok(())
@@ -267,7 +286,7 @@ pub(crate) fn render_command(
     }
     let code = match (run.reason, is_part) {
         (StopReason::Complete, true) => {
-            save(&session)?;
+            save(&session, true)?;
             errln!(
                 "{name}: {part_text} of {total} spp written to {}",
                 out.display()
@@ -275,7 +294,7 @@ pub(crate) fn render_command(
             ExitCode::SUCCESS
         }
         (StopReason::Complete, false) => {
-            save(&session)?;
+            save(&session, true)?;
             if let Err(e) = checkpoint::remove(&ckpt_path) {
                 errln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
             }
@@ -296,7 +315,7 @@ pub(crate) fn render_command(
             ExitCode::from(EXIT_INTERRUPTED)
         }
         (reason, _) => {
-            save(&session)?;
+            save(&session, true)?;
             let (why, code) = match reason {
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 // An unfinished part is not a finished task: a job engine

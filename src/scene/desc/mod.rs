@@ -286,6 +286,12 @@ pub struct RenderDesc {
     /// Feature buffers written beside the image (see [`crate::aov`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub aovs: Vec<crate::aov::Aov>,
+    /// Whether the finished image is denoised (see [`crate::denoise`]);
+    /// the film then keeps the albedo and normal buffers the denoiser
+    /// uses, and the image files carry them (see
+    /// [`RenderDesc::written_aovs`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub denoise: bool,
 }
 
 /// A pixel filter (see [`crate::filter`]).
@@ -304,6 +310,22 @@ fn is_box(f: &PixelFilterDesc) -> bool {
 }
 
 impl RenderDesc {
+    /// The feature buffers the render keeps and writes: `aovs`, with the
+    /// albedo and normal a denoised render needs, in
+    /// [`Aov::ALL`](crate::aov::Aov::ALL)'s order.
+    pub fn written_aovs(&self) -> Vec<crate::aov::Aov> {
+        use crate::aov::Aov;
+        let needed: &[Aov] = if self.denoise {
+            &[Aov::Albedo, Aov::Normal]
+        } else {
+            &[]
+        };
+        Aov::ALL
+            .into_iter()
+            .filter(|a| self.aovs.contains(a) || needed.contains(a))
+            .collect()
+    }
+
     /// The image's width and height: `height`, or else `width /
     /// aspect_ratio` rounded down (at least 1); `None` when they give no
     /// size (compiling the scene says why).
@@ -343,6 +365,7 @@ impl Default for RenderDesc {
             pixel_filter: PixelFilterDesc::Box,
             filter_stddev: None,
             aovs: Vec::new(),
+            denoise: false,
         }
     }
 }

@@ -555,6 +555,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "filter_stddev",
             "crop",
             "aovs",
+            "denoise",
         ],
         &[],
     )?;
@@ -591,6 +592,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             .unwrap_or(d.pixel_filter),
         filter_stddev: t.optional("filter_stddev", float)?,
         aovs: t.optional("aovs", aovs)?.unwrap_or_default(),
+        denoise: t.optional("denoise", boolean)?.unwrap_or(false),
     })
 }
 

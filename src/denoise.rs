@@ -1,0 +1,352 @@
+//! Denoising: a noisy image and its albedo and normal buffers
+//! ([`crate::aov`]) in, a clean image out, by Intel Open Image Denoise
+//! (OIDN).
+//!
+//! OIDN is a C++ library, so it is never part of the default build: the
+//! cargo feature `oidn` compiles [`oidn`], which loads the library when a
+//! denoise is first asked for (see `docs/denoising.md` for where it is
+//! looked for). A build without the feature, or a machine without the
+//! library, gets a [`DenoiseError`] saying what to do, never a crash.
+//!
+//! The filter is OIDN's `RT` in HDR mode, with its auxiliary images
+//! prefiltered first and then marked clean (`cleanAux`), OIDN's
+//! recommended use for final frames. It runs on the CPU device with a
+//! fixed number of threads, which makes its output the same bits for the
+//! same input on the same machine.
+
+// A foreign library's functions can only be called unsafely.
+#[cfg(feature = "oidn")]
+#[allow(unsafe_code)]
+pub mod oidn;
+
+use crate::aov::Layer;
+use crate::film::Film;
+use crate::math::{Color, Vec3};
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// What kept an image from being denoised.
+#[derive(Clone, Debug, Error)]
+pub enum DenoiseError {
+    /// This build has no denoiser.
+    #[error(
+        "this lumen was built without the denoiser; build it with \
+         `OIDN_DIR=/path/to/oidn cargo build --release --features oidn` \
+         (see docs/denoising.md)"
+    )]
+    NotBuilt,
+    /// The OIDN library was not found, or would not load.
+    #[error("cannot load Open Image Denoise: {}", .tried.iter().map(|(p, why)| format!("{}: {why}", p.display())).collect::<Vec<_>>().join("; "))]
+    NotFound {
+        /// Each file tried, with why it did not load.
+        tried: Vec<(PathBuf, String)>,
+    },
+    /// The library loaded, but it is not a version lumen can use.
+    #[error("{path}: {message}", path = .path.display())]
+    Incompatible {
+        /// The library's file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// OIDN reported an error.
+    #[error("Open Image Denoise: {0}")]
+    Oidn(String),
+    /// The image has no pixels, or buffers of different sizes.
+    #[error("{0}")]
+    BadInput(String),
+}
+
+/// An image to denoise: its linear colours and, when known, its albedo and
+/// shading normals, each row-major, top row first.
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a> {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// The noisy image (HDR, linear).
+    pub color: &'a [Color],
+    /// The albedo buffer, in [0, 1].
+    pub albedo: Option<&'a [Vec3]>,
+    /// The normal buffer (unit or zero vectors); only with an albedo.
+    pub normal: Option<&'a [Vec3]>,
+}
+
+impl Inputs<'_> {
+    fn check(&self) -> Result<(), DenoiseError> {
+        let n = self.width * self.height;
+        if n == 0 {
+            return Err(DenoiseError::BadInput("an image without pixels".into()));
+        }
+        let sizes = [Some(self.color), self.albedo, self.normal];
+        if sizes.iter().flatten().any(|b| b.len() != n) {
+            return Err(DenoiseError::BadInput(format!(
+                "buffers of a {}x{} image must hold {n} pixels each",
+                self.width, self.height
+            )));
+        }
+        if self.normal.is_some() && self.albedo.is_none() {
+            return Err(DenoiseError::BadInput(
+                "a normal buffer needs an albedo buffer beside it".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Whether this build has a denoiser and its library loads: asked before
+/// a render that ends in a denoise starts, so that a missing library is
+/// found out at once and not after hours of rendering. Returns the
+/// library's description (its path and version).
+pub fn check_available() -> Result<String, DenoiseError> {
+    #[cfg(feature = "oidn")]
+    {
+        oidn::Library::get().map(|lib| lib.describe())
+    }
+    #[cfg(not(feature = "oidn"))]
+    {
+        Err(DenoiseError::NotBuilt)
+    }
+}
+
+/// The denoised image of `inputs`, with `threads` threads. Its values are
+/// finite and non-negative.
+pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseError> {
+    inputs.check()?;
+    #[cfg(feature = "oidn")]
+    {
+        let mut out = oidn::Library::get()?.denoise(inputs, threads)?;
+        // The HDR filter can leave tiny negative values and, given
+        // values it cannot represent, NaN: neither belongs in an image.
+        for c in &mut out {
+            *c = Color::new(clean(c.x), clean(c.y), clean(c.z));
+        }
+        Ok(out)
+    }
+    #[cfg(not(feature = "oidn"))]
+    {
+        let _ = threads;
+        Err(DenoiseError::NotBuilt)
+    }
+}
+
+#[cfg(feature = "oidn")]
+fn clean(v: f32) -> f32 {
+    if v > 0.0 && v.is_finite() {
+        v
+    } else {
+        0.0
+    }
+}
+
+/// The film's image denoised, with its albedo and normal layers as the
+/// auxiliary images when it keeps them.
+pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseError> {
+    let layers = film.layers();
+    let layer = |l: Layer| -> Option<Vec<Vec3>> {
+        layers
+            .has(l)
+            .then(|| (0..film.len()).map(|i| film.feature(l, i)).collect())
+    };
+    let color = film.linear();
+    let albedo = layer(Layer::Albedo);
+    let normal = albedo.as_ref().and(layer(Layer::Normal));
+    denoise(
+        &Inputs {
+            width: film.width() as usize,
+            height: film.height() as usize,
+            color: &color,
+            albedo: albedo.as_deref(),
+            normal: normal.as_deref(),
+        },
+        threads,
+    )
+}
+
+/// What a file to denoise lacks or holds wrong.
+#[derive(Debug, Error)]
+pub enum ReadError {
+    /// The file cannot be read as an OpenEXR image.
+    #[error("{path}: cannot read it as an OpenEXR image: {message}", path = .path.display())]
+    Exr {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The image would not fit the memory there is.
+    #[error("{path}: {source}", path = .path.display())]
+    Memory {
+        /// The file.
+        path: PathBuf,
+        /// The refusal.
+        source: crate::memory::MemoryError,
+    },
+    /// Layers the denoiser needs are missing.
+    #[error(
+        "{path}: has no {missing} layer; its channels are {found}",
+        path = .path.display(),
+        found = .found.join(", ")
+    )]
+    MissingLayers {
+        /// The file.
+        path: PathBuf,
+        /// The layers missing, as channel names (`albedo.R, albedo.G, …`).
+        missing: String,
+        /// Every channel the file has.
+        found: Vec<String>,
+    },
+    /// Its layers are not all of one size, or subsampled.
+    #[error("{path}: {message}", path = .path.display())]
+    Layout {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// An OpenEXR image's channels, by their full names (`R`, `albedo.R`:
+/// the layer's name, a dot, the channel's), each as 32-bit floats,
+/// row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct ExrChannels {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// The channels, in the file's order.
+    pub channels: Vec<(String, Vec<f32>)>,
+}
+
+/// An image with the buffers that guide its denoising, each row-major.
+#[derive(Clone, Debug)]
+pub struct Guided {
+    /// The noisy image.
+    pub color: Vec<Color>,
+    /// Its albedo.
+    pub albedo: Vec<Vec3>,
+    /// Its shading normals.
+    pub normal: Vec<Vec3>,
+}
+
+/// The three channels of a layer the denoiser reads, as lumen writes them
+/// and as other renderers' names allow: the image's `R`, `G`, `B`; the
+/// albedo's `albedo.R`…; the normal's `normal.X`… or `normal.R`….
+const BEAUTY: [&[&str]; 1] = [&["R", "G", "B"]];
+const ALBEDO: [&[&str]; 1] = [&["albedo.R", "albedo.G", "albedo.B"]];
+const NORMAL: [&[&str]; 2] = [
+    &["normal.X", "normal.Y", "normal.Z"],
+    &["normal.R", "normal.G", "normal.B"],
+];
+
+impl ExrChannels {
+    /// Reads every channel of every layer of `path` (its full resolution),
+    /// after checking that they fit in memory. All layers must be of one
+    /// size.
+    pub fn read(path: &std::path::Path) -> Result<ExrChannels, ReadError> {
+        let exr_error = |e: exr::error::Error| ReadError::Exr {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let layout = |message: String| ReadError::Layout {
+            path: path.to_path_buf(),
+            message,
+        };
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(exr_error)?;
+        let bytes: u64 = meta
+            .headers
+            .iter()
+            .map(|h| h.layer_size.area() as u64 * h.channels.list.len() as u64 * 4)
+            .sum();
+        crate::memory::check(bytes, "the image's channels").map_err(|source| {
+            ReadError::Memory {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
+        let image = exr::prelude::read_all_flat_layers_from_file(path).map_err(exr_error)?;
+        let mut size = None;
+        let mut channels = Vec::new();
+        for layer in &image.layer_data {
+            let (w, h) = (layer.size.x(), layer.size.y());
+            if *size.get_or_insert((w, h)) != (w, h) {
+                return Err(layout(format!(
+                    "its layers are of different sizes ({}x{} and {w}x{h})",
+                    size.unwrap_or_default().0,
+                    size.unwrap_or_default().1
+                )));
+            }
+            let prefix = layer
+                .attributes
+                .layer_name
+                .as_ref()
+                .map_or(String::new(), |n| format!("{n}."));
+            for channel in &layer.channel_data.list {
+                let name = format!("{prefix}{}", channel.name);
+                let values: Vec<f32> = match &channel.sample_data {
+                    exr::prelude::FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+                    exr::prelude::FlatSamples::F32(v) => v.clone(),
+                    exr::prelude::FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+                };
+                if values.len() != w * h {
+                    return Err(layout(format!(
+                        "channel {name} is subsampled, which the denoiser cannot read"
+                    )));
+                }
+                channels.push((name, values));
+            }
+        }
+        let (width, height) = size.unwrap_or_default();
+        Ok(ExrChannels {
+            width,
+            height,
+            channels,
+        })
+    }
+
+    /// The names of its channels.
+    pub fn names(&self) -> Vec<String> {
+        self.channels.iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// The layer named by one of `spellings` (three channel names each,
+    /// matched without regard to case), as vectors.
+    fn layer(&self, spellings: &[&[&str]]) -> Option<Vec<Vec3>> {
+        let find = |name: &str| {
+            self.channels
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(name))
+                .map(|(_, v)| v)
+        };
+        spellings.iter().find_map(|names| {
+            let [x, y, z] = [find(names[0])?, find(names[1])?, find(names[2])?];
+            Some((0..x.len()).map(|i| Vec3::new(x[i], y[i], z[i])).collect())
+        })
+    }
+
+    /// The image and its albedo and normal, as the denoiser takes them;
+    /// refused, naming the channels found, when any is missing.
+    pub fn denoiser_layers(&self, path: &std::path::Path) -> Result<Guided, ReadError> {
+        let missing = |what: &str| ReadError::MissingLayers {
+            path: path.to_path_buf(),
+            missing: what.to_string(),
+            found: self.names(),
+        };
+        let beauty = self
+            .layer(&BEAUTY)
+            .ok_or_else(|| missing("image (R, G, B)"))?;
+        let albedo = self
+            .layer(&ALBEDO)
+            .ok_or_else(|| missing("albedo (albedo.R, albedo.G, albedo.B)"))?;
+        let normal = self
+            .layer(&NORMAL)
+            .ok_or_else(|| missing("normal (normal.X, normal.Y, normal.Z)"))?;
+        Ok(Guided {
+            color: beauty,
+            albedo,
+            normal,
+        })
+    }
+}

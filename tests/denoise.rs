@@ -1,0 +1,180 @@
+//! Denoising with Open Image Denoise (the `oidn` feature): run by `.ci/run`
+//! with `OIDN_DIR` pointing at the library.
+#![cfg(feature = "oidn")]
+
+use lumen::denoise::{self, Inputs};
+use lumen::math::{Color, Vec3};
+use lumen::rng::Rng;
+
+/// A 64×64 image of two flat halves (0.2 and 0.8 grey), each sample of a
+/// pixel's mean drawn with a noise of standard deviation `sigma`, with its
+/// exact albedo and normal.
+fn noisy(sigma: f32, seed: u64) -> (Vec<Color>, Vec<Color>, Vec<Vec3>, Vec<Vec3>) {
+    let (w, h) = (64, 64);
+    let mut rng = Rng::new(seed);
+    let mut clean = Vec::new();
+    let mut color = Vec::new();
+    for _ in 0..h {
+        for x in 0..w {
+            let v = if x < w / 2 { 0.2 } else { 0.8 };
+            clean.push(Color::splat(v));
+            // A mean of uniform noise: zero mean, variance σ².
+            let n = (rng.next_f32() - 0.5) * sigma * 12f32.sqrt();
+            color.push(Color::splat((v + n).max(0.0)));
+        }
+    }
+    let albedo = clean.clone();
+    let normal = vec![Vec3::Z; w * h];
+    (clean, color, albedo, normal)
+}
+
+fn mse(a: &[Color], b: &[Color]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| f64::from((*a - *b).length_squared()) / 3.0)
+        .sum::<f64>()
+        / a.len() as f64
+}
+
+#[test]
+fn a_noisy_image_comes_out_closer_to_the_clean_one_with_its_mean_kept() {
+    let (clean, color, albedo, normal) = noisy(0.1, 7);
+    let out = denoise::denoise(
+        &Inputs {
+            width: 64,
+            height: 64,
+            color: &color,
+            albedo: Some(&albedo),
+            normal: Some(&normal),
+        },
+        2,
+    )
+    .expect("OIDN runs");
+    assert_eq!(out.len(), color.len());
+    assert!(out.iter().all(|c| c.min_element() >= 0.0 && c.is_finite()));
+    let (before, after) = (mse(&color, &clean), mse(&out, &clean));
+    assert!(
+        after < before / 10.0,
+        "error {before} before, {after} after"
+    );
+    let mean = |v: &[Color]| v.iter().map(|c| f64::from(c.x)).sum::<f64>() / v.len() as f64;
+    let (m, m0) = (mean(&out), mean(&clean));
+    assert!((m / m0 - 1.0).abs() < 0.01, "mean {m} against {m0}");
+}
+
+#[test]
+fn the_same_input_gives_the_same_bits() {
+    let (_, color, albedo, normal) = noisy(0.2, 3);
+    let run = |threads| {
+        denoise::denoise(
+            &Inputs {
+                width: 64,
+                height: 64,
+                color: &color,
+                albedo: Some(&albedo),
+                normal: Some(&normal),
+            },
+            threads,
+        )
+        .expect("OIDN runs")
+    };
+    let first = run(2);
+    assert!(first == run(2), "two runs on 2 threads differ");
+}
+
+#[test]
+fn an_image_alone_is_denoised_too() {
+    let (clean, color, _, _) = noisy(0.1, 11);
+    let out = denoise::denoise(
+        &Inputs {
+            width: 64,
+            height: 64,
+            color: &color,
+            albedo: None,
+            normal: None,
+        },
+        2,
+    )
+    .expect("OIDN runs");
+    assert!(mse(&out, &clean) < mse(&color, &clean) / 4.0);
+}
+
+#[test]
+fn buffers_of_the_wrong_size_are_refused() {
+    let (_, color, albedo, _) = noisy(0.1, 1);
+    let e = denoise::denoise(
+        &Inputs {
+            width: 64,
+            height: 64,
+            color: &color,
+            albedo: Some(&albedo[1..]),
+            normal: None,
+        },
+        2,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("4096 pixels"), "{e}");
+}
+
+mod library {
+    use lumen::denoise::oidn::{Library, FILE_NAME};
+    use std::path::{Path, PathBuf};
+
+    fn dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("lumen-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("lib")).unwrap();
+        dir
+    }
+
+    fn refusal(dir: &Path) -> String {
+        let Err(e) = Library::open(Some(dir.to_path_buf())) else {
+            panic!("{} holds no OIDN library", dir.display())
+        };
+        std::fs::remove_dir_all(dir).unwrap();
+        e.to_string()
+    }
+
+    #[test]
+    fn a_directory_without_the_library_names_each_file_tried() {
+        let dir = dir("no-oidn");
+        let lib = dir.join("lib").join(FILE_NAME).display().to_string();
+        let text = refusal(&dir);
+        assert!(text.contains(&format!("{lib}: no such file")), "{text}");
+    }
+
+    #[test]
+    fn a_file_that_is_not_a_library_is_refused_with_the_loaders_reason() {
+        let dir = dir("bad-oidn");
+        std::fs::write(dir.join("lib").join(FILE_NAME), b"not a library").unwrap();
+        let text = refusal(&dir);
+        assert!(text.starts_with("cannot load Open Image Denoise"), "{text}");
+        assert!(text.contains(FILE_NAME), "{text}");
+    }
+
+    #[test]
+    fn a_library_without_oidns_functions_is_refused_as_incompatible() {
+        // A shared library of the system's that is not OIDN.
+        let other = [
+            "/lib/x86_64-linux-gnu/libm.so.6",
+            "/usr/lib/x86_64-linux-gnu/libm.so.6",
+        ]
+        .into_iter()
+        .find(|p| Path::new(p).exists())
+        .expect("the C library's libm");
+        let dir = dir("other-oidn");
+        std::fs::copy(other, dir.join("lib").join(FILE_NAME)).unwrap();
+        let text = refusal(&dir);
+        assert!(text.contains("has no function oidnNewDevice"), "{text}");
+    }
+
+    #[test]
+    fn the_library_of_oidn_dir_is_version_2() {
+        let lib = Library::get().expect("OIDN_DIR names a library");
+        assert!(
+            lib.describe().starts_with("Open Image Denoise 2."),
+            "{}",
+            lib.describe()
+        );
+    }
+}

@@ -1,0 +1,219 @@
+//! `render --denoise` and `lumen denoise` from the command line: in every
+//! build, what is refused; with the `oidn` feature (`.ci/run` builds it,
+//! with `OIDN_DIR` set), what they write.
+
+mod lumen_process;
+
+use lumen_process::*;
+use std::path::Path;
+
+const SMALL: &[&str] = &[
+    "render",
+    "cornell-box",
+    "--width",
+    "48",
+    "--spp",
+    "8",
+    "--threads",
+    "2",
+];
+
+/// A render to `out` of [`SMALL`] with `extra` arguments, which must succeed.
+fn render(out: &Path, extra: &[&str]) {
+    let (status, err) = run(SMALL, out, extra);
+    assert!(status.success(), "{err}");
+}
+
+#[test]
+fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
+    let dir = temp_dir("denoise-layers");
+    let noisy = dir.join("noisy.exr");
+    render(&noisy, &["--aov", "depth"]);
+    let out = dir.join("clean.exr");
+    let o = lumen_output(&[
+        "denoise",
+        noisy.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(
+        &o,
+        &[
+            "noisy.exr",
+            "has no albedo (albedo.R, albedo.G, albedo.B) layer",
+            "its channels are B, G, R, depth.Z",
+        ],
+    );
+    assert!(!out.exists());
+    // A file that is not an EXR image.
+    std::fs::write(dir.join("text.exr"), "not an image").unwrap();
+    let o = lumen_output(&[
+        "denoise",
+        dir.join("text.exr").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["text.exr", "cannot read it as an OpenEXR image"]);
+    // Its own input is not replaced.
+    let o = lumen_output(&[
+        "denoise",
+        noisy.to_str().unwrap(),
+        "-o",
+        noisy.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["cannot replace its input"]);
+}
+
+#[test]
+fn denoised_previews_need_a_denoised_render() {
+    let dir = temp_dir("denoise-previews");
+    let (status, err) = run(SMALL, &dir.join("out.png"), &["--denoise-previews"]);
+    assert_eq!(status.code(), Some(2), "{err}");
+    assert!(err.contains("add --denoise"), "{err}");
+    assert!(!dir.join("out.png").exists());
+}
+
+#[test]
+fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
+    use lumen::aov::Aov;
+    let dir = temp_dir("denoise-toml");
+    let path = dir.join("s.toml");
+    std::fs::write(&path, "[render]\ndenoise = true\naovs = [\"depth\"]\n").unwrap();
+    let file = lumen::scene::file::SceneFile::read(&path).unwrap();
+    assert!(file.desc.render.denoise);
+    assert_eq!(
+        file.desc.render.written_aovs(),
+        [Aov::Albedo, Aov::Normal, Aov::Depth]
+    );
+    std::fs::write(&path, "[render]\ndenoise = 1\n").unwrap();
+    let err = lumen::scene::file::SceneFile::read(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("s.toml:2:") && err.contains("render.denoise"),
+        "{err}"
+    );
+}
+
+#[cfg(not(feature = "oidn"))]
+#[test]
+fn a_build_without_the_denoiser_says_how_to_get_one_before_rendering() {
+    let dir = temp_dir("denoise-none");
+    let out = dir.join("out.exr");
+    let (status, err) = run(SMALL, &out, &["--denoise"]);
+    assert_eq!(status.code(), Some(1), "{err}");
+    assert!(err.contains("built without the denoiser"), "{err}");
+    assert!(err.contains("--features oidn"), "{err}");
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "nothing is written"
+    );
+    // `lumen denoise` on a good file says the same.
+    let noisy = dir.join("noisy.exr");
+    render(&noisy, &["--aov", "albedo,normal"]);
+    let o = lumen_output(&[
+        "denoise",
+        noisy.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["built without the denoiser"]);
+    assert!(!out.exists());
+}
+
+#[cfg(feature = "oidn")]
+mod with_oidn {
+    use super::*;
+
+    fn rgb(path: &Path) -> Vec<[f32; 3]> {
+        exr_rgb(path)
+    }
+
+    #[test]
+    fn a_denoised_render_keeps_its_noisy_image_and_is_reproduced_by_lumen_denoise() {
+        let dir = temp_dir("denoise-render");
+        let out = dir.join("out.exr");
+        render(&out, &["--denoise"]);
+        render(&dir.join("plain.exr"), &[]);
+        // The noisy image is the render without --denoise.
+        let noisy = output_noisy(&out);
+        assert_eq!(rgb(&noisy), rgb(&dir.join("plain.exr")));
+        let clean = rgb(&out);
+        assert_ne!(clean, rgb(&noisy));
+        assert!(clean.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+        let exr = std::fs::read(&out).unwrap();
+        for name in ["albedo.R", "normal.Z"] {
+            assert!(
+                exr.windows(name.len()).any(|w| w == name.as_bytes()),
+                "no {name}"
+            );
+        }
+        // The same input gives the same bits, from the render or from its
+        // noisy image.
+        let again = dir.join("again.exr");
+        let o = lumen_output(&[
+            "denoise",
+            noisy.to_str().unwrap(),
+            "-o",
+            again.to_str().unwrap(),
+            "--threads",
+            "2",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert_eq!(std::fs::read(&again).unwrap(), exr);
+        render(&dir.join("second.exr"), &["--denoise"]);
+        assert_eq!(std::fs::read(dir.join("second.exr")).unwrap(), exr);
+        // Another format: the denoised image, the noisy one, the buffers.
+        render(&dir.join("out.png"), &["--denoise"]);
+        for f in [
+            "out.png",
+            "out.noisy.png",
+            "out.albedo.pfm",
+            "out.normal.pfm",
+        ] {
+            assert!(dir.join(f).exists(), "{f}");
+        }
+        assert!(!dir.join("out.noisy.albedo.pfm").exists());
+    }
+
+    fn output_noisy(out: &Path) -> std::path::PathBuf {
+        lumen::output::noisy_path(out)
+    }
+
+    #[test]
+    fn a_missing_library_is_refused_before_rendering_naming_the_files_tried() {
+        let dir = temp_dir("denoise-missing");
+        let empty = dir.join("oidn");
+        std::fs::create_dir_all(&empty).unwrap();
+        let out = dir.join("out.exr");
+        let o = lumen()
+            .args(SMALL)
+            .args(["--denoise", "-o"])
+            .arg(&out)
+            .env("OIDN_DIR", &empty)
+            .output()
+            .unwrap();
+        assert_refused(
+            &o,
+            &[
+                "--denoise: cannot load Open Image Denoise",
+                "oidn/lib/libOpenImageDenoise",
+                "no such file",
+            ],
+        );
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, ["oidn"], "nothing is written");
+    }
+}
+
+/// The R, G, B channels of an EXR file.
+#[cfg(feature = "oidn")]
+fn exr_rgb(path: &Path) -> Vec<[f32; 3]> {
+    let image = lumen::denoise::ExrChannels::read(path).unwrap();
+    let channel = |name: &str| &image.channels.iter().find(|(n, _)| n == name).unwrap().1;
+    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
+    (0..r.len()).map(|i| [r[i], g[i], b[i]]).collect()
+}
