@@ -83,6 +83,7 @@ pub mod mesh;
 pub mod output;
 pub mod part;
 pub mod phase;
+pub mod preview;
 pub mod progressive;
 pub mod ray;
 pub mod render;

@@ -8,6 +8,7 @@ use lumen::aov::Aov;
 use lumen::denoise::{self, ExrChannels, Inputs};
 use lumen::film::Film;
 use lumen::lock::RenderLock;
+use lumen::math::Color;
 use lumen::output::{self, Beauty, ImageFormat};
 use std::path::Path;
 use std::process::ExitCode;
@@ -23,17 +24,17 @@ pub(crate) fn announce() -> Result<()> {
 /// Writes the film to `out` with its feature buffers; when `denoise`, the
 /// image denoised, and the noisy one beside it (see
 /// [`output::noisy_path`]), written first so that a failed denoise loses
-/// nothing.
+/// nothing. Returns the denoised image, if it made one.
 pub(crate) fn write_image(
     out: &Path,
     film: &Film,
     gamma: f32,
     aovs: &[Aov],
     denoise: bool,
-) -> Result<()> {
+) -> Result<Option<Vec<Color>>> {
     if !denoise {
         output::write_image(out, film, gamma, aovs)?;
-        return Ok(());
+        return Ok(None);
     }
     let noisy = output::noisy_path(out);
     // Another format's feature buffers are files of their own, written
@@ -61,7 +62,7 @@ pub(crate) fn write_image(
         start.elapsed().as_secs_f64(),
         noisy.display()
     );
-    Ok(())
+    Ok(Some(clean))
 }
 
 /// `lumen denoise IN.exr -o OUT`: the image of `input` denoised with its

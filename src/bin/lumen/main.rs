@@ -392,6 +392,14 @@ struct ProgressiveArgs {
     /// image saved after every pass too, not only the finished one.
     #[arg(long)]
     denoise_previews: bool,
+    /// Serve the image so far on a local web page (http://127.0.0.1:PORT,
+    /// printed at start), updated after every pass: docs/preview.md.
+    #[arg(long)]
+    preview: bool,
+    /// The port of --preview's page (a port in use is refused) [default:
+    /// a free one].
+    #[arg(long, value_name = "PORT", requires = "preview")]
+    preview_port: Option<u16>,
 }
 
 /// The feature buffers of `--aov` (a type of its own: clap would read a

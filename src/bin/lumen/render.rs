@@ -6,7 +6,9 @@ use crate::{progress_bar, summary, ProgressiveArgs, SettingArgs, Usage};
 use anyhow::{bail, Context, Result};
 use lumen::checkpoint::{self, Checkpoint, Existing};
 use lumen::lock::RenderLock;
+use lumen::math::Color;
 use lumen::part::{self, Share};
+use lumen::preview::{Preview, Status};
 use lumen::progressive::{Session, StopReason};
 use lumen::{files, output};
 use std::path::{Path, PathBuf};
@@ -175,6 +177,16 @@ pub(crate) fn render_command(
         session
     };
 
+    // Started once everything else is checked: a port in use is refused
+    // before any sample is taken.
+    let preview = match prog.preview {
+        true => {
+            let preview = Preview::start(prog.preview_port.unwrap_or(0))?;
+            errln!("preview: {}", preview.url());
+            Some(preview)
+        }
+        false => None,
+    };
     let stop = Arc::new(AtomicBool::new(false));
     install_stop_handler(&stop, &targets)?;
 
@@ -213,16 +225,18 @@ pub(crate) fn render_command(
     // one step that a second interrupt lets finish (see `signals`).
     // `last`: the render's final image (denoised, when asked), not a
     // preview after a pass.
-    let save = |session: &Session, last: bool| -> Result<()> {
+    // Returns the denoised image when it made one.
+    let save = |session: &Session, last: bool| -> Result<Option<Vec<Color>>> {
         // An image of nothing but dropped samples is black, and replacing the
         // file there with it would lose what it held for no image at all.
         if session.stats().all_dropped() {
-            return Ok(());
+            return Ok(None);
         }
         let _saving = saving();
+        let mut denoised = None;
         if let Some(image) = image {
-            let denoised = denoise && (last || prog.denoise_previews);
-            crate::denoise::write_image(image, session.film(), s.gamma, &s.aovs, denoised)?;
+            let now = denoise && (last || prog.denoise_previews);
+            denoised = crate::denoise::write_image(image, session.film(), s.gamma, &s.aovs, now)?;
         }
         if image.is_none() || !session.is_complete() {
             session
@@ -234,7 +248,20 @@ pub(crate) fn render_command(
                 })?;
         }
         quit_if_asked();
-        Ok(())
+        Ok(denoised)
+    };
+    // The page's status after a pass: the ETA from this run's pace.
+    let status = |session: &Session, pass: u32, elapsed: std::time::Duration| {
+        let done = session.spp_done() - resumed_from;
+        let left = session.spp_total() - session.spp_done();
+        Status {
+            pass,
+            spp_done: session.spp_done(),
+            spp_total: session.spp_total(),
+            elapsed: elapsed.as_secs_f64(),
+            eta: (done > 0).then(|| elapsed.as_secs_f64() * f64::from(left) / f64::from(done)),
+            gamma: s.gamma,
+        }
     };
     let pixels = tile.area();
     let bar = progress_bar(pixels * u64::from(samples.end - resumed_from));
@@ -266,14 +293,21 @@ pub(crate) fn render_command(
         let due = prog
             .checkpoint_interval
             .is_none_or(|every| last_save.elapsed() >= every);
+        let mut denoised = None;
         if !session.is_complete() && due {
-            save(session, false)?;
+            denoised = save(session, false)?;
             last_save = Instant::now();
+        }
+        if let Some(preview) = &preview {
+            let status = status(session, pass.number, start.elapsed());
+            let film = session.film();
+            preview.publish(status, film, &s.aovs, denoised.as_deref(), false);
         }
         Ok(())
     })?;
     let elapsed = start.elapsed();
     bar.finish_and_clear();
+    let mut last_denoised = None;
     let (held, total) = (session.spp_done(), session.spp_total());
     if session.stats().all_dropped() {
         errln!("{}", summary(&run.stats, &session.stats(), elapsed));
@@ -286,7 +320,7 @@ pub(crate) fn render_command(
     }
     let code = match (run.reason, is_part) {
         (StopReason::Complete, true) => {
-            save(&session, true)?;
+            last_denoised = save(&session, true)?;
             errln!(
                 "{name}: {part_text} of {total} spp written to {}",
                 out.display()
@@ -294,7 +328,7 @@ pub(crate) fn render_command(
             ExitCode::SUCCESS
         }
         (StopReason::Complete, false) => {
-            save(&session, true)?;
+            last_denoised = save(&session, true)?;
             if let Err(e) = checkpoint::remove(&ckpt_path) {
                 errln!("lumen: warning: cannot remove {}: {e}", ckpt_path.display())
             }
@@ -315,7 +349,7 @@ pub(crate) fn render_command(
             ExitCode::from(EXIT_INTERRUPTED)
         }
         (reason, _) => {
-            save(&session, true)?;
+            last_denoised = save(&session, true)?;
             let (why, code) = match reason {
                 StopReason::Interrupted => ("interrupted", ExitCode::from(EXIT_INTERRUPTED)),
                 // An unfinished part is not a finished task: a job engine
@@ -341,6 +375,12 @@ pub(crate) fn render_command(
             code
         }
     };
+    if let Some(preview) = &preview {
+        let status = status(&session, run.passes, elapsed);
+        let film = session.film();
+        preview.publish(status, film, &s.aovs, last_denoised.as_deref(), true);
+        preview.finish();
+    }
     errln!("{}", summary(&run.stats, &session.stats(), elapsed));
     let all = session.stats();
     if let Some(warning) = all.dropped_warning() {
