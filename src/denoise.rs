@@ -36,7 +36,11 @@ pub enum DenoiseError {
     )]
     NotBuilt,
     /// The OIDN library was not found, or would not load.
-    #[error("cannot load Open Image Denoise: {}", .tried.iter().map(|(p, why)| format!("{}: {why}", p.display())).collect::<Vec<_>>().join("; "))]
+    #[error(
+        "cannot load Open Image Denoise: {}; OIDN_DIR names the folder whose lib/ holds it \
+         (see docs/denoising.md)",
+        .tried.iter().map(|(p, why)| format!("{}: {why}", p.display())).collect::<Vec<_>>().join("; ")
+    )]
     NotFound {
         /// Each file tried, with why it did not load.
         tried: Vec<(PathBuf, String)>,

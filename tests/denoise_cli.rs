@@ -176,6 +176,30 @@ mod with_oidn {
         assert!(!dir.join("out.noisy.albedo.pfm").exists());
     }
 
+    #[test]
+    fn a_render_resumed_with_denoise_it_was_not_started_with_is_refused_naming_it() {
+        let dir = temp_dir("denoise-resume");
+        let out = dir.join("out.pfm");
+        make_checkpoint(&out, 2);
+        let args = [
+            "render",
+            "cover",
+            "--width",
+            "48",
+            "--spp",
+            "16",
+            "--resume",
+            "--denoise",
+        ];
+        let (status, err) = run(&args, &out, &[]);
+        assert_eq!(status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("denoise unset in the checkpoint, true here"),
+            "{err}"
+        );
+        assert!(!out.exists(), "nothing is written");
+    }
+
     fn output_noisy(out: &Path) -> std::path::PathBuf {
         lumen::output::noisy_path(out)
     }
