@@ -17,16 +17,8 @@ shift 2
 [ $# -gt 0 ] || set -- cover --width 400 --spp 64 --seed 1
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+. "$(dirname "$0")/lib/timing.sh"
 
-# The render time (s) printed in output file $1, or the output and exit 1.
-seconds() {
-    t=$(sed -n 's/^time \([0-9.]*\) s.*/\1/p' "$1")
-    if [ -z "$t" ]; then
-        cat "$1" >&2
-        exit 1
-    fi
-    echo "$t"
-}
 
 ratios=
 i=1
@@ -45,9 +37,4 @@ while [ "$i" -le "$rounds" ]; do
     ratios="$ratios $r"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | sort -n | awk '
-    { v[NR] = $1 }
-    END {
-        m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-        printf "B/A median %.3f (range %.3f to %.3f, %d rounds)\n", m, v[1], v[NR], NR
-    }'
+echo "$ratios" | tr ' ' '\n' | grep . | median "B/A"

@@ -17,15 +17,8 @@ shift
 [ $# -gt 0 ] || set -- cover --width 640 --spp 256 --seed 1
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+. "$(dirname "$0")/lib/timing.sh"
 
-seconds() {
-    t=$(sed -n 's/^time \([0-9.]*\) s.*/\1/p' "$1")
-    if [ -z "$t" ]; then
-        cat "$1" >&2
-        exit 1
-    fi
-    echo "$t"
-}
 
 plain() {
     "$lumen" render "$@" -o "$out/plain.png" >"$out/plain.txt" 2>&1
@@ -79,9 +72,4 @@ while [ "$i" -le "$rounds" ]; do
     ratios="$ratios $r"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | sort -n | awk '
-    { v[NR] = $1 }
-    END {
-        m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-        printf "speed with the page / without: median %.3f (range %.3f to %.3f, %d rounds)\n", m, v[1], v[NR], NR
-    }'
+echo "$ratios" | tr ' ' '\n' | grep . | median "speed with the page / without:"

@@ -171,6 +171,14 @@ pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseEr
 /// What a file to denoise lacks or holds wrong.
 #[derive(Debug, Error)]
 pub enum ReadError {
+    /// The file is missing, not a regular file, or too large.
+    #[error("{path}: {source}", path = .path.display())]
+    Input {
+        /// The file.
+        path: PathBuf,
+        /// Why it was not read.
+        source: crate::input::ReadError,
+    },
     /// The file cannot be read as an OpenEXR image.
     #[error("{path}: cannot read it as an OpenEXR image: {message}", path = .path.display())]
     Exr {
@@ -248,8 +256,17 @@ const NORMAL: [&[&str]; 2] = [
 impl ExrChannels {
     /// Reads every channel of every layer of `path` (its full resolution),
     /// after checking that they fit in memory. All layers must be of one
-    /// size.
+    /// size. The file is read as every input is ([`crate::input::read`]):
+    /// a regular file of at most [`crate::input::MAX_IMAGE_BYTES`].
     pub fn read(path: &std::path::Path) -> Result<ExrChannels, ReadError> {
+        use exr::prelude::ReadChannels as _;
+        use exr::prelude::ReadLayers as _;
+        let bytes = crate::input::read(path, crate::input::MAX_IMAGE_BYTES).map_err(|source| {
+            ReadError::Input {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
         let exr_error = |e: exr::error::Error| ReadError::Exr {
             path: path.to_path_buf(),
             message: e.to_string(),
@@ -258,7 +275,8 @@ impl ExrChannels {
             path: path.to_path_buf(),
             message,
         };
-        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(exr_error)?;
+        let cursor = || std::io::Cursor::new(&bytes[..]);
+        let meta = exr::meta::MetaData::read_from_buffered(cursor(), false).map_err(exr_error)?;
         let bytes: u64 = meta
             .headers
             .iter()
@@ -270,7 +288,14 @@ impl ExrChannels {
                 source,
             }
         })?;
-        let image = exr::prelude::read_all_flat_layers_from_file(path).map_err(exr_error)?;
+        let image = exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .all_layers()
+            .all_attributes()
+            .from_buffered(cursor())
+            .map_err(exr_error)?;
         let mut size = None;
         let mut channels = Vec::new();
         for layer in &image.layer_data {

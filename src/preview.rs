@@ -98,7 +98,12 @@ struct Shared {
     last_request: AtomicU64,
     /// Requests being answered (a page's waiting `/status` among them).
     open_requests: AtomicUsize,
+    /// The newest snapshot version a `/status` has answered with.
+    served: AtomicU64,
 }
+
+/// How long [`Preview::finish`] waits for a watching page.
+const DRAIN: Duration = Duration::from_secs(2);
 
 /// `Shared::last_request` before any request.
 const NEVER: u64 = u64::MAX;
@@ -147,6 +152,7 @@ impl Preview {
             started: Instant::now(),
             last_request: AtomicU64::new(NEVER),
             open_requests: AtomicUsize::new(0),
+            served: AtomicU64::new(0),
         });
         let (s, sh) = (Arc::clone(&server), Arc::clone(&shared));
         std::thread::Builder::new()
@@ -244,12 +250,28 @@ impl Preview {
         self.shared.changed.notify_all();
     }
 
-    /// Tells the page that the render has ended.
+    /// Tells the page that the render has ended, and gives a watching
+    /// page up to [`DRAIN`] to fetch the last status and image before the
+    /// process, and the server with it, ends.
     pub fn finish(&self) {
-        let mut snapshot = self.shared.snapshot.lock().expect("the preview's lock");
-        snapshot.finished = true;
-        snapshot.version += 1;
-        self.shared.changed.notify_all();
+        let version = {
+            let mut snapshot = self.shared.snapshot.lock().expect("the preview's lock");
+            snapshot.finished = true;
+            snapshot.version += 1;
+            self.shared.changed.notify_all();
+            snapshot.version
+        };
+        if !self.shared.watched() {
+            return;
+        }
+        let deadline = Instant::now() + DRAIN;
+        while Instant::now() < deadline {
+            let served = self.shared.served.load(Ordering::Relaxed) >= version;
+            if served && self.shared.open_requests.load(Ordering::Relaxed) == 0 {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
     }
 }
 
@@ -293,6 +315,7 @@ fn respond(shared: &Shared, request: tiny_http::Request) {
                 }
                 None => snapshot,
             };
+            shared.served.fetch_max(snapshot.version, Ordering::Relaxed);
             let json = serde_json::to_string(&StatusJson {
                 version: snapshot.version,
                 width: snapshot.width,

@@ -28,6 +28,22 @@ fn noisy(sigma: f32, seed: u64) -> (Vec<Color>, Vec<Color>, Vec<Vec3>, Vec<Vec3>
     (clean, color, albedo, normal)
 }
 
+/// The 64×64 image `color` denoised on two threads, with the buffers given.
+fn denoised(
+    color: &[Color],
+    albedo: Option<&[Vec3]>,
+    normal: Option<&[Vec3]>,
+) -> Result<Vec<Color>, denoise::DenoiseError> {
+    let inputs = Inputs {
+        width: 64,
+        height: 64,
+        color,
+        albedo,
+        normal,
+    };
+    denoise::denoise(&inputs, 2)
+}
+
 fn mse(a: &[Color], b: &[Color]) -> f64 {
     a.iter()
         .zip(b)
@@ -39,17 +55,7 @@ fn mse(a: &[Color], b: &[Color]) -> f64 {
 #[test]
 fn a_noisy_image_comes_out_closer_to_the_clean_one_with_its_mean_kept() {
     let (clean, color, albedo, normal) = noisy(0.1, 7);
-    let out = denoise::denoise(
-        &Inputs {
-            width: 64,
-            height: 64,
-            color: &color,
-            albedo: Some(&albedo),
-            normal: Some(&normal),
-        },
-        2,
-    )
-    .expect("OIDN runs");
+    let out = denoised(&color, Some(&albedo), Some(&normal)).expect("OIDN runs");
     assert_eq!(out.len(), color.len());
     assert!(out.iter().all(|c| c.min_element() >= 0.0 && c.is_finite()));
     let (before, after) = (mse(&color, &clean), mse(&out, &clean));
@@ -65,54 +71,22 @@ fn a_noisy_image_comes_out_closer_to_the_clean_one_with_its_mean_kept() {
 #[test]
 fn the_same_input_gives_the_same_bits() {
     let (_, color, albedo, normal) = noisy(0.2, 3);
-    let run = |threads| {
-        denoise::denoise(
-            &Inputs {
-                width: 64,
-                height: 64,
-                color: &color,
-                albedo: Some(&albedo),
-                normal: Some(&normal),
-            },
-            threads,
-        )
-        .expect("OIDN runs")
-    };
-    let first = run(2);
-    assert!(first == run(2), "two runs on 2 threads differ");
+    let run = || denoised(&color, Some(&albedo), Some(&normal)).expect("OIDN runs");
+    let first = run();
+    assert!(first == run(), "two runs on 2 threads differ");
 }
 
 #[test]
 fn an_image_alone_is_denoised_too() {
     let (clean, color, _, _) = noisy(0.1, 11);
-    let out = denoise::denoise(
-        &Inputs {
-            width: 64,
-            height: 64,
-            color: &color,
-            albedo: None,
-            normal: None,
-        },
-        2,
-    )
-    .expect("OIDN runs");
+    let out = denoised(&color, None, None).expect("OIDN runs");
     assert!(mse(&out, &clean) < mse(&color, &clean) / 4.0);
 }
 
 #[test]
 fn buffers_of_the_wrong_size_are_refused() {
     let (_, color, albedo, _) = noisy(0.1, 1);
-    let e = denoise::denoise(
-        &Inputs {
-            width: 64,
-            height: 64,
-            color: &color,
-            albedo: Some(&albedo[1..]),
-            normal: None,
-        },
-        2,
-    )
-    .unwrap_err();
+    let e = denoised(&color, Some(&albedo[1..]), None).unwrap_err();
     assert!(e.to_string().contains("4096 pixels"), "{e}");
 }
 

@@ -54,6 +54,21 @@ fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
         out.to_str().unwrap(),
     ]);
     assert_refused(&o, &["text.exr", "cannot read it as an OpenEXR image"]);
+    // Nothing there, or a directory.
+    let o = lumen_output(&[
+        "denoise",
+        dir.join("none.exr").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["none.exr: no such file"]);
+    let o = lumen_output(&[
+        "denoise",
+        dir.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&o, &["not a regular file"]);
     // Its own input is not replaced.
     let o = lumen_output(&[
         "denoise",
