@@ -546,13 +546,7 @@ impl Film {
     /// 8-bit bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.
     /// Computed pixel by pixel, with no full-size intermediate image.
     pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
-        let mut bytes = Vec::with_capacity(self.sums.len() * 3);
-        for c in self.pixels() {
-            for v in [c.x, c.y, c.z] {
-                bytes.push((256.0 * to_display(v, gamma).clamp(0.0, 0.999)) as u8);
-            }
-        }
-        bytes
+        rgb8(self.pixels(), self.sums.len(), gamma)
     }
 
     /// The mean linear colour of every pixel, row-major, top row first.
@@ -562,6 +556,17 @@ impl Film {
             .zip(&self.counts)
             .map(|(&s, &n)| mean(s, n))
     }
+}
+
+/// 8-bit bytes of `n` linear colours, as [`Film::to_rgb8`] makes them.
+pub fn rgb8(colors: impl Iterator<Item = Color>, n: usize, gamma: f32) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(n * 3);
+    for c in colors {
+        for v in [c.x, c.y, c.z] {
+            bytes.push((256.0 * to_display(v, gamma).clamp(0.0, 0.999)) as u8);
+        }
+    }
+    bytes
 }
 
 /// The mean of `n` samples summing to `sum`; black if there are none.

@@ -9,7 +9,7 @@
 //! it (`out.png` → `out.albedo.pfm`).
 
 use crate::aov::{Aov, Layer};
-use crate::film::{to_display, Film};
+use crate::film::Film;
 use crate::math::{Color, Vec3};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -196,11 +196,9 @@ impl Beauty<'_> {
     fn rgb8(&self, gamma: f32) -> Vec<u8> {
         match self {
             Beauty::Film(film) => film.to_rgb8(gamma),
-            Beauty::Colors { colors, .. } => colors
-                .iter()
-                .flat_map(|c| [c.x, c.y, c.z])
-                .map(|v| (256.0 * to_display(v, gamma).clamp(0.0, 0.999)) as u8)
-                .collect(),
+            Beauty::Colors { colors, .. } => {
+                crate::film::rgb8(colors.iter().copied(), colors.len(), gamma)
+            }
         }
     }
 }

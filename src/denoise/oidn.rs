@@ -227,21 +227,20 @@ impl Library {
         let mut normal = inputs.normal.map(flat);
         // Prefiltered auxiliary images: each cleaned by a filter of its own
         // (written in place), so that the image's filter can trust them.
-        if let Some(albedo) = albedo.as_mut() {
-            let mut clean = vec![0.0; albedo.len()];
+        let prefilter = |name: &CStr, buffer: &mut Vec<f32>| -> Result<(), DenoiseError> {
+            let mut clean = vec![0.0; buffer.len()];
             let filter = device.filter()?;
-            filter.image(c"albedo", albedo, w, h);
+            filter.image(name, buffer, w, h);
             filter.image(c"output", &mut clean, w, h);
             filter.run()?;
-            *albedo = clean;
+            *buffer = clean;
+            Ok(())
+        };
+        if let Some(albedo) = albedo.as_mut() {
+            prefilter(c"albedo", albedo)?;
         }
         if let Some(normal) = normal.as_mut() {
-            let mut clean = vec![0.0; normal.len()];
-            let filter = device.filter()?;
-            filter.image(c"normal", normal, w, h);
-            filter.image(c"output", &mut clean, w, h);
-            filter.run()?;
-            *normal = clean;
+            prefilter(c"normal", normal)?;
         }
         let mut output = vec![0.0; color.len()];
         let filter = device.filter()?;
