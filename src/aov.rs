@@ -232,20 +232,6 @@ pub struct Features {
     pub depth: f32,
 }
 
-impl Features {
-    /// The sample's value in `layer`, `colour` being the sample's colour.
-    #[inline(always)]
-    pub fn layer(&self, layer: Layer, colour: Color) -> Vec3 {
-        match layer {
-            Layer::Albedo => self.albedo,
-            Layer::Normal => self.normal,
-            Layer::Depth => Vec3::new(self.depth, 0.0, 0.0),
-            Layer::Position => self.position,
-            Layer::Moment => colour * colour,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

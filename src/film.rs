@@ -3,6 +3,7 @@
 
 use crate::aov::{Features, Layer, Layers, LAYERS};
 use crate::math::{Color, Vec3};
+use rayon::prelude::*;
 
 /// The sum of some samples of a pixel, a number per channel, in 64.64 fixed
 /// point: integers counting 2⁻⁶⁴.
@@ -50,8 +51,9 @@ impl Sum {
     /// A channel beyond ±2³¹ saturates there; NaN is 0.
     #[inline(always)]
     pub fn of_feature(v: Vec3) -> Sum {
-        // Saturating, as `as` converts.
-        let fixed = |x: f32| i128::from((f64::from(x) * 4_294_967_296.0) as i64) << 32;
+        // Scaling by a power of two is exact in `f32` (as through `f64`);
+        // the conversion saturates, as `as` converts.
+        let fixed = |x: f32| i128::from((x * 4_294_967_296.0) as i64) << 32;
         Sum([fixed(v.x), fixed(v.y), fixed(v.z)])
     }
 
@@ -82,7 +84,28 @@ impl Sum {
     /// The sum as floating-point numbers (rounded to `f64`).
     #[inline]
     pub fn to_f64(self) -> [f64; 3] {
-        self.0.map(|v| v as f64 / ONE)
+        // Times 2⁻⁶⁴, exact as dividing by 2⁶⁴ is, and quicker; written
+        // out, as `map`'s closure may be left a call a channel.
+        let f = |v: i128| i128_to_f64(v) * (1.0 / ONE);
+        [f(self.0[0]), f(self.0[1]), f(self.0[2])]
+    }
+}
+
+/// `v as f64` (rounded to nearest, ties to even), without the library call
+/// the compiler makes of it: the top 64 bits of `|v|` keep, in their last
+/// bit, whether any bit below them is set, which is all the rounding to 53
+/// bits needs; the shift back is by a power of two, exact.
+#[inline(always)]
+fn i128_to_f64(v: i128) -> f64 {
+    let magnitude = v.unsigned_abs();
+    let shift = 64u32.saturating_sub(magnitude.leading_zeros());
+    let top = (magnitude >> shift) as u64;
+    let sticky = u64::from(magnitude & ((1u128 << shift) - 1) != 0);
+    let scaled = (top | sticky) as f64 * f64::from_bits(u64::from(1023 + shift) << 52);
+    if v < 0 {
+        -scaled
+    } else {
+        scaled
     }
 }
 
@@ -187,24 +210,32 @@ impl RowMut<'_> {
     /// [`RowMut::add`], and the sample's `features` to the layers the film
     /// keeps when the sample is added: each feature to 2⁻³² and within
     /// ±2³¹ ([`Sum::of_feature`]), the squared colour exactly. A squared
-    /// colour beyond what a [`Sum`] holds, or a value that would take its
+    /// colour beyond what a [`Sum`] holds, or one that would take its
     /// pixel's sum past it, counts as 0.
+    ///
+    /// A feature's sum needs no such check: a pixel holds fewer than 2³²
+    /// samples (its count is a `u32`), each feature below 2³¹, so their sum
+    /// stays below 2⁶³, what a [`Sum`] holds.
     #[inline(always)]
     pub fn add_with(&mut self, x: usize, index: u32, c: Color, features: &Features) -> bool {
         if !self.add(x, index, c) {
             return false;
         }
-        for layer in Layer::ALL {
-            if self.layers.has(layer) {
+        let layers = self.layers;
+        let mut add_feature = |layer: Layer, v: Vec3| {
+            if layers.has(layer) {
                 let sum = &mut self.layer_sums[layer as usize][x];
-                let v = features.layer(layer, c);
-                let value = match layer {
-                    Layer::Moment => Sum::of_color(v),
-                    _ => Some(Sum::of_feature(v)),
-                };
-                if let Some(added) = value.and_then(|v| sum.checked_plus(v)) {
-                    *sum = added;
-                }
+                *sum = sum.plus(Sum::of_feature(v));
+            }
+        };
+        add_feature(Layer::Albedo, features.albedo);
+        add_feature(Layer::Normal, features.normal);
+        add_feature(Layer::Depth, Vec3::new(features.depth, 0.0, 0.0));
+        add_feature(Layer::Position, features.position);
+        if layers.has(Layer::Moment) {
+            let sum = &mut self.layer_sums[Layer::Moment as usize][x];
+            if let Some(added) = Sum::of_color(c * c).and_then(|v| sum.checked_plus(v)) {
+                *sum = added;
             }
         }
         true
@@ -372,7 +403,6 @@ impl Film {
 
     /// Mutable access to the rows, for parallel rendering.
     pub fn rows_mut(&mut self) -> impl rayon::iter::IndexedParallelIterator<Item = RowMut<'_>> {
-        use rayon::prelude::*;
         let w = (self.width as usize).max(1);
         let layers = self.layers();
         // What only some films keep, row by row (empty slices elsewhere).
@@ -538,9 +568,13 @@ impl Film {
         mean(self.sums[i], self.counts[i])
     }
 
-    /// All pixels' mean linear colours, row-major, top row first.
+    /// All pixels' mean linear colours, row-major, top row first (on all
+    /// threads).
     pub fn linear(&self) -> Vec<Color> {
-        self.pixels().collect()
+        (0..self.len())
+            .into_par_iter()
+            .map(|i| self.mean(i))
+            .collect()
     }
 
     /// 8-bit bytes, three a pixel: ⌊256·clamp(v, 0, 0.999)⌋ of the display value.
@@ -576,8 +610,8 @@ fn mean(sum: Sum, n: u32) -> Color {
         return Color::ZERO;
     }
     let n = f64::from(n);
-    let [r, g, b] = sum.to_f64().map(|v| (v / n) as f32);
-    Color::new(r, g, b)
+    let [r, g, b] = sum.to_f64();
+    Color::new((r / n) as f32, (g / n) as f32, (b / n) as f32)
 }
 
 /// Applies the display gamma (v^(1/γ)) and tone-maps by clamping to [0, 1].
@@ -599,6 +633,33 @@ pub fn to_display(linear: f32, gamma: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sums_convert_to_f64_as_the_compiler_converts() {
+        let mut edges = vec![0i128, 1, -1, i128::MAX, i128::MIN, i128::MIN + 1];
+        for bit in 0..127 {
+            let p = 1i128 << bit;
+            // Powers of two, their neighbours, and halfway cases of the
+            // rounding to 53 bits, odd and even.
+            edges.extend([p, p - 1, p + 1, -p, 1 - p, -p - 1]);
+            if bit > 53 {
+                let half = 1i128 << (bit - 53);
+                edges.extend([p + half, p + 3 * half, p + half + 1, p + half - 1]);
+            }
+        }
+        for v in edges {
+            assert_eq!(i128_to_f64(v).to_bits(), (v as f64).to_bits(), "{v}");
+        }
+        let word = |i: u64| crate::rng::mix64(i);
+        for i in 0..200_000u64 {
+            // A random value of a random length.
+            let length = (word(4 * i) % 128) as u32;
+            let wide = u128::from(word(4 * i + 1)) << 64 | u128::from(word(4 * i + 2));
+            let v = (wide >> (128 - length.max(1))) as i128;
+            let v = if word(4 * i + 3) % 2 == 0 { v } else { -v };
+            assert_eq!(i128_to_f64(v).to_bits(), (v as f64).to_bits(), "{v}");
+        }
+    }
 
     #[test]
     fn a_colour_converts_from_its_bits_as_through_f64() {

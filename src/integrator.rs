@@ -2,7 +2,7 @@
 //! ([`trace_path`]), and the same for a group of camera rays of one pixel
 //! traced side by side ([`trace_paths`]), which is how the renderer runs it.
 
-use crate::aov::Features;
+use crate::aov::{Features, Layer, Layers};
 use crate::bsdf::{Bsdf, LobeFlags};
 use crate::geometry::bvh::Hit;
 use crate::geometry::bvh_bundle::LANES;
@@ -100,12 +100,13 @@ impl PathState {
 }
 
 impl FeatureSearch {
-    /// The search of a path leaving the camera.
-    pub fn start() -> FeatureSearch {
+    /// The search of a path leaving the camera, for what `layers` need
+    /// (the features no layer keeps are left at 0).
+    pub fn start(layers: Layers) -> FeatureSearch {
         FeatureSearch {
             features: Features::default(),
-            seeking: true,
-            placing: true,
+            seeking: layers.has(Layer::Albedo) || layers.has(Layer::Normal),
+            placing: layers.has(Layer::Depth) || layers.has(Layer::Position),
             tint: Color::ONE,
         }
     }
@@ -654,7 +655,7 @@ pub fn trace_path_features(
     rays: &mut u64,
 ) -> (Color, Features) {
     let mut path = PathState::start(scene);
-    let mut search = FeatureSearch::start();
+    let mut search = FeatureSearch::start(scene.settings.layers);
     let searching = scene.settings.layers.need_features();
     let mut from = None;
     // A path still going after `max_depth` segments keeps what it gathered.
@@ -700,7 +701,7 @@ fn clip_far(scene: &Scene, ray: &Ray, hit: &mut Option<Hit>) {
 /// `trace_path(scene, rays[i], &mut samplers[i], ..)` returns, and
 /// `searches[i]`, where `searches` is not empty (the render keeps feature
 /// buffers), what the path found for them ([`trace_path_features`]): each
-/// search starts as [`FeatureSearch::start`].
+/// search starts as [`FeatureSearch::start`] of the render's layers.
 ///
 /// The paths advance together, one segment each per round, so that the rays
 /// of a round can be traced as bundles (see
@@ -926,8 +927,10 @@ mod tests {
                         })
                         .unzip();
                     let mut together = vec![Color::ZERO; n];
-                    let mut searches =
-                        vec![FeatureSearch::start(); if with_features { n } else { 0 }];
+                    let mut searches = vec![
+                        FeatureSearch::start(scene.settings.layers);
+                        if with_features { n } else { 0 }
+                    ];
                     let mut together_rays = 0;
                     let reference = scene.camera.central_ray(x, y);
                     trace_paths(

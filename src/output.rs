@@ -278,16 +278,18 @@ fn aov_pixel(film: &Film, aov: Aov, i: usize) -> Vec3 {
 }
 
 /// The first `channels` channels of `value` over `n` pixels: a vector a
-/// channel, each pixel's value computed once.
-fn channel_vectors(n: usize, channels: usize, value: impl Fn(usize) -> Vec3) -> Vec<Vec<f32>> {
-    let mut out = vec![Vec::with_capacity(n); channels];
-    for i in 0..n {
-        let v = value(i);
-        for (c, channel) in out.iter_mut().enumerate() {
-            channel.push(v[c]);
-        }
-    }
-    out
+/// channel, each pixel's value computed once, on all threads (an image is
+/// saved between passes, while they wait).
+fn channel_vectors(
+    n: usize,
+    channels: usize,
+    value: impl Fn(usize) -> Vec3 + Sync + Send,
+) -> Vec<Vec<f32>> {
+    use rayon::prelude::*;
+    let values: Vec<Vec3> = (0..n).into_par_iter().map(value).collect();
+    (0..channels)
+        .map(|c| values.iter().map(|v| v[c]).collect())
+        .collect()
 }
 
 /// Feature buffer `aov` of `film`: a vector of values a channel (of

@@ -1,6 +1,6 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
-use crate::aov::Features;
+use crate::aov::{Features, Layers};
 use crate::film::{Film, RowMut};
 use crate::halt::Halt;
 use crate::integrator::{first_hit_view, trace_paths, FeatureSearch, PATHS};
@@ -298,7 +298,7 @@ impl SideBySide {
             rays: [Ray::new(Vec3::ZERO, Vec3::X); PATHS],
             samplers: [const { PixelSample::placeholder() }; PATHS],
             colours: [Color::ZERO; PATHS],
-            searches: [FeatureSearch::start(); PATHS],
+            searches: [FeatureSearch::start(Layers::NONE); PATHS],
         }
     }
 
@@ -328,7 +328,7 @@ impl SideBySide {
         }
         let searches = if scene.settings.layers.need_features() {
             let searches = &mut self.searches[..n];
-            searches.fill(FeatureSearch::start());
+            searches.fill(FeatureSearch::start(scene.settings.layers));
             searches
         } else {
             &mut []

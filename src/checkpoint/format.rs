@@ -60,29 +60,38 @@ impl CheckpointView<'_> {
         Ok(())
     }
 
-    /// Writes the checkpoint, header included, to `out`: one pass over the
-    /// payload computes its checksum, a second writes it.
-    pub fn encode_to(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+    /// Writes the checkpoint, header included, to `out`, encoding the
+    /// payload once: the header's length and checksum, which come first,
+    /// are written after it, in the room left for them.
+    pub fn encode_to<W: std::io::Write + std::io::Seek>(&self, out: &mut W) -> std::io::Result<()> {
+        use std::io::SeekFrom;
+        let start = out.stream_position()?;
+        out.write_all(MAGIC)?;
+        out.write_all(&VERSION.to_le_bytes())?;
+        let room = out.stream_position()?;
+        out.write_all(&[0; 12])?;
         let mut hasher = crc32fast::Hasher::new();
         let mut len = 0u64;
         self.payload(&mut |bytes| {
             hasher.update(bytes);
             len += bytes.len() as u64;
-            Ok(())
+            out.write_all(bytes)
         })?;
-        out.write_all(MAGIC)?;
-        out.write_all(&VERSION.to_le_bytes())?;
+        let end = out.stream_position()?;
+        out.seek(SeekFrom::Start(room))?;
         out.write_all(&len.to_le_bytes())?;
         out.write_all(&hasher.finalize().to_le_bytes())?;
-        self.payload(&mut |bytes| out.write_all(bytes))
+        out.seek(SeekFrom::Start(end))?;
+        debug_assert!(end - start == room - start + 12 + len);
+        Ok(())
     }
 
     /// The checkpoint's bytes, header included.
     pub fn encode(&self) -> Vec<u8> {
-        let mut out = Vec::new();
+        let mut out = std::io::Cursor::new(Vec::new());
         self.encode_to(&mut out)
             .expect("writing to memory cannot fail");
-        out
+        out.into_inner()
     }
 }
 

@@ -31,18 +31,32 @@ pub(super) fn write_pixels(
         }
         sink(&buf)?;
     }
-    for row in sums.chunks(width.max(1)) {
-        buf.clear();
-        for sum in row {
-            put_sum(&mut buf, sum);
+    // Rows are encoded on all threads (a checkpoint is saved between
+    // passes, while they wait), a batch at a time to bound the memory.
+    const BATCH_PIXELS: usize = 1 << 16;
+    let width = width.max(1);
+    let batch_rows = (BATCH_PIXELS / width).max(1);
+    for batch in sums.chunks(width * batch_rows) {
+        let rows: Vec<Vec<u8>> = batch
+            .par_chunks(width)
+            .map(|row| {
+                let mut out = Vec::with_capacity(row.len() * (2 + 3 * 16));
+                for sum in row {
+                    put_sum(&mut out, sum);
+                }
+                out
+            })
+            .collect();
+        for row in rows {
+            sink(&(row.len() as u32).to_le_bytes())?;
+            sink(&row)?;
         }
-        sink(&(buf.len() as u32).to_le_bytes())?;
-        sink(&buf)?;
     }
     Ok(())
 }
 
 /// Appends one pixel's sums: shift, length, and three values.
+#[inline]
 fn put_sum(out: &mut Vec<u8>, sum: &Sum) {
     let shift = match sum.0.iter().map(|v| v.trailing_zeros()).min() {
         Some(128) | None => 0,
@@ -51,10 +65,13 @@ fn put_sum(out: &mut Vec<u8>, sum: &Sum) {
     let values = sum.0.map(|v| zigzag(v >> shift));
     let bits = values.iter().map(|z| 128 - z.leading_zeros()).max();
     let len = bits.unwrap_or(0).div_ceil(8) as usize;
-    out.push(shift as u8);
-    out.push(len as u8);
+    // Each value's 16 bytes are appended whole and cut to length: a copy
+    // of a variable length would be a library call, slower than the
+    // encoding.
+    out.extend_from_slice(&[shift as u8, len as u8]);
     for z in values {
-        out.extend_from_slice(&z.to_le_bytes()[..len]);
+        out.extend_from_slice(&z.to_le_bytes());
+        out.truncate(out.len() - 16 + len);
     }
 }
 
