@@ -6,6 +6,7 @@ mod lumen_process;
 
 use lumen_process::*;
 use std::path::Path;
+use std::process::Output;
 
 const SMALL: &[&str] = &[
     "render",
@@ -24,18 +25,22 @@ fn render(out: &Path, extra: &[&str]) {
     assert!(status.success(), "{err}");
 }
 
+/// `lumen denoise INPUT -o OUT`.
+fn denoise(input: &Path, out: &Path) -> Output {
+    lumen_output(&[
+        "denoise",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ])
+}
 #[test]
 fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
     let dir = temp_dir("denoise-layers");
     let noisy = dir.join("noisy.exr");
     render(&noisy, &["--aov", "depth"]);
     let out = dir.join("clean.exr");
-    let o = lumen_output(&[
-        "denoise",
-        noisy.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = denoise(&noisy, &out);
     assert_refused(
         &o,
         &[
@@ -47,35 +52,15 @@ fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
     assert!(!out.exists());
     // A file that is not an EXR image.
     std::fs::write(dir.join("text.exr"), "not an image").unwrap();
-    let o = lumen_output(&[
-        "denoise",
-        dir.join("text.exr").to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = denoise(&dir.join("text.exr"), &out);
     assert_refused(&o, &["text.exr", "cannot read it as an OpenEXR image"]);
     // Nothing there, or a directory.
-    let o = lumen_output(&[
-        "denoise",
-        dir.join("none.exr").to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = denoise(&dir.join("none.exr"), &out);
     assert_refused(&o, &["none.exr: no such file"]);
-    let o = lumen_output(&[
-        "denoise",
-        dir.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = denoise(&dir, &out);
     assert_refused(&o, &["not a regular file"]);
     // Its own input is not replaced.
-    let o = lumen_output(&[
-        "denoise",
-        noisy.to_str().unwrap(),
-        "-o",
-        noisy.to_str().unwrap(),
-    ]);
+    let o = denoise(&noisy, &noisy);
     assert_refused(&o, &["cannot replace its input"]);
 }
 
@@ -126,12 +111,7 @@ fn a_build_without_the_denoiser_says_how_to_get_one_before_rendering() {
     // `lumen denoise` on a good file says the same.
     let noisy = dir.join("noisy.exr");
     render(&noisy, &["--aov", "albedo,normal"]);
-    let o = lumen_output(&[
-        "denoise",
-        noisy.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = denoise(&noisy, &out);
     assert_refused(&o, &["built without the denoiser"]);
     assert!(!out.exists());
 }
