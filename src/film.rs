@@ -109,6 +109,21 @@ fn i128_to_f64(v: i128) -> f64 {
     }
 }
 
+/// Makes `dst` a copy of `src`, on all threads when it already has its
+/// length: a render copies its film before every pass while its threads
+/// wait, and a film with feature layers is several times the image's size.
+fn copy_vec<T: Copy + Send + Sync>(dst: &mut Vec<T>, src: &[T]) {
+    const CHUNK: usize = 1 << 14;
+    if dst.len() == src.len() {
+        dst.par_chunks_mut(CHUNK)
+            .zip(src.par_chunks(CHUNK))
+            .for_each(|(d, s)| d.copy_from_slice(s));
+    } else {
+        dst.clear();
+        dst.extend_from_slice(src);
+    }
+}
+
 /// `v` in 64.64 fixed point, truncated towards zero; `None` if NaN,
 /// infinite, or of magnitude 2⁶³ or more. Worked out from the bits: the
 /// significand shifted by the exponent.
@@ -485,12 +500,12 @@ impl Film {
     pub fn copy_from(&mut self, other: &Film) {
         self.width = other.width;
         self.height = other.height;
-        self.sums.clone_from(&other.sums);
-        self.counts.clone_from(&other.counts);
-        self.odd_sums.clone_from(&other.odd_sums);
-        self.odd_counts.clone_from(&other.odd_counts);
+        copy_vec(&mut self.sums, &other.sums);
+        copy_vec(&mut self.counts, &other.counts);
+        copy_vec(&mut self.odd_sums, &other.odd_sums);
+        copy_vec(&mut self.odd_counts, &other.odd_counts);
         for (mine, theirs) in self.layer_sums.iter_mut().zip(&other.layer_sums) {
-            mine.clone_from(theirs);
+            copy_vec(mine, theirs);
         }
     }
 
