@@ -99,6 +99,50 @@ pub fn ends_a_share_pass(done: u32, len: u32, spp: u32) -> bool {
     at == done
 }
 
+/// When a render saves its image and checkpoint between passes (the
+/// finished image is always written).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum SaveSchedule {
+    /// After a pass once the time since the last save is at least
+    /// [`SAVE_SPACING`] times what that save took, so that saving takes at
+    /// most about a twentieth of the render's time however short its passes
+    /// and however large its image; the first pass is always saved.
+    #[default]
+    Bounded,
+    /// After every pass.
+    EveryPass,
+    /// After a pass once this long has passed since the last save.
+    Every(Duration),
+}
+
+/// How many times as long as its last save a render with
+/// [`SaveSchedule::Bounded`] renders before it saves again: saves then take
+/// at most 1/(1 + 19) = 5 % of the time.
+pub const SAVE_SPACING: u32 = 19;
+
+impl SaveSchedule {
+    /// Whether a pass that ends `since` after the last save ended (or the
+    /// run started), which took `took` (`None` before the run's first save),
+    /// is saved.
+    pub fn due(self, since: Duration, took: Option<Duration>) -> bool {
+        match (self, took) {
+            (SaveSchedule::EveryPass, _) | (SaveSchedule::Bounded, None) => true,
+            (SaveSchedule::Every(every), _) => since >= every,
+            (SaveSchedule::Bounded, Some(took)) => since >= took * SAVE_SPACING,
+        }
+    }
+
+    /// Parses `--checkpoint-interval`'s value: a duration (see
+    /// [`parse_duration`]), or `0` for every pass.
+    pub fn parse(text: &str) -> Result<SaveSchedule, String> {
+        let zero = text.trim().trim_end_matches(['s', 'm', 'h']).trim();
+        if zero.parse::<f64>().is_ok_and(|v| v == 0.0) {
+            return Ok(SaveSchedule::EveryPass);
+        }
+        parse_duration(text).map(SaveSchedule::Every)
+    }
+}
+
 /// Parses a duration such as `90s`, `1.5m`, `2h` or `45` (seconds).
 pub fn parse_duration(text: &str) -> Result<Duration, String> {
     let t = text.trim();
@@ -599,6 +643,48 @@ mod tests {
         assert_eq!(schedule(64).len(), 11);
         assert!(ends_a_pass(4, 64) && ends_a_pass(64, 64));
         assert!(!ends_a_pass(3, 64) && !ends_a_pass(65, 64));
+    }
+
+    #[test]
+    fn bounded_saves_take_at_most_a_twentieth_of_the_time() {
+        let ms = Duration::from_millis;
+        let bounded = SaveSchedule::Bounded;
+        // The first pass is saved, however short.
+        assert!(bounded.due(ms(1), None));
+        // Then only once 19 times the last save's duration has passed.
+        assert!(!bounded.due(ms(1899), Some(ms(100))));
+        assert!(bounded.due(ms(1900), Some(ms(100))));
+        // A simulated render after its first save: passes of 10 ms, saves
+        // of 40 ms.
+        let (pass, save) = (ms(10), ms(40));
+        let (mut since, mut took, mut rendering, mut saving) = (ms(0), Some(save), ms(0), ms(0));
+        for _ in 0..10_000 {
+            rendering += pass;
+            since += pass;
+            if bounded.due(since, took) {
+                saving += save;
+                (since, took) = (ms(0), Some(save));
+            }
+        }
+        let share = saving.as_secs_f64() / (saving + rendering).as_secs_f64();
+        assert!(share <= 0.05 && share > 0.049, "{share}");
+        // Every pass, or at most every interval, counted from the start.
+        assert!(SaveSchedule::EveryPass.due(ms(0), Some(ms(100))));
+        let every = SaveSchedule::Every(Duration::from_secs(60));
+        assert!(!every.due(ms(59_999), None) && every.due(ms(60_000), Some(ms(1))));
+    }
+
+    #[test]
+    fn a_checkpoint_interval_is_a_duration_or_zero() {
+        let every = |s| SaveSchedule::Every(Duration::from_secs(s));
+        assert_eq!(SaveSchedule::parse("90s"), Ok(every(90)));
+        assert_eq!(SaveSchedule::parse("2m"), Ok(every(120)));
+        for zero in ["0", "0s", " 0.0m "] {
+            assert_eq!(SaveSchedule::parse(zero), Ok(SaveSchedule::EveryPass));
+        }
+        for bad in ["-1s", "soon", "", "s"] {
+            assert!(SaveSchedule::parse(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -80,7 +80,8 @@ fn a_second_interrupt_exits_at_once_leaving_complete_files() {
     let dir = temp_dir("twice");
     let reference = reference(&dir, RENDER);
     let out = dir.join("twice.pfm");
-    let r = spawn(RENDER, &out, &[]);
+    // Saved after every pass, so that passes 1 and 2 are on disk.
+    let r = spawn(RENDER, &out, &["--checkpoint-interval", "0"]);
     r.wait_line("pass 3:");
     // Two different signals, so that the kernel cannot merge them into one.
     r.signal(libc::SIGINT);
@@ -129,7 +130,12 @@ fn sigkill_during_checkpoint_writes_leaves_a_usable_checkpoint() {
         }
         rounds += 1;
         let resume = ckpt_path.exists();
-        let extra: &[&str] = if resume { &["--resume"] } else { &[] };
+        // Saved after every pass: as many writes to land in as there are.
+        let extra: &[&str] = if resume {
+            &["--checkpoint-interval", "0", "--resume"]
+        } else {
+            &["--checkpoint-interval", "0"]
+        };
         let r = spawn(RENDER, &out, extra);
         // The name lumen::output::temp_path gives in the child process.
         let tmp = dir.join(format!(".killed.pfm.lumen-ckpt.{}.tmp", r.child.id()));

@@ -21,8 +21,9 @@ const MAX_THREADS: i64 = 1024;
 /// status (see `render.rs` and `signals.rs`).
 const RENDER_HELP: &str = "\
 The image and a checkpoint (OUTPUT.lumen-ckpt unless --checkpoint says
-otherwise) are saved after every pass (or every --checkpoint-interval); the
-checkpoint is removed when the render completes. While it runs, the render
+otherwise) are saved after the first pass, then after a pass once saving
+takes at most 5 % of the time (or every --checkpoint-interval; 0: after every
+pass); the checkpoint is removed when the render completes. While it runs, the render
 holds a lock file beside each (.NAME.lumen-lock): a second render to the same
 image or checkpoint is refused. Only regular files are written.
 
@@ -376,10 +377,12 @@ struct ProgressiveArgs {
     /// NAME.lumen-part); with --part K/N, that share of their samples.
     #[arg(long, value_name = "X0,Y0,X1,Y1", conflicts_with = "checkpoint")]
     tile: Option<lumen::tile::Tile>,
-    /// Save the image and the checkpoint at most this often (e.g. 30s, 5m)
-    /// instead of after every pass.
-    #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
-    checkpoint_interval: Option<Duration>,
+    /// Save the image and the checkpoint at most this often (e.g. 30s, 5m),
+    /// or after every pass (0) [default: after a pass once the render has
+    /// run 19 times as long as the last save took, so that saving takes at
+    /// most 5 % of the time].
+    #[arg(long, value_name = "DURATION", value_parser = lumen::progressive::SaveSchedule::parse)]
+    checkpoint_interval: Option<lumen::progressive::SaveSchedule>,
     /// Continue the render saved in the checkpoint; the scene and settings
     /// must be the same as when it was made.
     #[arg(long)]

@@ -267,6 +267,7 @@ pub(crate) fn render_command(
     let bar = progress_bar(pixels * u64::from(samples.end - resumed_from));
     let start = Instant::now();
     let mut last_save = start;
+    let mut last_save_took = None;
     let run = session.run(&stop, prog.time_limit, &|n| bar.inc(n), &mut |session,
                                                                           pass|
      -> Result<
@@ -292,11 +293,14 @@ pub(crate) fn render_command(
         // The finished image is written once, below.
         let due = prog
             .checkpoint_interval
-            .is_none_or(|every| last_save.elapsed() >= every);
+            .unwrap_or_default()
+            .due(last_save.elapsed(), last_save_took);
         let mut denoised = None;
         if !session.is_complete() && due {
+            let saving = Instant::now();
             denoised = save(session, false)?;
             last_save = Instant::now();
+            last_save_took = Some(last_save - saving);
         }
         if let Some(preview) = &preview {
             let status = status(session, pass.number, start.elapsed());
