@@ -114,8 +114,7 @@ impl FeatureSearch {
     /// The features are those of a surface of albedo `albedo` (before the
     /// tint of the deltas followed) and shading normal `normal`, on the
     /// side the path came from.
-    #[cold]
-    #[inline(never)]
+    #[inline(always)]
     fn seen(&mut self, albedo: Color, normal: Vec3) {
         self.features.albedo = (self.tint * albedo).clamp(Color::ZERO, Color::ONE);
         self.features.normal = normal;
