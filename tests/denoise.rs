@@ -69,6 +69,39 @@ fn a_noisy_image_comes_out_closer_to_the_clean_one_with_its_mean_kept() {
 }
 
 #[test]
+fn glints_come_out_as_rendered() {
+    // Sun glints: single pixels a thousand times the image's mean, which
+    // neither the albedo nor the normal announces. The filter alone
+    // spreads or removes them.
+    let (_, mut color, albedo, normal) = noisy(0.05, 5);
+    let glints = [(10, 10), (40, 20), (50, 50), (20, 45)];
+    for &(x, y) in &glints {
+        color[y * 64 + x] = Color::new(500.0, 450.0, 400.0);
+    }
+    let out = denoised(&color, Some(&albedo), Some(&normal)).expect("OIDN runs");
+    // What passes ten times the mean luminance is kept whole; the filter
+    // sees the rest.
+    let (_, highlights) = denoise::split_highlights(&color);
+    for &(x, y) in &glints {
+        let i = y * 64 + x;
+        let (got, want, kept) = (out[i], color[i], highlights[i]);
+        assert!(kept.min_element() > 0.9 * want.min_element(), "{kept}");
+        assert!(
+            got.cmpge(kept).all() && got.cmple(want * 1.01).all(),
+            "glint ({x}, {y}): {got} against {want}, of which {kept} above the limit"
+        );
+    }
+    let mean = |v: &[Color], c: usize| v.iter().map(|p| f64::from(p[c])).sum::<f64>() / 4096.0;
+    for c in 0..3 {
+        let (m, m0) = (mean(&out, c), mean(&color, c));
+        assert!(
+            (m / m0 - 1.0).abs() < 0.01,
+            "channel {c}: mean {m} against {m0}"
+        );
+    }
+}
+
+#[test]
 fn the_same_input_gives_the_same_bits() {
     let (_, color, albedo, normal) = noisy(0.2, 3);
     let run = || denoised(&color, Some(&albedo), Some(&normal)).expect("OIDN runs");
