@@ -17,6 +17,9 @@ set -euo pipefail
 MITSUBA_VERSION=3.9.1
 DRJIT_VERSION=1.5.0
 NUMPY_VERSION=2.4.6
+# HDR-FLIP, for the denoising benchmarks (scripts/denoise-bench.py and
+# scripts/peers/denoise_cycles.py).
+FLIP_VERSION=1.7
 
 VENV="${LUMEN_PEERS_VENV:-$HOME/.cache/lumen-peers/venv}"
 ENV_ONLY=0
@@ -57,21 +60,22 @@ export DRJIT_LIBLLVM_PATH="$LIBLLVM"
 # --- venv with mitsuba ---------------------------------------------------
 PY="$VENV/bin/python"
 have_pins() {
-    [[ -x "$PY" ]] && "$PY" - "$MITSUBA_VERSION" "$DRJIT_VERSION" "$NUMPY_VERSION" <<'PYEOF' 2>/dev/null
+    [[ -x "$PY" ]] && "$PY" - "$MITSUBA_VERSION" "$DRJIT_VERSION" "$NUMPY_VERSION" "$FLIP_VERSION" <<'PYEOF' 2>/dev/null
 import sys, importlib.metadata as md
-want = dict(zip(("mitsuba", "drjit", "numpy"), sys.argv[1:]))
+want = dict(zip(("mitsuba", "drjit", "numpy", "flip-evaluator"), sys.argv[1:]))
 sys.exit(0 if all(md.version(k) == v for k, v in want.items()) else 1)
 PYEOF
 }
 
 if [[ $ENV_ONLY == 0 ]]; then
     if have_pins; then
-        log "venv $VENV already has mitsuba $MITSUBA_VERSION, drjit $DRJIT_VERSION, numpy $NUMPY_VERSION"
+        log "venv $VENV already has mitsuba $MITSUBA_VERSION, drjit $DRJIT_VERSION, numpy $NUMPY_VERSION, flip-evaluator $FLIP_VERSION"
     else
         log "creating venv $VENV"
         python3 -m venv "$VENV" >&2
         "$PY" -m pip install --quiet --upgrade pip >&2
-        "$PY" -m pip install --quiet "mitsuba==$MITSUBA_VERSION" "drjit==$DRJIT_VERSION" "numpy==$NUMPY_VERSION" >&2
+        "$PY" -m pip install --quiet "mitsuba==$MITSUBA_VERSION" "drjit==$DRJIT_VERSION" "numpy==$NUMPY_VERSION" \
+            "flip-evaluator==$FLIP_VERSION" >&2
     fi
 
     # --- check: llvm_ad_rgb really runs, with several threads -------------
