@@ -22,10 +22,11 @@ const MAX_THREADS: i64 = 1024;
 const RENDER_HELP: &str = "\
 The image and a checkpoint (OUTPUT.lumen-ckpt unless --checkpoint says
 otherwise) are saved after the first pass, then after a pass once saving
-takes at most 5 % of the time (or every --checkpoint-interval; 0: after every
-pass); the checkpoint is removed when the render completes. While it runs, the render
-holds a lock file beside each (.NAME.lumen-lock): a second render to the same
-image or checkpoint is refused. Only regular files are written.
+takes at most 5 % of the time (or every --checkpoint-interval; 0: after
+every pass); the checkpoint is removed when the render completes. While it
+runs, the render holds a lock file beside each (.NAME.lumen-lock): a second
+render to the same image or checkpoint is refused. Only regular files are
+written.
 
 Ctrl-C (or SIGTERM) stops the render: the pass in flight is abandoned and the
 image and checkpoint of the passes finished so far are saved; continue with
