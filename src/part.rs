@@ -11,7 +11,7 @@
 //! samples. A part file is a checkpoint ([`crate::checkpoint`]) of its
 //! share: it records the render's identity, the samples and pixels it
 //! takes, the samples done and the film's sums, with a checksum, is
-//! rewritten atomically after every pass (so a killed task resumes from
+//! rewritten atomically between passes (so a killed task resumes from
 //! it), and is complete once its share is done. Pixels sum their samples in fixed point ([`crate::film::Sum`]),
 //! whose addition is associative, so the parts' films add up to the
 //! one-machine film exactly, in any order. See `docs/distributed.md`.

@@ -393,7 +393,7 @@ struct ProgressiveArgs {
     #[arg(long, value_name = "DURATION", value_parser = parse_duration)]
     time_limit: Option<Duration>,
     /// With --denoise (or `denoise = true` in the scene), denoise the
-    /// image saved after every pass too, not only the finished one.
+    /// images saved between passes too, not only the finished one.
     #[arg(long)]
     denoise_previews: bool,
     /// Serve the image so far on a local web page (http://127.0.0.1:PORT,

@@ -28,7 +28,7 @@ pub(crate) fn resolved(path: &Path) -> PathBuf {
     }
 }
 
-/// The checkpoint is overwritten after every pass and deleted at the end:
+/// The checkpoint is overwritten between passes and deleted at the end:
 /// it must be neither the output image nor the scene file. (What is
 /// already at its path is looked at once the render holds its lock.)
 fn check_checkpoint_path(ckpt: &Path, out: &Path, scene: &str) -> Result<()> {
