@@ -148,7 +148,7 @@ fn a_second_render_to_the_same_files_is_refused_naming_the_first() {
     refused(status, &err, &["in use by another lumen render", &holder]);
     assert!(!other.exists());
     assert!(ckpt.exists(), "the running render's checkpoint was removed");
-    // Still the running render's (rewritten after every pass, its size
+    // Still the running render's (rewritten between passes, its size
     // changing with the samples it holds).
     let now = Checkpoint::read(&ckpt).unwrap();
     assert_eq!(now.description, saved.description);
