@@ -18,7 +18,6 @@ use std::ffi::OsStr;
 use std::fs;
 use std::io::Write;
 use std::net::TcpListener;
-use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -58,9 +57,28 @@ fn part_file(parts: &Path, index: u32, count: u32) -> PathBuf {
     lumen::part::file_name(parts, lumen::part::Part { index, count })
 }
 
+/// Writes an executable script. A child process writes it, so that this
+/// process never holds the file open: a test thread that spawned a command
+/// meanwhile would inherit the open file until its exec, and running the
+/// script then fails with "Text file busy" (ETXTBSY).
 fn write_executable(path: &Path, text: &str) {
-    fs::write(path, text).unwrap();
-    fs::set_permissions(path, fs::Permissions::from_mode(0o755)).unwrap();
+    let mut child = Command::new("sh")
+        .args(["-c", "cat > \"$1\" && chmod 755 \"$1\"", "sh"])
+        .arg(path)
+        .stdin(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    assert!(
+        child.wait().unwrap().success(),
+        "writing {}",
+        path.display()
+    );
 }
 
 fn text(bytes: &[u8]) -> String {
