@@ -32,9 +32,9 @@ while [ "$i" -le "$rounds" ]; do
     wait "$pa" "$pb"
     ta=$(seconds "$out/a.txt")
     tb=$(seconds "$out/b.txt")
-    r=$(awk -v a="$ta" -v b="$tb" 'BEGIN { printf "%.3f", a / b }')
+    r=$(ratio "$ta" "$tb")
     echo "round $i: A $ta s  B $tb s  speed B/A $r"
     ratios="$ratios $r"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | median "B/A"
+report "B/A" "$ratios"

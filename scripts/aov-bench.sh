@@ -46,9 +46,9 @@ while [ "$i" -le "$rounds" ]; do
     wait "$pa" "$pb"
     ta=$(cat "$out/off.s")
     tb=$(cat "$out/on.s")
-    r=$(awk -v a="$ta" -v b="$tb" 'BEGIN { printf "%.3f", a / b }')
+    r=$(ratio "$ta" "$tb")
     echo "round $i: without $ta s  with $tb s  speed with/without $r"
     ratios="$ratios $r"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | median "with/without"
+report "with/without" "$ratios"

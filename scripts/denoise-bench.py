@@ -53,8 +53,13 @@ def rgb(path):
 
 def render(lumen, scene, extra, width, spp, out):
     """Renders; returns (render seconds, denoise seconds or None)."""
-    command = [lumen, "render", scene, "--width", str(width), "--spp", str(spp),
-               "-o", out, "--checkpoint-interval", "1h"] + extra
+    return run_render([lumen, "render", scene, "--width", str(width), "--spp", str(spp),
+                       "-o", out, "--checkpoint-interval", "1h"] + extra)
+
+
+def run_render(command):
+    """Runs a `lumen render` command line; returns (render seconds, denoise
+    seconds or None) from its report, or exits with its error."""
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"{' '.join(command)} failed:\n{done.stderr}")

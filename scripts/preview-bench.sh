@@ -67,9 +67,9 @@ while [ "$i" -le "$rounds" ]; do
     fi
     ta=$(seconds "$out/plain.txt")
     tb=$(seconds "$out/watched.txt")
-    r=$(awk -v a="$ta" -v b="$tb" 'BEGIN { printf "%.3f", a / b }')
+    r=$(ratio "$ta" "$tb")
     echo "round $i: without $ta s  with the page $tb s  speed $r"
     ratios="$ratios $r"
     i=$((i + 1))
 done
-echo "$ratios" | tr ' ' '\n' | grep . | median "speed with the page / without:"
+report "speed with the page / without:" "$ratios"

@@ -142,8 +142,8 @@ pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseErr
             threads,
         )?;
         // The HDR filter can leave tiny negative values and, given
-        // values it cannot represent, NaN: neither belongs in an image.
-        let clean = |c: Color| Color::new(clean(c.x), clean(c.y), clean(c.z));
+        // values it cannot represent, NaN, and a highlight is NaN where
+        // the input was: neither belongs in an image.
         for (c, h) in out.iter_mut().zip(&highlights) {
             *c = clean(clean(*c) + *h);
         }
@@ -161,21 +161,19 @@ pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseErr
 /// that (0 elsewhere).
 pub fn split_highlights(color: &[Color]) -> (Vec<Color>, Vec<Color>) {
     // In a fixed order, so that the same image gives the same bits.
-    let finite = color.iter().map(|&c| f64::from(luminance(c)));
-    let sum: f64 = finite.filter(|l| l.is_finite()).sum();
+    let luminances = color.iter().map(|&c| f64::from(luminance(c)));
+    let sum: f64 = luminances.filter(|l| l.is_finite()).sum();
     let limit = (HIGHLIGHT_FACTOR * sum / color.len().max(1) as f64).max(0.0) as f32;
     let base: Vec<Color> = color.iter().map(|c| c.min(Color::splat(limit))).collect();
     let highlights = color.iter().zip(&base).map(|(c, b)| *c - *b).collect();
     (base, highlights)
 }
 
+/// `c` with every channel that is not finite and positive made 0.
 #[cfg(feature = "oidn")]
-fn clean(v: f32) -> f32 {
-    if v > 0.0 && v.is_finite() {
-        v
-    } else {
-        0.0
-    }
+fn clean(c: Color) -> Color {
+    let v = |v: f32| if v > 0.0 && v.is_finite() { v } else { 0.0 };
+    Color::new(v(c.x), v(c.y), v(c.z))
 }
 
 /// The film's image denoised, with its albedo and normal layers as the

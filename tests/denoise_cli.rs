@@ -34,6 +34,7 @@ fn denoise(input: &Path, out: &Path) -> Output {
         out.to_str().unwrap(),
     ])
 }
+
 #[test]
 fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
     let dir = temp_dir("denoise-layers");

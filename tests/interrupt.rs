@@ -131,11 +131,8 @@ fn sigkill_during_checkpoint_writes_leaves_a_usable_checkpoint() {
         rounds += 1;
         let resume = ckpt_path.exists();
         // Saved after every pass: as many writes to land in as there are.
-        let extra: &[&str] = if resume {
-            &["--checkpoint-interval", "0", "--resume"]
-        } else {
-            &["--checkpoint-interval", "0"]
-        };
+        let all = ["--checkpoint-interval", "0", "--resume"];
+        let extra = if resume { &all[..] } else { &all[..2] };
         let r = spawn(RENDER, &out, extra);
         // The name lumen::output::temp_path gives in the child process.
         let tmp = dir.join(format!(".killed.pfm.lumen-ckpt.{}.tmp", r.child.id()));

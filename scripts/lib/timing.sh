@@ -10,6 +10,17 @@ seconds() {
     echo "$t"
 }
 
+# $1 / $2 to three decimals: a speed ratio from two times.
+ratio() {
+    awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a / b }'
+}
+
+# Prints "$1 median M (range A to B, N rounds)" of the ratios in $2
+# (separated by spaces).
+report() {
+    echo "$2" | tr ' ' '\n' | grep . | median "$1"
+}
+
 # Reads one ratio a line; prints "$1 median M (range A to B, N rounds)".
 median() {
     sort -n | awk -v label="$1" '

@@ -211,13 +211,9 @@ def run_lumen(a, name, spp, out, denoise, seed=None, nice=False, extra=()):
     if a.nice or nice:
         command = ["nice", "-n", "19"] + command
     t0 = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True)
+    seconds, denoise_s = a.bench.run_render(command)
     wall = time.perf_counter() - t0
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(command)} failed:\n{done.stderr}")
-    seconds = float(re.search(r"^time ([0-9.]+) s", done.stderr, re.M).group(1))
-    d = re.search(r"^denoised in ([0-9.]+) s", done.stderr, re.M)
-    return {"wall_s": wall, "time_s": seconds, "denoise_s": float(d.group(1)) if d else None}
+    return {"wall_s": wall, "time_s": seconds, "denoise_s": denoise_s}
 
 
 def cycles_file(a, name):
