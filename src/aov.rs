@@ -5,9 +5,13 @@
 //! - **albedo**: the colour of the first surface a camera path meets that is
 //!   not a perfect mirror or clear glass, independent of the light. Such
 //!   delta surfaces are followed, their tint (the sample's weight) carried
-//!   on; the albedo is then the lobe's own colour (see
-//!   [`Lobe::feature_albedo`](crate::bsdf::Lobe::feature_albedo)), times
-//!   that tint, clamped to [0, 1]. A path that escapes takes the sky's
+//!   on, and so are near mirrors: microfacets no wider than
+//!   [`NEAR_MIRROR_ALPHA`](crate::bsdf::microfacet::NEAR_MIRROR_ALPHA), or
+//!   layered surfaces that reflect three quarters of their light or more
+//!   by such layers (Blender Cycles' rule). The albedo is then the lobe's
+//!   own colour (see
+//!   [`Lobe::feature_albedo_seen`](crate::bsdf::Lobe::feature_albedo_seen)),
+//!   times that tint, clamped to [0, 1]. A path that escapes takes the sky's
 //!   colour (clamped); one that meets a light without a surface, or
 //!   scatters in a medium before any surface, the tint (white where there
 //!   was none).

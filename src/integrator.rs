@@ -335,9 +335,12 @@ fn bounce(
         }
         return done(path.radiance);
     };
-    if bsdf.lobe.flags().is_spread() {
-        if let Some(s) = search.take() {
-            s.seen(bsdf.lobe.feature_albedo(), bsdf.frame.n);
+    if bsdf.lobe.flags().is_spread() && search.is_some() {
+        // A near mirror is looked through, as a delta is.
+        if let Some(albedo) = bsdf.lobe.feature_albedo_seen(bsdf.frame.to_local(wo)) {
+            if let Some(s) = search.take() {
+                s.seen(albedo, bsdf.frame.n);
+            }
         }
     }
     if last && !scene.volumetric {

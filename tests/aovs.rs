@@ -117,6 +117,86 @@ fn a_mirror_passes_on_the_albedo_it_shows_times_its_tint() {
     }
 }
 
+/// The albedo and normal features of a floor of `material` (TOML fields)
+/// under a wall facing it (albedo [`WALL`]), seen straight down: their
+/// means over the image.
+fn floor_under_a_wall(name: &str, material: &str) -> (Color, Vec3) {
+    let dir = scratch_dir(name);
+    let text = looking_down(
+        16,
+        &format!(
+            "[materials.floor]\n{material}\n\
+             [materials.wall]\ntype = \"diffuse\"\nalbedo = [{}, {}, {}]\n{}{}",
+            WALL.x,
+            WALL.y,
+            WALL.z,
+            square(0.0, "floor", true),
+            square(10.0, "wall", false)
+        ),
+    );
+    let scene = compile_file(&dir, "floor.toml", &text);
+    let (film, _) = render_with_threads(&scene, 2);
+    let n = film.len() as f32;
+    let albedo = (0..film.len())
+        .map(|i| film.feature(Layer::Albedo, i))
+        .sum::<Vec3>()
+        / n;
+    let normal = (0..film.len())
+        .map(|i| film.feature(Layer::Normal, i))
+        .sum::<Vec3>()
+        / n;
+    (albedo, normal)
+}
+
+const WALL: Color = Color::new(0.5, 0.25, 0.125);
+
+#[test]
+fn a_near_mirror_is_looked_through_and_a_rougher_surface_is_not() {
+    // Roughness 0.2 is α = 0.04, a near mirror (α ≤ 0.075): the wall it
+    // reflects is what the features show, tinted by the metal; at 0.5
+    // (α = 0.25) the metal itself is.
+    for (metal, colour) in [
+        ("type = \"conductor\"\nmetal = \"Au\"", None),
+        (
+            "type = \"principled\"\nbase_color = [0.9, 0.6, 0.3]\nmetallic = 1",
+            Some(Color::new(0.9, 0.6, 0.3)),
+        ),
+    ] {
+        let (rough_albedo, rough_normal) =
+            floor_under_a_wall("aov-rough-metal", &format!("{metal}\nroughness = 0.5"));
+        assert!(
+            rough_normal.abs_diff_eq(Vec3::Z, 1e-5),
+            "{metal}: {rough_normal}"
+        );
+        if let Some(c) = colour {
+            assert!(rough_albedo.abs_diff_eq(c, 1e-5), "{metal}: {rough_albedo}");
+        }
+        let (albedo, normal) =
+            floor_under_a_wall("aov-near-mirror", &format!("{metal}\nroughness = 0.2"));
+        assert!(normal.z < -0.99, "{metal}: the wall's normal, not {normal}");
+        // The tint of a near mirror is its reflectance, the rough one's
+        // albedo, give or take what its microfacets shadow.
+        let expected = rough_albedo * WALL;
+        for c in 0..3 {
+            assert!(
+                (albedo[c] / expected[c] - 1.0).abs() < 0.03,
+                "{metal}: albedo {albedo}, expected about {expected}"
+            );
+        }
+    }
+    // A glTF dielectric of a coloured base reflects a little by a
+    // near-mirror layer, and mostly diffuses: the surface itself is seen.
+    let (albedo, normal) = floor_under_a_wall(
+        "aov-red-gltf",
+        "type = \"principled\"\nbase_color = [0.8, 0.1, 0.1]\nroughness = 0.2",
+    );
+    assert!(
+        albedo.abs_diff_eq(Color::new(0.8, 0.1, 0.1), 1e-5),
+        "{albedo}"
+    );
+    assert!(normal.abs_diff_eq(Vec3::Z, 1e-5), "{normal}");
+}
+
 #[test]
 fn glass_over_a_floor_shows_the_floor_as_often_as_light_gets_through() {
     let dir = scratch_dir("aov-glass");

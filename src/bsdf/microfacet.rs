@@ -74,6 +74,13 @@ fn erf(x: f32) -> f32 {
     y.copysign(x)
 }
 
+/// The widest microfacets (α, or √(αx αy) when anisotropic) that the
+/// feature buffers still follow as a mirror (see [`crate::aov`]): what
+/// such a surface shows is a sharp reflection of what lies beyond it, not
+/// detail of its own. Blender Cycles' threshold for its denoising features;
+/// a glTF roughness of about 0.27.
+pub const NEAR_MIRROR_ALPHA: f32 = 0.075;
+
 impl Microfacet {
     /// The distribution with widths α (each clamped to at least 10⁻⁴).
     pub fn new(alpha_x: f32, alpha_y: f32, model: Model) -> Self {
@@ -88,6 +95,13 @@ impl Microfacet {
     #[inline]
     pub fn is_smooth(alpha_x: f32, alpha_y: f32) -> bool {
         alpha_x.max(alpha_y) < SMOOTH_ALPHA
+    }
+
+    /// Whether it is smooth enough for the feature buffers to look through
+    /// it as through a mirror (see [`NEAR_MIRROR_ALPHA`]).
+    #[inline]
+    pub fn is_near_mirror(&self) -> bool {
+        self.alpha_x * self.alpha_y <= NEAR_MIRROR_ALPHA * NEAR_MIRROR_ALPHA
     }
 
     /// D(wm): the density of microfacet normals per unit projected area of

@@ -40,6 +40,7 @@ pub mod thin_dielectric;
 
 use crate::math::{Color, Vec3};
 use crate::sampler::{Dim, Sampler};
+use microfacet::Microfacet;
 
 /// An orthonormal frame: tangent `t`, bitangent `b` and normal `n`, with
 /// `t × b = n`.
@@ -200,6 +201,11 @@ impl BsdfSample {
     }
 }
 
+/// The share of a layered lobe's reflectance in near-mirror layers from
+/// which the feature buffers look through it (see
+/// [`Lobe::feature_albedo_seen`]).
+const NEAR_MIRROR_SHARE: f32 = 0.75;
+
 /// The lobe of a [`Bsdf`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Lobe {
@@ -262,6 +268,25 @@ impl Lobe {
             Lobe::Plastic(p) => p.albedo,
             Lobe::Principled(p) => p.base_color,
         }
+    }
+
+    /// Its colour for the albedo feature buffer seen along local `wo`, or
+    /// `None` where the feature buffers look through it to what it
+    /// reflects, as through a delta lobe: a conductor or glass whose
+    /// microfacets are near mirrors ([`Microfacet::is_near_mirror`]), or a
+    /// coated or glTF surface that reflects three quarters or more of what
+    /// it reflects at all by such layers (as Blender Cycles decides).
+    #[inline]
+    pub fn feature_albedo_seen(&self, wo: Vec3) -> Option<Color> {
+        let near_mirror = |m: &Option<Microfacet>| m.is_some_and(|m| m.is_near_mirror());
+        let followed = match self {
+            Lobe::Conductor(c) => near_mirror(&c.roughness),
+            Lobe::ExactDielectric(d) => near_mirror(&d.roughness),
+            Lobe::Plastic(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
+            Lobe::Principled(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
+            _ => false,
+        };
+        (!followed).then(|| self.feature_albedo())
     }
 
     /// A direction for light leaving along local `wo`, from `uc` (a

@@ -76,6 +76,24 @@ impl Plastic {
         }
     }
 
+    /// The share of what it reflects along `wo` that its coat reflects,
+    /// if the coat is a near mirror (0 otherwise): the coat's reflectance
+    /// against the base's albedo seen through it (see
+    /// [`Lobe::feature_albedo_seen`](super::Lobe::feature_albedo_seen)).
+    pub fn near_mirror_share(&self, wo: Vec3) -> f32 {
+        if self.roughness.is_some_and(|m| !m.is_near_mirror()) {
+            return 0.0;
+        }
+        let t = self.transmittance(wo.z.abs());
+        let base = t * (self.albedo.x + self.albedo.y + self.albedo.z) / 3.0;
+        let coat = 1.0 - t;
+        if coat + base > 0.0 {
+            coat / (coat + base)
+        } else {
+            0.0
+        }
+    }
+
     /// The fraction of the base's diffuse light the coat reflects back.
     #[inline]
     fn internal_reflectance(&self) -> f32 {

@@ -197,6 +197,44 @@ impl Principled {
         }
     }
 
+    /// The share of what it reflects and transmits along `wo` that goes by
+    /// layers whose microfacets are near mirrors (see
+    /// [`Lobe::feature_albedo_seen`](super::Lobe::feature_albedo_seen)):
+    /// each layer's reflectance estimated from its Fresnel factor at the
+    /// view, as [`Principled::weights`] estimates them to choose a layer.
+    pub fn near_mirror_share(&self, wo: Vec3) -> f32 {
+        let mu = wo.z.abs();
+        let coat = self.coat_weight(wo);
+        let under = (1.0 - coat) * self.sheen_scale(mu);
+        let m = self.metallic;
+        let metal = mean(self.base_color + (Color::ONE - self.base_color) * fifth(mu));
+        let fd = self.dielectric_fresnel(mu).max_element();
+        let specular = under * (m * metal + (1.0 - m) * fd);
+        let base = under * (1.0 - m) * (1.0 - fd) * mean(self.base_color);
+        // The transmitted part is refracted through the specular
+        // microfacets; the rest of the base is diffuse.
+        let transmitted = base * self.transmission;
+        let diffuse = base - transmitted;
+        let sheen = if self.sheen_color.max_element() > 0.0 {
+            (1.0 - coat) * self.sheen_color.max_element() * sheen::albedo(self.sheen_roughness, mu)
+        } else {
+            0.0
+        };
+        let mut mirror = 0.0;
+        if self.clearcoat > 0.0 && self.coat.is_near_mirror() {
+            mirror += coat;
+        }
+        if self.specular.is_near_mirror() {
+            mirror += specular + transmitted;
+        }
+        let total = coat + specular + transmitted + diffuse + sheen;
+        if total > 0.0 {
+            mirror / total
+        } else {
+            0.0
+        }
+    }
+
     /// The frame of the coat's normal, when it is not the shading normal.
     #[inline]
     fn coat_frame(&self) -> Option<Frame> {

@@ -1121,3 +1121,48 @@ fn no_nan_at_the_edges() {
         }
     }
 }
+
+#[test]
+fn feature_buffers_look_through_near_mirrors_only() {
+    let wo = Vec3::new(0.3, 0.0, 0.954).normalize();
+    let plastic = |albedo: f32, roughness: Option<Microfacet>| {
+        Lobe::Plastic(Plastic {
+            albedo: Color::splat(albedo),
+            eta: 1.5,
+            roughness,
+            coat: None,
+            multiscatter: false,
+            nonlinear: true,
+        })
+    };
+    let near = Microfacet::new(0.05, 0.05, Model::Ggx);
+    let rough = Microfacet::new(0.2, 0.2, Model::Ggx);
+    // A black base under a smooth or near-mirror coat shows only its
+    // coat's reflection; a white one is mostly its base; a rough coat is
+    // never looked through.
+    for coat in [None, Some(near)] {
+        assert_eq!(plastic(0.0, coat).feature_albedo_seen(wo), None);
+        assert!(plastic(0.8, coat).feature_albedo_seen(wo).is_some());
+    }
+    assert!(plastic(0.0, Some(rough)).feature_albedo_seen(wo).is_some());
+    let gold = |m| {
+        Lobe::Conductor(Conductor {
+            eta: Color::new(0.2, 0.4, 1.4),
+            k: Color::new(3.6, 2.4, 1.8),
+            tint: Color::ONE,
+            roughness: Some(m),
+            multiscatter: false,
+        })
+    };
+    assert_eq!(gold(near).feature_albedo_seen(wo), None);
+    assert_eq!(
+        gold(rough).feature_albedo_seen(wo),
+        Some(gold(rough).feature_albedo())
+    );
+    // The anisotropic width is the geometric mean: 0.2 × 0.02 is a near
+    // mirror (√0.004 ≈ 0.063).
+    assert_eq!(
+        gold(Microfacet::new(0.2, 0.02, Model::Ggx)).feature_albedo_seen(wo),
+        None
+    );
+}
