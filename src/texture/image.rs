@@ -2,7 +2,7 @@
 //! and JPEG as the file stores them (8 or 16 bits a channel, with alpha),
 //! decoded from sRGB, or read as linear data, at each lookup.
 
-use crate::math::Color;
+use crate::math::{floor_i64, wrap_index, Color};
 use std::path::Path;
 
 /// An image, row by row from the top: 8- and 16-bit images as they are
@@ -319,7 +319,7 @@ impl Image {
     /// a surface whose (u, v) run past [0, 1]).
     #[inline]
     pub fn bilinear_repeat(&self, u: f32, v: f32) -> Color {
-        self.bilinear(u, v, i64::rem_euclid)
+        self.bilinear(u, v, wrap_index)
     }
 
     /// Bilinear interpolation, wrapping in u, with `row(y, height)` placing
@@ -328,11 +328,11 @@ impl Image {
     fn bilinear(&self, u: f32, v: f32, row: impl Fn(i64, i64) -> i64) -> Color {
         let x = u * self.width as f32 - 0.5;
         let y = v * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (floor_i64(x), floor_i64(y));
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
         let (w, h) = (self.width as i64, self.height as i64);
-        let (xa, xb) = ((x0 as i64).rem_euclid(w), (x0 as i64 + 1).rem_euclid(w));
-        let (ya, yb) = (row(y0 as i64, h), row(y0 as i64 + 1, h));
+        let (xa, xb) = (wrap_index(x0, w), wrap_index(x0 + 1, w));
+        let (ya, yb) = (row(y0, h), row(y0 + 1, h));
         let at = |x: i64, y: i64| self.texel(x as usize, y as usize);
         let top = at(xa, ya).lerp(at(xb, ya), fx);
         let bottom = at(xa, yb).lerp(at(xb, yb), fx);

@@ -6,6 +6,7 @@
 
 use super::image::Image;
 use super::TexCoords;
+use crate::math::floor_i64;
 use std::sync::Arc;
 
 /// What a coordinate outside [0, 1] reads.
@@ -25,6 +26,10 @@ impl Wrap {
     /// wide.
     #[inline]
     fn place(self, i: i64, n: i64) -> usize {
+        // Inside the image every mode leaves it where it is.
+        if (0..n).contains(&i) {
+            return i as usize;
+        }
         (match self {
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
@@ -153,12 +158,11 @@ impl ImageMap {
         }
         let at = |x: i64, y: i64| image.texel_rgba(wu.place(x, w), wv.place(y, h), self.srgb);
         match self.filter {
-            Filter::Nearest => at(x.floor() as i64, y.floor() as i64),
+            Filter::Nearest => at(floor_i64(x), floor_i64(y)),
             Filter::Bilinear => {
                 let (x, y) = (x - 0.5, y - 0.5);
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = (x - x0, y - y0);
-                let (xa, ya) = (x0 as i64, y0 as i64);
+                let (xa, ya) = (floor_i64(x), floor_i64(y));
+                let (fx, fy) = (x - xa as f32, y - ya as f32);
                 let (p, q, r, s) = (
                     at(xa, ya),
                     at(xa + 1, ya),
