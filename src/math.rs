@@ -48,6 +48,36 @@ pub fn floor_i64(x: f32) -> i64 {
     }
 }
 
+/// atan2(y, x), the angle of finite (x, y) in [−π, π], to within 3·10⁻⁷ radians
+/// (`tests`): libm's `atan2f` is a call of some hundred instructions, which
+/// every lookup of an environment map made twice. Range reduction to
+/// |t| ≤ tan(π/8) and a polynomial in t² (the coefficients of Cephes'
+/// `atanf`).
+#[inline]
+pub fn atan2(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let steep = ay > ax;
+    let (a, b) = if steep { (ay, ax) } else { (ax, ay) };
+    // t in [0, 1]: the tangent of the angle from the nearer axis.
+    let t = if a == 0.0 { 0.0 } else { b / a };
+    let (base, t) = if t > 0.414_213_57 {
+        (FRAC_PI_4, (t - 1.0) / (t + 1.0))
+    } else {
+        (0.0, t)
+    };
+    let z = t * t;
+    let p = (((0.080_537_445 * z - 0.138_776_86) * z + 0.199_777_1) * z - 0.333_329_5) * z * t + t;
+    let mut angle = base + p;
+    if steep {
+        angle = FRAC_PI_2 - angle;
+    }
+    if x.is_sign_negative() {
+        angle = PI - angle;
+    }
+    angle.copysign(y)
+}
+
 /// `i.rem_euclid(n)` (n > 0), without the division where `i` already lies
 /// in `0..n`, as a texel index nearly always does.
 #[inline(always)]
@@ -123,5 +153,34 @@ mod tests {
                 assert_eq!(wrap_index(i, n), i.rem_euclid(n), "{i} in {n}");
             }
         }
+    }
+
+    #[test]
+    fn atan2_is_within_three_tenths_of_a_microradian_of_the_library() {
+        let mut worst = 0.0f64;
+        let n = 2000;
+        for i in 0..=n {
+            // Every direction of the circle, and the axes' signed zeros.
+            let phi = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+            for r in [1.0f64, 1e-3, 37.0] {
+                let (y, x) = ((r * phi.sin()) as f32, (r * phi.cos()) as f32);
+                let exact = f64::from(y).atan2(f64::from(x));
+                worst = worst.max((f64::from(atan2(y, x)) - exact).abs());
+            }
+        }
+        assert!(worst < 3e-7, "worst error {worst}");
+        for (y, x) in [
+            (0.0f32, 1.0f32),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (0.0, -0.0),
+            (-0.0, -0.0),
+        ] {
+            assert_eq!(atan2(y, x), y.atan2(x), "atan2({y}, {x})");
+        }
+        assert!(atan2(f32::NAN, 1.0).is_nan() && atan2(1.0, f32::NAN).is_nan());
     }
 }

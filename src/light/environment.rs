@@ -5,7 +5,7 @@
 
 use super::luminance;
 use crate::distribution::Distribution2D;
-use crate::math::{lerp, Color, Vec3};
+use crate::math::{atan2, lerp, Color, Vec3};
 use crate::sampling::sin_cos_turns;
 use crate::texture::Image;
 use std::f32::consts::PI;
@@ -332,10 +332,10 @@ impl EnvironmentMap {
         let (s, c) = self.rotation;
         let x = c * direction.x - s * direction.z;
         let z = s * direction.x + c * direction.z;
-        let u = 0.5 + x.atan2(-z) * (0.5 / PI);
+        let u = 0.5 + atan2(x, -z) * (0.5 / PI);
         // θ from its sine and cosine: acos(y) loses the digits near the
         // poles.
-        let v = (x * x + z * z).sqrt().atan2(direction.y) / PI;
+        let v = atan2((x * x + z * z).sqrt(), direction.y) / PI;
         [u.rem_euclid(1.0), v.clamp(0.0, 1.0)]
     }
 
