@@ -76,6 +76,11 @@ pub struct Inputs<'a> {
     pub albedo: Option<&'a [Vec3]>,
     /// The normal buffer (unit or zero vectors); only with an albedo.
     pub normal: Option<&'a [Vec3]>,
+    /// The variance of each pixel's value (the `variance` feature buffer):
+    /// with it the filter's output is blended back towards the noisy
+    /// image where the two differ by more than the noise explains (see
+    /// [`blend`]).
+    pub variance: Option<&'a [Color]>,
 }
 
 impl Inputs<'_> {
@@ -84,8 +89,13 @@ impl Inputs<'_> {
         if n == 0 {
             return Err(DenoiseError::BadInput("an image without pixels".into()));
         }
-        let sizes = [Some(self.color), self.albedo, self.normal];
-        if sizes.iter().flatten().any(|b| b.len() != n) {
+        let sizes = [
+            Some(self.color.len()),
+            self.albedo.map(<[Vec3]>::len),
+            self.normal.map(<[Vec3]>::len),
+            self.variance.map(<[Color]>::len),
+        ];
+        if sizes.iter().flatten().any(|&len| len != n) {
             return Err(DenoiseError::BadInput(format!(
                 "buffers of a {}x{} image must hold {n} pixels each",
                 self.width, self.height
@@ -147,6 +157,9 @@ pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseErr
         for (c, h) in out.iter_mut().zip(&highlights) {
             *c = clean(clean(*c) + *h);
         }
+        if let Some(variance) = inputs.variance {
+            blend(&mut out, inputs.color, variance, inputs.width);
+        }
         Ok(out)
     }
     #[cfg(not(feature = "oidn"))]
@@ -154,6 +167,85 @@ pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseErr
         let _ = threads;
         Err(DenoiseError::NotBuilt)
     }
+}
+
+/// Half the side of the square of pixels over which [`blend`] averages
+/// the noise and the change (5 × 5).
+pub const BLEND_RADIUS: usize = 2;
+
+/// Moves each `denoised` pixel back towards the `noisy` one where the
+/// filter changed the image by more than its noise explains.
+///
+/// The noisy pixel n is unbiased with variance σ² (`variance`, averaged
+/// over the channels); the denoised d has little variance but a bias b.
+/// Of the blends n + α(d − n), the one of least expected squared error has
+/// α = σ² / (σ² + b²), and E[(d − n)²] ≈ σ² + b² estimates the
+/// denominator. Both are averaged over the [`BLEND_RADIUS`] square around
+/// the pixel, as a single pixel's are too noisy to weigh by:
+/// α = ⟨σ²⟩ / max(⟨(d − n)²⟩, ⟨σ²⟩). Where the filter only took noise away,
+/// α is near 1 and the denoised image stays; where it smoothed detail
+/// that the samples had already resolved (fine texture, normal-mapped
+/// bumps, reflections at many samples per pixel), the difference dwarfs
+/// the noise and the pixel goes back towards the samples'.
+///
+/// A variance buffer that is 0 everywhere (one sample a pixel, or a
+/// constant image) says nothing about the noise; the image is left as
+/// denoised.
+pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width: usize) {
+    let mean = |c: Color| (f64::from(c.x) + f64::from(c.y) + f64::from(c.z)) / 3.0;
+    let noise: Vec<f64> = variance.iter().map(|&v| mean(v).max(0.0)).collect();
+    if !noise.iter().any(|&v| v > 0.0) {
+        return;
+    }
+    let change: Vec<f64> = denoised
+        .iter()
+        .zip(noisy)
+        .map(|(&d, &n)| {
+            let e = d - n;
+            mean(e * e)
+        })
+        .collect();
+    let noise = box_mean(&noise, width, BLEND_RADIUS);
+    let change = box_mean(&change, width, BLEND_RADIUS);
+    for (i, (d, &n)) in denoised.iter_mut().zip(noisy).enumerate() {
+        // Where every sample agreed (no noise), any change is the
+        // filter's own and α is 0.
+        let alpha = if change[i] > noise[i] {
+            (noise[i] / change[i]) as f32
+        } else {
+            1.0
+        };
+        *d = clean(n + (*d - n) * alpha);
+    }
+}
+
+/// The mean of `values` (an image `width` wide) over the square of side
+/// 2 `radius` + 1 around each pixel, the edge pixels repeated beyond the
+/// image: a running sum along the rows, then along the columns.
+fn box_mean(values: &[f64], width: usize, radius: usize) -> Vec<f64> {
+    let height = values.len() / width;
+    let along = |len: usize, get: &dyn Fn(usize) -> f64, out: &mut dyn FnMut(usize, f64)| {
+        let at = |i: isize| get(i.clamp(0, len as isize - 1) as usize);
+        let r = radius as isize;
+        let mut sum: f64 = (-r..=r).map(at).sum();
+        for i in 0..len as isize {
+            out(i as usize, sum);
+            sum += at(i + r + 1) - at(i - r);
+        }
+    };
+    let mut rows = vec![0.0; values.len()];
+    for y in 0..height {
+        let row = &values[y * width..(y + 1) * width];
+        along(width, &|x| row[x], &mut |x, v| rows[y * width + x] = v);
+    }
+    let k = (2 * radius + 1) as f64;
+    let mut out = vec![0.0; values.len()];
+    for x in 0..width {
+        along(height, &|y| rows[y * width + x], &mut |y, v| {
+            out[y * width + x] = v / (k * k)
+        });
+    }
+    out
 }
 
 /// `color` split into what the filter sees, each channel at most
@@ -170,7 +262,6 @@ pub fn split_highlights(color: &[Color]) -> (Vec<Color>, Vec<Color>) {
 }
 
 /// `c` with every channel that is not finite and positive made 0.
-#[cfg(feature = "oidn")]
 fn clean(c: Color) -> Color {
     let v = |v: f32| if v > 0.0 && v.is_finite() { v } else { 0.0 };
     Color::new(v(c.x), v(c.y), v(c.z))
@@ -188,6 +279,11 @@ pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseEr
     let color = film.linear();
     let albedo = layer(Layer::Albedo);
     let normal = albedo.as_ref().and(layer(Layer::Normal));
+    let variance = layers.has(Layer::Moment).then(|| {
+        (0..film.len())
+            .map(|i| film.variance(i))
+            .collect::<Vec<_>>()
+    });
     denoise(
         &Inputs {
             width: film.width() as usize,
@@ -195,6 +291,7 @@ pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseEr
             color: &color,
             albedo: albedo.as_deref(),
             normal: normal.as_deref(),
+            variance: variance.as_deref(),
         },
         threads,
     )
@@ -273,6 +370,8 @@ pub struct Guided {
     pub albedo: Vec<Vec3>,
     /// Its shading normals.
     pub normal: Vec<Vec3>,
+    /// The variance of its pixels, if the file has a `variance` layer.
+    pub variance: Option<Vec<Color>>,
 }
 
 /// The three channels of a layer the denoiser reads, as lumen writes them
@@ -280,6 +379,7 @@ pub struct Guided {
 /// albedo's `albedo.R`…; the normal's `normal.X`… or `normal.R`….
 const BEAUTY: [&[&str]; 1] = [&["R", "G", "B"]];
 const ALBEDO: [&[&str]; 1] = [&["albedo.R", "albedo.G", "albedo.B"]];
+const VARIANCE: [&[&str]; 1] = [&["variance.R", "variance.G", "variance.B"]];
 const NORMAL: [&[&str]; 2] = [
     &["normal.X", "normal.Y", "normal.Z"],
     &["normal.R", "normal.G", "normal.B"],
@@ -408,6 +508,7 @@ impl ExrChannels {
             color: beauty,
             albedo,
             normal,
+            variance: self.layer(&VARIANCE),
         })
     }
 }
@@ -415,6 +516,72 @@ impl ExrChannels {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn box_mean_is_the_mean_over_the_square_with_edges_repeated() {
+        let (w, h) = (7, 5);
+        let values: Vec<f64> = (0..w * h).map(|i| ((i * 37) % 11) as f64).collect();
+        let out = box_mean(&values, w, 2);
+        for y in 0..h as isize {
+            for x in 0..w as isize {
+                let mut sum = 0.0;
+                for dy in -2..=2 {
+                    for dx in -2..=2 {
+                        let (xx, yy) = (
+                            (x + dx).clamp(0, w as isize - 1),
+                            (y + dy).clamp(0, h as isize - 1),
+                        );
+                        sum += values[yy as usize * w + xx as usize];
+                    }
+                }
+                let got = out[y as usize * w + x as usize];
+                assert!((got - sum / 25.0).abs() < 1e-12, "({x}, {y}): {got}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_blend_keeps_what_took_noise_away_and_undoes_what_took_detail() {
+        let (w, h) = (32, 32);
+        let mut rng = crate::rng::Rng::new(3);
+        let sigma = 0.05f32;
+        // A flat truth: the "filter" returned it exactly, the noisy image
+        // is it plus noise of variance σ². The change is all noise: α ≈ 1.
+        let truth = vec![Color::splat(0.5); w * h];
+        let noisy: Vec<Color> = truth
+            .iter()
+            .map(|c| *c + Color::splat((rng.next_f32() - 0.5) * sigma * 12f32.sqrt()))
+            .collect();
+        let variance = vec![Color::splat(sigma * sigma); w * h];
+        let mut out = truth.clone();
+        blend(&mut out, &noisy, &variance, w);
+        let err = |a: &[Color]| {
+            a.iter()
+                .zip(&truth)
+                .map(|(a, b)| f64::from((*a - *b).length_squared()))
+                .sum::<f64>()
+        };
+        assert!(
+            err(&out) < err(&noisy) / 5.0,
+            "{} against {}",
+            err(&out),
+            err(&noisy)
+        );
+        // A "filter" that flattened a resolved pattern (±0.3, six σ): the
+        // change dwarfs the noise, and the blend goes back to the samples.
+        let pattern: Vec<Color> = (0..w * h)
+            .map(|i| Color::splat(if i % 2 == 0 { 0.2 } else { 0.8 }))
+            .collect();
+        let mut out = vec![Color::splat(0.5); w * h];
+        blend(&mut out, &pattern, &variance, w);
+        for (o, p) in out.iter().zip(&pattern) {
+            assert!((o.x - p.x).abs() < 0.02, "{o} against {p}");
+        }
+        // No variance (a render of one sample a pixel): left as filtered.
+        let mut out = vec![Color::splat(0.5); w * h];
+        blend(&mut out, &pattern, &vec![Color::ZERO; w * h], w);
+        assert!(out.iter().all(|c| *c == Color::splat(0.5)));
+    }
 
     #[test]
     fn highlights_are_what_passes_ten_times_the_mean_luminance() {

@@ -84,7 +84,7 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
     assert!(file.desc.render.denoise);
     assert_eq!(
         file.desc.render.written_aovs(),
-        [Aov::Albedo, Aov::Normal, Aov::Depth]
+        [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance]
     );
     std::fs::write(&path, "[render]\ndenoise = 1\n").unwrap();
     let err = lumen::scene::file::SceneFile::read(&path)

@@ -89,6 +89,7 @@ pub(crate) fn denoise_command(input: &Path, out: &Path, gamma: f32) -> Result<Ex
             color: &guided.color,
             albedo: Some(&guided.albedo),
             normal: Some(&guided.normal),
+            variance: guided.variance.as_deref(),
         },
         rayon::current_num_threads(),
     )?;

@@ -287,8 +287,8 @@ pub struct RenderDesc {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub aovs: Vec<crate::aov::Aov>,
     /// Whether the finished image is denoised (see [`crate::denoise`]);
-    /// the film then keeps the albedo and normal buffers the denoiser
-    /// uses, and the image files carry them (see
+    /// the film then keeps the albedo, normal and variance buffers the
+    /// denoiser uses, and the image files carry them (see
     /// [`RenderDesc::written_aovs`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub denoise: bool,
@@ -311,12 +311,12 @@ fn is_box(f: &PixelFilterDesc) -> bool {
 
 impl RenderDesc {
     /// The feature buffers the render keeps and writes: `aovs`, with the
-    /// albedo and normal a denoised render needs, in
+    /// albedo, normal and variance a denoised render needs, in
     /// [`Aov::ALL`](crate::aov::Aov::ALL)'s order.
     pub fn written_aovs(&self) -> Vec<crate::aov::Aov> {
         use crate::aov::Aov;
         let needed: &[Aov] = if self.denoise {
-            &[Aov::Albedo, Aov::Normal]
+            &[Aov::Albedo, Aov::Normal, Aov::Variance]
         } else {
             &[]
         };
