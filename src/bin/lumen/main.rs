@@ -93,6 +93,8 @@ enum Command {
     /// Denoise an OpenEXR image that has albedo and normal layers (as
     /// `render --aov albedo,normal` or `--denoise` writes them) with Open
     /// Image Denoise: for split renders, merged first and denoised once.
+    /// With a variance layer the result is blended back towards the
+    /// samples where the filter changed more than the noise explains.
     /// See docs/denoising.md.
     Denoise {
         /// The noisy image: channels R, G, B, albedo.R/G/B and
@@ -339,9 +341,10 @@ struct SettingArgs {
     #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
     aov: Option<AovList>,
     /// Denoise the finished image with Open Image Denoise (builds with the
-    /// `oidn` feature; see docs/denoising.md). The albedo and normal
-    /// buffers are kept and written, and the noisy image is written beside
-    /// it as NAME.noisy.EXT.
+    /// `oidn` feature; see docs/denoising.md), then blended back towards
+    /// the samples where the filter changed more than their noise
+    /// explains. The albedo, normal and variance buffers are kept and
+    /// written, and the noisy image is written beside it as NAME.noisy.EXT.
     #[arg(long)]
     denoise: bool,
     /// Let mesh files read files outside their folder (glTF buffers and
