@@ -193,7 +193,17 @@ pub const BLEND_RADIUS: usize = 2;
 /// denoised.
 pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width: usize) {
     let mean = |c: Color| (f64::from(c.x) + f64::from(c.y) + f64::from(c.z)) / 3.0;
-    let noise: Vec<f64> = variance.iter().map(|&v| mean(v).max(0.0)).collect();
+    // A file's variance may hold anything: what is not a finite
+    // variance counts as none.
+    let noise: Vec<f64> = variance
+        .iter()
+        .map(|&v| {
+            Some(mean(v))
+                .filter(|v| v.is_finite())
+                .unwrap_or(0.0)
+                .max(0.0)
+        })
+        .collect();
     if !noise.iter().any(|&v| v > 0.0) {
         return;
     }
@@ -202,7 +212,8 @@ pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width:
         .zip(noisy)
         .map(|(&d, &n)| {
             let e = d - n;
-            mean(e * e)
+            // A pixel that is not finite in the input says nothing.
+            Some(mean(e * e)).filter(|v| v.is_finite()).unwrap_or(0.0)
         })
         .collect();
     let noise = box_mean(&noise, width, BLEND_RADIUS);
@@ -211,7 +222,7 @@ pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width:
         // Where every sample agreed (no noise), any change is the
         // filter's own and α is 0.
         let alpha = if change[i] > noise[i] {
-            (noise[i] / change[i]) as f32
+            (noise[i] / change[i]).clamp(0.0, 1.0) as f32
         } else {
             1.0
         };
@@ -221,29 +232,30 @@ pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width:
 
 /// The mean of `values` (an image `width` wide) over the square of side
 /// 2 `radius` + 1 around each pixel, the edge pixels repeated beyond the
-/// image: a running sum along the rows, then along the columns.
+/// image: along the rows, then along the columns, each window summed
+/// afresh (a running sum would carry a firefly's rounding, or a NaN, on
+/// down the row).
 fn box_mean(values: &[f64], width: usize, radius: usize) -> Vec<f64> {
     let height = values.len() / width;
-    let along = |len: usize, get: &dyn Fn(usize) -> f64, out: &mut dyn FnMut(usize, f64)| {
-        let at = |i: isize| get(i.clamp(0, len as isize - 1) as usize);
-        let r = radius as isize;
-        let mut sum: f64 = (-r..=r).map(at).sum();
-        for i in 0..len as isize {
-            out(i as usize, sum);
-            sum += at(i + r + 1) - at(i - r);
-        }
+    let r = radius as isize;
+    let window = |len: usize, i: usize, get: &dyn Fn(usize) -> f64| -> f64 {
+        (-r..=r)
+            .map(|d| get((i as isize + d).clamp(0, len as isize - 1) as usize))
+            .sum()
     };
     let mut rows = vec![0.0; values.len()];
     for y in 0..height {
         let row = &values[y * width..(y + 1) * width];
-        along(width, &|x| row[x], &mut |x, v| rows[y * width + x] = v);
+        for x in 0..width {
+            rows[y * width + x] = window(width, x, &|x| row[x]);
+        }
     }
     let k = (2 * radius + 1) as f64;
     let mut out = vec![0.0; values.len()];
-    for x in 0..width {
-        along(height, &|y| rows[y * width + x], &mut |y, v| {
-            out[y * width + x] = v / (k * k)
-        });
+    for y in 0..height {
+        for x in 0..width {
+            out[y * width + x] = window(height, y, &|y| rows[y * width + x]) / (k * k);
+        }
     }
     out
 }
@@ -577,6 +589,19 @@ mod tests {
         for (o, p) in out.iter().zip(&pattern) {
             assert!((o.x - p.x).abs() < 0.02, "{o} against {p}");
         }
+        // A pixel that is not a number, in the image or its variance,
+        // leaves the output finite, and the blend goes on past it as
+        // before: far from it, the same pixels as without it.
+        let mut broken = pattern.clone();
+        broken[w + 1] = Color::splat(f32::NAN);
+        let mut broken_variance = variance.clone();
+        broken_variance[2 * w + 2] = Color::splat(f32::INFINITY);
+        let mut out = vec![Color::splat(0.5); w * h];
+        blend(&mut out, &broken, &broken_variance, w);
+        assert!(out.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
+        let mut reference = vec![Color::splat(0.5); w * h];
+        blend(&mut reference, &pattern, &variance, w);
+        assert_eq!(out[10 * w..], reference[10 * w..]);
         // No variance (a render of one sample a pixel): left as filtered.
         let mut out = vec![Color::splat(0.5); w * h];
         blend(&mut out, &pattern, &vec![Color::ZERO; w * h], w);
