@@ -177,13 +177,15 @@ fn overrides_replace_the_files_settings() {
         (LightSelection::Power, LightSelection::Uniform)
     );
     assert_eq!(own.settings.aovs, []);
-    // Denoising keeps the albedo and normal it needs beside those asked for.
+    // Denoising keeps the albedo, normal and variance it needs beside
+    // those asked for.
     assert!(!own.settings.denoise && s.denoise);
     assert_eq!(
         s.aovs,
         [
             lumen::aov::Aov::Albedo,
             lumen::aov::Aov::Normal,
+            lumen::aov::Aov::Variance,
             lumen::aov::Aov::Spp
         ]
     );
