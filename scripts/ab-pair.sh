@@ -17,6 +17,7 @@ pa=
 pb=
 trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"' EXIT
 trap 'kill $pa $pb 2>/dev/null; rm -rf "$out"; exit 130' INT TERM
+. "$(dirname "$0")/lib/timing.sh"
 
 # Runs binary $1 on core $2, its output to $3, in the background.
 bench() {
@@ -34,6 +35,7 @@ rays() {
     echo "$r"
 }
 
+ratios=
 i=0
 while [ "$i" -lt "$rounds" ]; do
     core_a=$((i % 2))
@@ -45,12 +47,10 @@ while [ "$i" -lt "$rounds" ]; do
     wait "$pb" || { cat "$out/b" >&2; exit 1; }
     ra=$(rays "$out/a")
     rb=$(rays "$out/b")
-    ratio=$(awk -v a="$ra" -v b="$rb" 'BEGIN {printf "%.3f", b / a}')
-    echo "round $((i + 1)): A $ra  B $rb M rays/s  B/A $ratio"
-    echo "$ratio" >>"$out/ratios"
+    # Rays per second: B's over A's.
+    r=$(ratio "$rb" "$ra")
+    echo "round $((i + 1)): A $ra  B $rb M rays/s  B/A $r"
+    ratios="$ratios $r"
     i=$((i + 1))
 done
-sort -n "$out/ratios" | awk '
-    { v[NR] = $1 }
-    END { m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2;
-          printf "B/A median %.3f (range %s to %s, %d rounds)\n", m, v[1], v[NR], NR }'
+report "B/A" "$ratios"

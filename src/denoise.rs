@@ -192,29 +192,24 @@ pub const BLEND_RADIUS: usize = 2;
 /// constant image) says nothing about the noise; the image is left as
 /// denoised.
 pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width: usize) {
-    let mean = |c: Color| (f64::from(c.x) + f64::from(c.y) + f64::from(c.z)) / 3.0;
-    // A file's variance may hold anything: what is not a finite
-    // variance counts as none.
-    let noise: Vec<f64> = variance
-        .iter()
-        .map(|&v| {
-            Some(mean(v))
-                .filter(|v| v.is_finite())
-                .unwrap_or(0.0)
-                .max(0.0)
-        })
-        .collect();
+    // The channels' mean; what is not finite (in a file's variance, or
+    // where the image is not a number) says nothing, and counts as 0.
+    let mean = |c: Color| {
+        let m = (f64::from(c.x) + f64::from(c.y) + f64::from(c.z)) / 3.0;
+        if m.is_finite() {
+            m
+        } else {
+            0.0
+        }
+    };
+    let noise: Vec<f64> = variance.iter().map(|&v| mean(v).max(0.0)).collect();
     if !noise.iter().any(|&v| v > 0.0) {
         return;
     }
     let change: Vec<f64> = denoised
         .iter()
         .zip(noisy)
-        .map(|(&d, &n)| {
-            let e = d - n;
-            // A pixel that is not finite in the input says nothing.
-            Some(mean(e * e)).filter(|v| v.is_finite()).unwrap_or(0.0)
-        })
+        .map(|(&d, &n)| mean((d - n) * (d - n)))
         .collect();
     let noise = box_mean(&noise, width, BLEND_RADIUS);
     let change = box_mean(&change, width, BLEND_RADIUS);
@@ -238,26 +233,27 @@ pub fn blend(denoised: &mut [Color], noisy: &[Color], variance: &[Color], width:
 fn box_mean(values: &[f64], width: usize, radius: usize) -> Vec<f64> {
     let height = values.len() / width;
     let r = radius as isize;
-    let window = |len: usize, i: usize, get: &dyn Fn(usize) -> f64| -> f64 {
-        (-r..=r)
-            .map(|d| get((i as isize + d).clamp(0, len as isize - 1) as usize))
-            .sum()
-    };
-    let mut rows = vec![0.0; values.len()];
-    for y in 0..height {
-        let row = &values[y * width..(y + 1) * width];
-        for x in 0..width {
-            rows[y * width + x] = window(width, x, &|x| row[x]);
-        }
-    }
+    // The index `d` away from `i`, within 0..len.
+    let near =
+        |i: usize, d: isize, len: usize| (i as isize + d).clamp(0, len as isize - 1) as usize;
+    let rows: Vec<f64> = (0..values.len())
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            (-r..=r)
+                .map(|d| values[y * width + near(x, d, width)])
+                .sum()
+        })
+        .collect();
     let k = (2 * radius + 1) as f64;
-    let mut out = vec![0.0; values.len()];
-    for y in 0..height {
-        for x in 0..width {
-            out[y * width + x] = window(height, y, &|y| rows[y * width + x]) / (k * k);
-        }
-    }
-    out
+    (0..values.len())
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            (-r..=r)
+                .map(|d| rows[near(y, d, height) * width + x])
+                .sum::<f64>()
+                / (k * k)
+        })
+        .collect()
 }
 
 /// `color` split into what the filter sees, each channel at most

@@ -335,12 +335,11 @@ fn bounce(
         }
         return done(path.radiance);
     };
-    if bsdf.lobe.flags().is_spread() && search.is_some() {
-        // A near mirror is looked through, as a delta is.
+    if let Some(s) = search.as_deref_mut() {
+        // Deltas and near mirrors are looked through.
         if let Some(albedo) = bsdf.lobe.feature_albedo_seen(bsdf.frame.to_local(wo)) {
-            if let Some(s) = search.take() {
-                s.seen(albedo, bsdf.frame.n);
-            }
+            s.seen(albedo, bsdf.frame.n);
+            search = None;
         }
     }
     if last && !scene.volumetric {

@@ -18,12 +18,7 @@ ratio() {
 # Prints "$1 median M (range A to B, N rounds)" of the ratios in $2
 # (separated by spaces).
 report() {
-    echo "$2" | tr ' ' '\n' | grep . | median "$1"
-}
-
-# Reads one ratio a line; prints "$1 median M (range A to B, N rounds)".
-median() {
-    sort -n | awk -v label="$1" '
+    echo "$2" | tr ' ' '\n' | grep . | sort -n | awk -v label="$1" '
         { v[NR] = $1 }
         END {
             m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2

@@ -272,20 +272,22 @@ impl Lobe {
 
     /// Its colour for the albedo feature buffer seen along local `wo`, or
     /// `None` where the feature buffers look through it to what it
-    /// reflects, as through a delta lobe: a conductor or glass whose
-    /// microfacets are near mirrors ([`Microfacet::is_near_mirror`]), or a
-    /// coated or glTF surface that reflects three quarters or more of what
-    /// it reflects at all by such layers (as Blender Cycles decides).
+    /// reflects or lets through: a delta lobe (a perfect mirror, clear
+    /// glass), a conductor or glass whose microfacets are near mirrors
+    /// ([`Microfacet::is_near_mirror`]), or a coated or glTF surface that
+    /// reflects three quarters or more of what it reflects at all by such
+    /// layers (as Blender Cycles decides).
     #[inline]
     pub fn feature_albedo_seen(&self, wo: Vec3) -> Option<Color> {
         let near_mirror = |m: &Option<Microfacet>| m.is_some_and(|m| m.is_near_mirror());
-        let followed = match self {
-            Lobe::Conductor(c) => near_mirror(&c.roughness),
-            Lobe::ExactDielectric(d) => near_mirror(&d.roughness),
-            Lobe::Plastic(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
-            Lobe::Principled(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
-            _ => false,
-        };
+        let followed = !self.flags().is_spread()
+            || match self {
+                Lobe::Conductor(c) => near_mirror(&c.roughness),
+                Lobe::ExactDielectric(d) => near_mirror(&d.roughness),
+                Lobe::Plastic(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
+                Lobe::Principled(p) => p.near_mirror_share(wo) >= NEAR_MIRROR_SHARE,
+                _ => false,
+            };
         (!followed).then(|| self.feature_albedo())
     }
 

@@ -77,7 +77,8 @@ pub struct Principled {
     pub multiscatter: bool,
 }
 
-/// The probabilities of sampling each layer from one view.
+/// A number per layer, from one view: its estimated reflectance, or the
+/// probability of sampling it.
 #[derive(Clone, Copy, Debug)]
 struct Weights {
     coat: f32,
@@ -148,35 +149,52 @@ impl Principled {
         (1.0 - s * sheen::albedo(self.sheen_roughness, mu.abs())).max(0.0)
     }
 
-    fn weights(&self, wo: Vec3) -> Weights {
+    /// Each layer's reflectance seen along `wo`, estimated from its Fresnel
+    /// factor at the view cosine `mu`: what [`Principled::weights`] samples
+    /// the layers in proportion to, and [`Principled::near_mirror_share`]
+    /// weighs.
+    #[inline]
+    fn reflectances(&self, wo: Vec3, mu: f32) -> Weights {
         let coat = self.coat_weight(wo);
         let under = 1.0 - coat;
-        let mu = wo.z;
         let scale = self.sheen_scale(mu);
         let metal = mean(self.base_color + (Color::ONE - self.base_color) * fifth(mu));
         let fd = self.dielectric_fresnel(mu).max_element();
         let m = self.metallic;
-        let base = mean(self.base_color);
-        let through = under * scale * (1.0 - m) * (1.0 - fd) * base;
+        let through = under * scale * (1.0 - m) * (1.0 - fd) * mean(self.base_color);
         let sheen = self.sheen_color.max_element();
         let sheen_w = if sheen > 0.0 {
             under * sheen * sheen::albedo(self.sheen_roughness, mu)
         } else {
             0.0
         };
+        Weights {
+            coat,
+            specular: under * scale * (m * metal + (1.0 - m) * fd),
+            cosine: through * (1.0 - self.transmission) + sheen_w,
+            // Refracted through the specular microfacets.
+            transmission: through * self.transmission,
+        }
+    }
+
+    fn weights(&self, wo: Vec3) -> Weights {
+        let r = self.reflectances(wo, wo.z);
+        let m = self.metallic;
+        let base = mean(self.base_color);
+        let sheen = self.sheen_color.max_element();
         let floor = |w: f32, present: bool| if present { w.max(MIN_WEIGHT) } else { 0.0 };
         let w = Weights {
-            coat: floor(coat, self.clearcoat > 0.0),
+            coat: floor(r.coat, self.clearcoat > 0.0),
             specular: floor(
-                under * scale * (m * metal + (1.0 - m) * fd),
+                r.specular,
                 m > 0.0 || self.f0.max_element() > 0.0 || self.f90 > 0.0,
             ),
             cosine: floor(
-                through * (1.0 - self.transmission) + sheen_w,
+                r.cosine,
                 (m < 1.0 && self.transmission < 1.0 && base > 0.0) || sheen > 0.0,
             ),
             transmission: floor(
-                through * self.transmission,
+                r.transmission,
                 m < 1.0 && self.transmission > 0.0 && base > 0.0,
             ),
         };
@@ -199,35 +217,18 @@ impl Principled {
 
     /// The share of what it reflects and transmits along `wo` that goes by
     /// layers whose microfacets are near mirrors (see
-    /// [`Lobe::feature_albedo_seen`](super::Lobe::feature_albedo_seen)):
-    /// each layer's reflectance estimated from its Fresnel factor at the
-    /// view, as [`Principled::weights`] estimates them to choose a layer.
+    /// [`Lobe::feature_albedo_seen`](super::Lobe::feature_albedo_seen)),
+    /// each layer's estimated as [`Principled::weights`] estimates it.
     pub fn near_mirror_share(&self, wo: Vec3) -> f32 {
-        let mu = wo.z.abs();
-        let coat = self.coat_weight(wo);
-        let under = (1.0 - coat) * self.sheen_scale(mu);
-        let m = self.metallic;
-        let metal = mean(self.base_color + (Color::ONE - self.base_color) * fifth(mu));
-        let fd = self.dielectric_fresnel(mu).max_element();
-        let specular = under * (m * metal + (1.0 - m) * fd);
-        let base = under * (1.0 - m) * (1.0 - fd) * mean(self.base_color);
-        // The transmitted part is refracted through the specular
-        // microfacets; the rest of the base is diffuse.
-        let transmitted = base * self.transmission;
-        let diffuse = base - transmitted;
-        let sheen = if self.sheen_color.max_element() > 0.0 {
-            (1.0 - coat) * self.sheen_color.max_element() * sheen::albedo(self.sheen_roughness, mu)
-        } else {
-            0.0
-        };
+        let r = self.reflectances(wo, wo.z.abs());
         let mut mirror = 0.0;
-        if self.clearcoat > 0.0 && self.coat.is_near_mirror() {
-            mirror += coat;
+        if self.coat.is_near_mirror() {
+            mirror += r.coat;
         }
         if self.specular.is_near_mirror() {
-            mirror += specular + transmitted;
+            mirror += r.specular + r.transmission;
         }
-        let total = coat + specular + transmitted + diffuse + sheen;
+        let total = r.coat + r.specular + r.cosine + r.transmission;
         if total > 0.0 {
             mirror / total
         } else {
