@@ -29,7 +29,9 @@
 //!
 //! Each is averaged over the pixel's samples, the beauty's own, so it is
 //! filtered as the image is; its sums are fixed-point like the image's
-//! ([`crate::film::Sum`]; features to 2⁻³², within ±2³¹, see
+//! ([`crate::film::Sum`]; the albedo and normal to 2⁻³⁰, see
+//! [`UnitFeatures`](crate::film::UnitFeatures), the depth and position to
+//! 2⁻³² within ±2³¹, see
 //! [`Sum::of_feature`](crate::film::Sum::of_feature)), so an image split
 //! into passes, threads, parts or resumed runs has bit-identical features.
 
@@ -197,6 +199,12 @@ impl Layers {
     #[inline(always)]
     pub const fn has(self, layer: Layer) -> bool {
         self.0 & (1 << layer as u8) != 0
+    }
+
+    /// Whether any of `other` is one of them.
+    #[inline(always)]
+    pub const fn meets(self, other: Layers) -> bool {
+        self.0 & other.0 != 0
     }
 
     /// Whether there are none.

@@ -46,9 +46,10 @@ impl Sum {
     }
 
     /// The fixed-point value of a feature (see [`crate::aov`]) to 2⁻³²: a
-    /// conversion of an instruction or so a channel, where
-    /// [`Sum::of_color`] keeps every bit of a colour at ten times the cost.
-    /// A channel beyond ±2³¹ saturates there; NaN is 0.
+    /// conversion of a few instructions a channel, where [`Sum::of_color`]
+    /// keeps every bit of a colour at several times the cost. A channel
+    /// beyond ±2³¹ saturates there; NaN is 0. (The albedo and normal, within
+    /// ±1, take a cheaper way: [`UnitFeatures`].)
     #[inline(always)]
     pub fn of_feature(v: Vec3) -> Sum {
         // Scaling by a power of two is exact in `f32` (as through `f64`);
@@ -106,6 +107,56 @@ fn i128_to_f64(v: i128) -> f64 {
         -scaled
     } else {
         scaled
+    }
+}
+
+/// One in the fixed point of [`UnitFeatures`]: 2³⁰.
+const UNIT: f64 = 1_073_741_824.0;
+
+/// 1.5 · 2⁵²: added to an `f64` of magnitude below 2⁵¹, it leaves that
+/// value rounded to an integer in the low bits of the significand, whose
+/// bits then differ from its own by that integer.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
+/// The albedos and normals of some samples of one pixel, summed channel by
+/// channel in fixed point to 2⁻³⁰ (each rounded to the nearest multiple),
+/// until [`RowMut::add_unit_features`] adds them to the pixel's sums at
+/// once.
+///
+/// Their channels lie within ±1, so each converts exactly through `f64`
+/// (four channels to an instruction, no saturation to check) and a
+/// pixel's sum of its samples, fewer than 2³², fits 64 bits: an addition a
+/// channel and sample in place of a conversion to and an addition of 128
+/// bits. The sums are integers, so how a pixel's samples are grouped
+/// before they reach the film changes no bit of its features.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UnitFeatures([i64; 8]);
+
+impl UnitFeatures {
+    /// Adds a sample's albedo and normal. A channel beyond ±2 (no albedo
+    /// or normal) or NaN counts as 0.
+    #[inline(always)]
+    pub fn add(&mut self, albedo: Color, normal: Vec3) {
+        let v = [
+            albedo.x, albedo.y, albedo.z, normal.x, normal.y, normal.z, 0.0, 0.0,
+        ];
+        for (sum, x) in self.0.iter_mut().zip(v) {
+            let x = if x.abs() <= 2.0 { x } else { 0.0 };
+            // Exact up to the rounding: 24 bits scaled by a power of two.
+            let rounded = f64::from(x) * UNIT + ROUND;
+            let fixed = (rounded.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64);
+            *sum = sum.wrapping_add(fixed);
+        }
+    }
+
+    /// The albedos' and the normals' sums as [`Sum`]s (in 2⁻⁶⁴, exactly).
+    #[inline(always)]
+    fn sums(&self) -> [Sum; 2] {
+        let wide = |c: usize| i128::from(self.0[c]) << 34;
+        [
+            Sum([wide(0), wide(1), wide(2)]),
+            Sum([wide(3), wide(4), wide(5)]),
+        ]
     }
 }
 
@@ -223,28 +274,40 @@ impl RowMut<'_> {
     }
 
     /// [`RowMut::add`], and the sample's `features` to the layers the film
-    /// keeps when the sample is added: each feature to 2⁻³² and within
-    /// ±2³¹ ([`Sum::of_feature`]), the squared colour exactly. A squared
-    /// colour beyond what a [`Sum`] holds, or one that would take its
-    /// pixel's sum past it, counts as 0.
+    /// keeps when the sample is added: its albedo and normal to `unit`
+    /// (for [`RowMut::add_unit_features`]), its depth and position to 2⁻³²
+    /// and within ±2³¹ ([`Sum::of_feature`]), its squared colour exactly. A
+    /// squared colour beyond what a [`Sum`] holds, or one that would take
+    /// its pixel's sum past it, counts as 0.
     ///
     /// A feature's sum needs no such check: a pixel holds fewer than 2³²
     /// samples (its count is a `u32`), each feature below 2³¹, so their sum
     /// stays below 2⁶³, what a [`Sum`] holds.
     #[inline(always)]
-    pub fn add_with(&mut self, x: usize, index: u32, c: Color, features: &Features) -> bool {
+    pub fn add_with(
+        &mut self,
+        x: usize,
+        index: u32,
+        c: Color,
+        features: &Features,
+        unit: &mut UnitFeatures,
+    ) -> bool {
         if !self.add(x, index, c) {
             return false;
         }
         let layers = self.layers;
+        if layers.meets(UNIT_LAYERS) {
+            unit.add(features.albedo, features.normal);
+        }
+        if !layers.meets(OTHER_LAYERS) {
+            return true;
+        }
         let mut add_feature = |layer: Layer, v: Vec3| {
             if layers.has(layer) {
                 let sum = &mut self.layer_sums[layer as usize][x];
                 *sum = sum.plus(Sum::of_feature(v));
             }
         };
-        add_feature(Layer::Albedo, features.albedo);
-        add_feature(Layer::Normal, features.normal);
         add_feature(Layer::Depth, Vec3::new(features.depth, 0.0, 0.0));
         add_feature(Layer::Position, features.position);
         if layers.has(Layer::Moment) {
@@ -255,7 +318,27 @@ impl RowMut<'_> {
         }
         true
     }
+
+    /// Adds the albedos and normals of samples of pixel `x` gathered in
+    /// `unit` (by [`RowMut::add_with`]) to the layers the film keeps of
+    /// them.
+    #[inline(always)]
+    pub fn add_unit_features(&mut self, x: usize, unit: &UnitFeatures) {
+        for (layer, add) in [Layer::Albedo, Layer::Normal].into_iter().zip(unit.sums()) {
+            if self.layers.has(layer) {
+                let sum = &mut self.layer_sums[layer as usize][x];
+                *sum = sum.plus(add);
+            }
+        }
+    }
 }
+
+/// The layers [`UnitFeatures`] gathers.
+const UNIT_LAYERS: Layers = Layers::of(Layer::Albedo).with(Layers::of(Layer::Normal));
+/// The layers [`RowMut::add_with`] adds sample by sample.
+const OTHER_LAYERS: Layers = Layers::of(Layer::Depth)
+    .with(Layers::of(Layer::Position))
+    .with(Layers::of(Layer::Moment));
 
 impl Film {
     /// A black film of `width`×`height` pixels with no samples.
@@ -320,7 +403,7 @@ impl Film {
     /// without the layer).
     pub fn feature(&self, layer: Layer, i: usize) -> Vec3 {
         match self.layer_sums[layer as usize].get(i) {
-            Some(&sum) => mean(sum, self.counts[i]),
+            Some(&sum) => feature_mean(sum, self.counts[i]),
             None => Vec3::ZERO,
         }
     }
@@ -629,6 +712,26 @@ fn mean(sum: Sum, n: u32) -> Color {
     Color::new((r / n) as f32, (g / n) as f32, (b / n) as f32)
 }
 
+/// [`mean`] of a feature's sum, the same to the bit, in fewer steps where
+/// each channel is a multiple of 2⁻³² below 2³¹ in magnitude, as a
+/// feature's are (see [`Sum::of_feature`], [`UnitFeatures`]): its value
+/// in 2⁻³² then fits 64 bits, whose conversion to `f64` rounds the same
+/// significant bits as the 128-bit one.
+fn feature_mean(sum: Sum, n: u32) -> Color {
+    let narrow = |v: i128| match i64::try_from(v >> 32) {
+        Ok(w) if v & 0xffff_ffff == 0 => Some(w),
+        _ => None,
+    };
+    match sum.0.map(narrow) {
+        [Some(x), Some(y), Some(z)] if n > 0 => {
+            let n = f64::from(n);
+            let f = |v: i64| (v as f64 * (1.0 / 4_294_967_296.0) / n) as f32;
+            Color::new(f(x), f(y), f(z))
+        }
+        _ => mean(sum, n),
+    }
+}
+
 /// Applies the display gamma (v^(1/γ)) and tone-maps by clamping to [0, 1].
 #[inline]
 pub fn to_display(linear: f32, gamma: f32) -> f32 {
@@ -677,6 +780,46 @@ mod tests {
     }
 
     #[test]
+    fn albedos_and_normals_beyond_two_or_nan_count_as_zero() {
+        let mut unit = UnitFeatures::default();
+        let odd = [f32::NAN, f32::INFINITY, -2.5, 1e30];
+        unit.add(
+            Color::new(odd[0], odd[1], 2.0),
+            Vec3::new(odd[2], odd[3], -2.0),
+        );
+        let [albedo, normal] = unit.sums();
+        assert_eq!(albedo.0, [0, 0, 2 << 64]);
+        assert_eq!(normal.0, [0, 0, -2 << 64]);
+    }
+
+    #[test]
+    fn a_feature_mean_equals_the_mean_to_the_bit() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for k in 0..200_000 {
+            // Multiples of 2⁻³² of every size up to 2³¹ and a little
+            // beyond, and some that are not multiples.
+            let bits = next();
+            let magnitude = (bits >> (k % 64)) as i128;
+            let v = if k % 2 == 0 { magnitude } else { -magnitude };
+            let v = if k % 7 == 0 { v } else { v << 32 };
+            let sum = Sum([v, v >> 3, -v]);
+            let n = (next() % 100_000) as u32;
+            let (fast, exact) = (feature_mean(sum, n), mean(sum, n));
+            assert_eq!(
+                fast.to_array().map(f32::to_bits),
+                exact.to_array().map(f32::to_bits),
+                "{sum:?} over {n}"
+            );
+        }
+    }
+
+    #[test]
     fn a_colour_converts_from_its_bits_as_through_f64() {
         let mut values = vec![
             0.0f32,
@@ -711,6 +854,25 @@ mod tests {
         }
         for v in values {
             let through_f64 = Sum::of([f64::from(v); 3]);
+            let (x, y) = (f64::from(v), f64::from(v * 0.5));
+            if x.abs() <= 2.0 && y.abs() <= 2.0 {
+                // Within ±2, albedos and normals take their own way, to
+                // 2⁻³⁰ rounded to nearest.
+                let mut unit = UnitFeatures::default();
+                unit.add(Color::new(v, 0.0, -v), Vec3::new(v * 0.5, 1.0, 0.0));
+                let to_unit = |x: f64| {
+                    Sum::of([
+                        (x * 1_073_741_824.0).round_ties_even() / 1_073_741_824.0,
+                        0.0,
+                        0.0,
+                    ])
+                    .unwrap()
+                    .0[0]
+                };
+                let [albedo, normal] = unit.sums();
+                assert_eq!(albedo.0, [to_unit(x), 0, to_unit(-x)], "{v:e}");
+                assert_eq!(normal.0, [to_unit(y), 1 << 64, 0], "{v:e}");
+            }
             assert_eq!(
                 Sum::of_color(Color::splat(v)),
                 through_f64,

@@ -111,6 +111,12 @@ impl FeatureSearch {
         }
     }
 
+    /// Whether it still looks for something.
+    #[inline(always)]
+    fn is_open(&self) -> bool {
+        self.seeking || self.placing
+    }
+
     /// The features are those of a surface of albedo `albedo` (before the
     /// tint of the deltas followed) and shading normal `normal`, on the
     /// side the path came from.
@@ -766,16 +772,20 @@ fn rounds<S: Sampler, const FEATURES: bool>(
         for k in 0..n_live {
             let i = live[k] as usize;
             let sampler = &mut samplers[i];
-            let search = if FEATURES { searches.get_mut(i) } else { None };
-            match step(
-                scene,
-                &rays[i],
-                hits[i],
-                round,
-                &mut paths[i],
-                sampler,
-                search,
-            ) {
+            let (ray, hit, path) = (&rays[i], hits[i], &mut paths[i]);
+            // A finished search is no longer passed down the path, which
+            // then takes the step compiled without one, as in a render
+            // without features.
+            let open = if FEATURES {
+                searches.get_mut(i).filter(|s| s.is_open())
+            } else {
+                None
+            };
+            let next = match open {
+                Some(search) => step(scene, ray, hit, round, path, sampler, Some(search)),
+                None => step(scene, ray, hit, round, path, sampler, None),
+            };
+            match next {
                 Step::Continue(next, left) => {
                     (rays[i], from[i]) = (next, left);
                     live[still] = i as u8;

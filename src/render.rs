@@ -1,7 +1,7 @@
 //! The render loop: camera samples for every pixel, in parallel, into a film.
 
 use crate::aov::{Features, Layers};
-use crate::film::{Film, RowMut};
+use crate::film::{Film, RowMut, UnitFeatures};
 use crate::halt::Halt;
 use crate::integrator::{first_hit_view, trace_paths, FeatureSearch, PATHS};
 use crate::isa::Isa;
@@ -235,7 +235,8 @@ fn render_row_generic(
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
-                add_sample(&mut row, &mut stats, x, index, c, &Features::default());
+                let sample = (index, c, &Features::default());
+                add_samples(&mut row, &mut stats, x, std::iter::once(sample));
             }
         }
         return stats;
@@ -347,35 +348,41 @@ impl SideBySide {
         let colours = self.colours[..n].chunks(per_pixel);
         let searches = self.searches[..n].chunks(per_pixel);
         for ((&(x, _), colours), searches) in pixels.iter().zip(colours).zip(searches) {
-            for ((index, &c), s) in samples.clone().zip(colours).zip(searches) {
-                add_sample(row, stats, x, index, c, &s.features);
-            }
+            let pixel = samples.clone().zip(colours).zip(searches);
+            add_samples(row, stats, x, pixel.map(|((i, &c), s)| (i, c, &s.features)));
         }
     }
 }
 
-/// Adds sample `index` of pixel `x`, of colour `c` and features `f`, to
-/// `row` and counts it in `stats`, as dropped if the film leaves it out. A
-/// function marked to be inlined rather than a closure, which the compiler
-/// may call out of line.
+/// Adds samples of pixel `x`, each its index, colour and features, to
+/// `row`, in order, and counts them in `stats`, as dropped if the film
+/// leaves them out; their albedos and normals are gathered and added at
+/// the end (see [`UnitFeatures`]). A function marked to be inlined rather
+/// than a closure, which the compiler may call out of line.
 #[inline(always)]
-fn add_sample(
+fn add_samples<'f>(
     row: &mut RowMut,
     stats: &mut RenderStats,
     x: usize,
-    index: u32,
-    c: Color,
-    f: &Features,
+    samples: impl Iterator<Item = (u32, Color, &'f Features)>,
 ) {
-    stats.samples += 1;
-    let added = if row.layers.is_empty() {
-        row.add(x, index, c)
-    } else {
-        row.add_with(x, index, c, f)
-    };
-    if !added {
-        stats.dropped += 1;
+    if row.layers.is_empty() {
+        for (index, c, _) in samples {
+            stats.samples += 1;
+            if !row.add(x, index, c) {
+                stats.dropped += 1;
+            }
+        }
+        return;
     }
+    let mut unit = UnitFeatures::default();
+    for (index, c, f) in samples {
+        stats.samples += 1;
+        if !row.add_with(x, index, c, f, &mut unit) {
+            stats.dropped += 1;
+        }
+    }
+    row.add_unit_features(x, &unit);
 }
 
 /// The camera ray of sample `index` of pixel `(x, y)`, whose sampler is
@@ -506,7 +513,8 @@ mod tests {
                                 &mut sampler,
                                 &mut expected.rays,
                             );
-                            add_sample(&mut row, &mut expected, x, index, c, &f);
+                            let sample = std::iter::once((index, c, &f));
+                            add_samples(&mut row, &mut expected, x, sample);
                         }
                     }
                     assert_eq!(stats, expected, "{}: {samples:?}, row {y}", desc.caption);
