@@ -67,7 +67,7 @@ pub const VERSION: u32 = 4;
 /// sample (random stream, sampling, intersection arithmetic, materials) must
 /// bump the revision, so that a checkpoint written before it is refused
 /// rather than mixed with different samples.
-pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.10");
+pub const RENDERER_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+samples.11");
 /// Extension added to an output path to name its default checkpoint.
 pub const EXTENSION: &str = "lumen-ckpt";
 

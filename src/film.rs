@@ -58,6 +58,30 @@ impl Sum {
         Sum([fixed(v.x), fixed(v.y), fixed(v.z)])
     }
 
+    /// The fixed-point value of a squared colour `square`, for the
+    /// variance's sum of squares: below 2¹⁹ in every channel, rounded to
+    /// the nearest multiple of 2⁻³² through `f64` (as [`UnitFeatures`]
+    /// rounds, a few instructions a channel, where [`Sum::of_color`] takes
+    /// tens); otherwise exactly, as [`Sum::of_color`] converts (`None` for
+    /// NaN, infinities and 2⁶³ or more). Either way the same square always
+    /// gives the same sum, so a pixel's sum of squares does not depend on
+    /// how its samples were split.
+    #[inline(always)]
+    pub fn of_square(square: Color) -> Option<Sum> {
+        /// 2¹⁹: a square below it, times 2³², is below 2⁵¹.
+        const QUICK: f32 = 524_288.0;
+        // NaN fails each test.
+        if square.x < QUICK && square.y < QUICK && square.z < QUICK {
+            let fixed = |v: f32| {
+                let rounded = f64::from(v) * 4_294_967_296.0 + ROUND;
+                i128::from((rounded.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64)) << 32
+            };
+            Some(Sum([fixed(square.x), fixed(square.y), fixed(square.z)]))
+        } else {
+            Sum::of_color(square)
+        }
+    }
+
     /// This sum plus `other`, channel by channel.
     #[inline]
     pub fn plus(self, other: Sum) -> Sum {
@@ -276,7 +300,8 @@ impl RowMut<'_> {
     /// [`RowMut::add`], and the sample's `features` to the layers the film
     /// keeps when the sample is added: its albedo and normal to `unit`
     /// (for [`RowMut::add_unit_features`]), its depth and position to 2⁻³²
-    /// and within ±2³¹ ([`Sum::of_feature`]), its squared colour exactly. A
+    /// and within ±2³¹ ([`Sum::of_feature`]), its squared colour to 2⁻³²
+    /// or exactly ([`Sum::of_square`]). A
     /// squared colour beyond what a [`Sum`] holds, or one that would take
     /// its pixel's sum past it, counts as 0.
     ///
@@ -312,7 +337,7 @@ impl RowMut<'_> {
         add_feature(Layer::Position, features.position);
         if layers.has(Layer::Moment) {
             let sum = &mut self.layer_sums[Layer::Moment as usize][x];
-            if let Some(added) = Sum::of_color(c * c).and_then(|v| sum.checked_plus(v)) {
+            if let Some(added) = Sum::of_square(c * c).and_then(|v| sum.checked_plus(v)) {
                 *sum = added;
             }
         }
@@ -790,6 +815,32 @@ mod tests {
         let [albedo, normal] = unit.sums();
         assert_eq!(albedo.0, [0, 0, 2 << 64]);
         assert_eq!(normal.0, [0, 0, -2 << 64]);
+    }
+
+    #[test]
+    fn a_square_is_rounded_to_two_to_the_minus_32_below_two_to_the_19_and_exact_above() {
+        let mut x = 0x9e37_79b9u32;
+        let mut values = vec![
+            0.0f32, -0.0, 1.0, 0.3, 1e-30, 524_287.97, 524_288.0, 1e19, 3e38,
+        ];
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            // Squares of every size from 2⁻⁴⁰ to about 2⁴⁰.
+            values.push(f32::from_bits(0x2b00_0000 + x % 0x2800_0000));
+        }
+        for v in values {
+            let got = Sum::of_square(Color::new(v, 0.25, 0.0));
+            if v < 524_288.0 {
+                let rounded = (f64::from(v) * 4_294_967_296.0).round_ties_even() / 4_294_967_296.0;
+                assert_eq!(got, Sum::of([rounded, 0.25, 0.0]), "{v:e}");
+            } else {
+                assert_eq!(got, Sum::of_color(Color::new(v, 0.25, 0.0)), "{v:e}");
+            }
+        }
+        assert_eq!(Sum::of_square(Color::new(f32::NAN, 0.0, 0.0)), None);
+        assert_eq!(Sum::of_square(Color::new(0.0, f32::INFINITY, 0.0)), None);
     }
 
     #[test]
