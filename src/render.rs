@@ -375,6 +375,18 @@ fn add_samples<'f>(
         }
         return;
     }
+    add_samples_with_features(row, stats, x, samples);
+}
+
+/// [`add_samples`] to a film that keeps layers: out of line, so that the
+/// layers' code does not weigh on the registers of the loop around it.
+#[inline(never)]
+fn add_samples_with_features<'f>(
+    row: &mut RowMut,
+    stats: &mut RenderStats,
+    x: usize,
+    samples: impl Iterator<Item = (u32, Color, &'f Features)>,
+) {
     let mut unit = UnitFeatures::default();
     for (index, c, f) in samples {
         stats.samples += 1;
