@@ -54,7 +54,7 @@ impl Sum {
     pub fn of_feature(v: Vec3) -> Sum {
         // Scaling by a power of two is exact in `f32` (as through `f64`);
         // the conversion saturates, as `as` converts.
-        let fixed = |x: f32| i128::from((x * 4_294_967_296.0) as i64) << 32;
+        let fixed = |x: f32| i128::from((x * TWO_32 as f32) as i64) << 32;
         Sum([fixed(v.x), fixed(v.y), fixed(v.z)])
     }
 
@@ -72,10 +72,7 @@ impl Sum {
         const QUICK: f32 = 524_288.0;
         // NaN fails each test.
         if square.x < QUICK && square.y < QUICK && square.z < QUICK {
-            let fixed = |v: f32| {
-                let rounded = f64::from(v) * 4_294_967_296.0 + ROUND;
-                i128::from((rounded.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64)) << 32
-            };
+            let fixed = |v: f32| i128::from(round_to_integer(f64::from(v) * TWO_32)) << 32;
             Some(Sum([fixed(square.x), fixed(square.y), fixed(square.z)]))
         } else {
             Sum::of_color(square)
@@ -137,10 +134,19 @@ fn i128_to_f64(v: i128) -> f64 {
 /// One in the fixed point of [`UnitFeatures`]: 2³⁰.
 const UNIT: f64 = 1_073_741_824.0;
 
-/// 1.5 · 2⁵²: added to an `f64` of magnitude below 2⁵¹, it leaves that
-/// value rounded to an integer in the low bits of the significand, whose
-/// bits then differ from its own by that integer.
-const ROUND: f64 = 6_755_399_441_055_744.0;
+/// 2³²: one in the fixed point of the depth, position and squared colour.
+const TWO_32: f64 = 4_294_967_296.0;
+
+/// `x`, of magnitude below 2⁵¹, rounded to the nearest integer (ties to
+/// even) without a conversion instruction's saturation and NaN tests:
+/// adding 1.5 · 2⁵² leaves the rounded value in the low bits of the
+/// significand, whose bits then differ from those of 1.5 · 2⁵² by it. Four
+/// lanes an instruction where the compiler vectorises it.
+#[inline(always)]
+fn round_to_integer(x: f64) -> i64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    ((x + ROUND).to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64)
+}
 
 /// The albedos and normals of some samples of one pixel, summed channel by
 /// channel in fixed point to 2⁻³⁰ (each rounded to the nearest multiple),
@@ -167,9 +173,7 @@ impl UnitFeatures {
         for (sum, x) in self.0.iter_mut().zip(v) {
             let x = if x.abs() <= 2.0 { x } else { 0.0 };
             // Exact up to the rounding: 24 bits scaled by a power of two.
-            let rounded = f64::from(x) * UNIT + ROUND;
-            let fixed = (rounded.to_bits() as i64).wrapping_sub(ROUND.to_bits() as i64);
-            *sum = sum.wrapping_add(fixed);
+            *sum = sum.wrapping_add(round_to_integer(f64::from(x) * UNIT));
         }
     }
 
@@ -750,7 +754,7 @@ fn feature_mean(sum: Sum, n: u32) -> Color {
     match sum.0.map(narrow) {
         [Some(x), Some(y), Some(z)] if n > 0 => {
             let n = f64::from(n);
-            let f = |v: i64| (v as f64 * (1.0 / 4_294_967_296.0) / n) as f32;
+            let f = |v: i64| (v as f64 * (1.0 / TWO_32) / n) as f32;
             Color::new(f(x), f(y), f(z))
         }
         _ => mean(sum, n),
@@ -804,6 +808,35 @@ mod tests {
         }
     }
 
+    /// `n` floats from their bits, spread over every exponent and sign.
+    fn spread_floats(n: u64) -> impl Iterator<Item = f32> {
+        (0..n).map(|k| f32::from_bits(crate::rng::mix64(k) as u32))
+    }
+
+    #[test]
+    fn albedos_and_normals_round_to_two_to_the_minus_30() {
+        for v in spread_floats(100_000) {
+            let (x, y) = (f64::from(v), f64::from(v * 0.5));
+            if x.abs() > 2.0 || y.abs() > 2.0 || x.is_nan() {
+                continue;
+            }
+            let mut unit = UnitFeatures::default();
+            unit.add(Color::new(v, 0.0, -v), Vec3::new(v * 0.5, 1.0, 0.0));
+            let to_unit = |x: f64| {
+                Sum::of([
+                    (x * 1_073_741_824.0).round_ties_even() / 1_073_741_824.0,
+                    0.0,
+                    0.0,
+                ])
+                .unwrap()
+                .0[0]
+            };
+            let [albedo, normal] = unit.sums();
+            assert_eq!(albedo.0, [to_unit(x), 0, to_unit(-x)], "{v:e}");
+            assert_eq!(normal.0, [to_unit(y), 1 << 64, 0], "{v:e}");
+        }
+    }
+
     #[test]
     fn albedos_and_normals_beyond_two_or_nan_count_as_zero() {
         let mut unit = UnitFeatures::default();
@@ -819,21 +852,18 @@ mod tests {
 
     #[test]
     fn a_square_is_rounded_to_two_to_the_minus_32_below_two_to_the_19_and_exact_above() {
-        let mut x = 0x9e37_79b9u32;
         let mut values = vec![
             0.0f32, -0.0, 1.0, 0.3, 1e-30, 524_287.97, 524_288.0, 1e19, 3e38,
         ];
-        for _ in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            // Squares of every size from 2⁻⁴⁰ to about 2⁴⁰.
-            values.push(f32::from_bits(0x2b00_0000 + x % 0x2800_0000));
-        }
+        // Squares of every size from 2⁻⁴¹ to about 2³⁹.
+        values.extend(
+            (0..100_000u64)
+                .map(|k| f32::from_bits(0x2b00_0000 + crate::rng::mix64(k) as u32 % 0x2800_0000)),
+        );
         for v in values {
             let got = Sum::of_square(Color::new(v, 0.25, 0.0));
             if v < 524_288.0 {
-                let rounded = (f64::from(v) * 4_294_967_296.0).round_ties_even() / 4_294_967_296.0;
+                let rounded = (f64::from(v) * TWO_32).round_ties_even() / TWO_32;
                 assert_eq!(got, Sum::of([rounded, 0.25, 0.0]), "{v:e}");
             } else {
                 assert_eq!(got, Sum::of_color(Color::new(v, 0.25, 0.0)), "{v:e}");
@@ -845,22 +875,15 @@ mod tests {
 
     #[test]
     fn a_feature_mean_equals_the_mean_to_the_bit() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
-        for k in 0..200_000 {
+        for k in 0..200_000u64 {
             // Multiples of 2⁻³² of every size up to 2³¹ and a little
             // beyond, and some that are not multiples.
-            let bits = next();
+            let bits = crate::rng::mix64(2 * k);
             let magnitude = (bits >> (k % 64)) as i128;
             let v = if k % 2 == 0 { magnitude } else { -magnitude };
             let v = if k % 7 == 0 { v } else { v << 32 };
             let sum = Sum([v, v >> 3, -v]);
-            let n = (next() % 100_000) as u32;
+            let n = (crate::rng::mix64(2 * k + 1) % 100_000) as u32;
             let (fast, exact) = (feature_mean(sum, n), mean(sum, n));
             assert_eq!(
                 fast.to_array().map(f32::to_bits),
@@ -905,25 +928,6 @@ mod tests {
         }
         for v in values {
             let through_f64 = Sum::of([f64::from(v); 3]);
-            let (x, y) = (f64::from(v), f64::from(v * 0.5));
-            if x.abs() <= 2.0 && y.abs() <= 2.0 {
-                // Within ±2, albedos and normals take their own way, to
-                // 2⁻³⁰ rounded to nearest.
-                let mut unit = UnitFeatures::default();
-                unit.add(Color::new(v, 0.0, -v), Vec3::new(v * 0.5, 1.0, 0.0));
-                let to_unit = |x: f64| {
-                    Sum::of([
-                        (x * 1_073_741_824.0).round_ties_even() / 1_073_741_824.0,
-                        0.0,
-                        0.0,
-                    ])
-                    .unwrap()
-                    .0[0]
-                };
-                let [albedo, normal] = unit.sums();
-                assert_eq!(albedo.0, [to_unit(x), 0, to_unit(-x)], "{v:e}");
-                assert_eq!(normal.0, [to_unit(y), 1 << 64, 0], "{v:e}");
-            }
             assert_eq!(
                 Sum::of_color(Color::splat(v)),
                 through_f64,
