@@ -10,7 +10,8 @@
 //!
 //! The filter is OIDN's `RT` in HDR mode, with its auxiliary images
 //! prefiltered first and then marked clean (`cleanAux`), OIDN's
-//! recommended use for final frames. It runs on the CPU device with a
+//! recommended use for final frames; the prefilters run at a lower
+//! [`Quality`] than the image's filter ([`PREFILTER_QUALITY`]). It runs on the CPU device with a
 //! fixed number of threads, which makes its output the same bits for the
 //! same input on the same machine.
 
@@ -62,8 +63,63 @@ pub enum DenoiseError {
     BadInput(String),
 }
 
+/// How much work OIDN puts into a filter: its `quality` parameter, and
+/// Cycles' "Quality" setting. A lower quality runs a smaller network.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    /// OIDN's "high performance", for interactive previews.
+    Fast,
+    /// OIDN's "balanced quality/performance".
+    Balanced,
+    /// OIDN's "high quality", for final frames.
+    High,
+}
+
+impl Quality {
+    /// Each quality with its name, as options and messages spell it.
+    pub const NAMES: [(&'static str, Quality); 3] = [
+        ("high", Quality::High),
+        ("balanced", Quality::Balanced),
+        ("fast", Quality::Fast),
+    ];
+
+    /// Its name (see [`Quality::NAMES`]).
+    pub fn name(self) -> &'static str {
+        Self::NAMES
+            .iter()
+            .find(|(_, q)| *q == self)
+            .map_or("high", |(name, _)| name)
+    }
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(name, _)| *name == s)
+            .map(|&(_, q)| q)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::NAMES.iter().map(|(name, _)| *name).collect();
+                format!("no quality `{s}`; it is one of {}", names.join(", "))
+            })
+    }
+}
+
+/// The quality of the image's filter in lumen's denoised renders.
+pub const IMAGE_QUALITY: Quality = Quality::High;
+
+/// The quality of the albedo's and normal's prefilters in lumen's
+/// denoised renders. Balanced: the guides are far less noisy than the
+/// image, and on the benchmark scenes it gives denoised images within
+/// 2.5 % of high prefilters' FLIP (the same to the fourth decimal on three
+/// of four) in about two fifths less time (docs/denoising.md, "Quality").
+pub const PREFILTER_QUALITY: Quality = Quality::Balanced;
+
 /// An image to denoise: its linear colours and, when known, its albedo and
-/// shading normals, each row-major, top row first.
+/// shading normals, each row-major, top row first; and how hard the
+/// filters work.
 #[derive(Clone, Copy, Debug)]
 pub struct Inputs<'a> {
     /// Width in pixels.
@@ -81,6 +137,11 @@ pub struct Inputs<'a> {
     /// image where the two differ by more than the noise explains (see
     /// [`blend`]).
     pub variance: Option<&'a [Color]>,
+    /// The quality of the image's filter ([`IMAGE_QUALITY`] in renders).
+    pub quality: Quality,
+    /// The quality of the albedo's and normal's prefilters
+    /// ([`PREFILTER_QUALITY`] in renders).
+    pub prefilter: Quality,
 }
 
 impl Inputs<'_> {
@@ -300,6 +361,8 @@ pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseEr
             albedo: albedo.as_deref(),
             normal: normal.as_deref(),
             variance: variance.as_deref(),
+            quality: IMAGE_QUALITY,
+            prefilter: PREFILTER_QUALITY,
         },
         threads,
     )
@@ -524,6 +587,19 @@ impl ExrChannels {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn qualities_are_named_as_options_spell_them() {
+        for (name, quality) in Quality::NAMES {
+            assert_eq!(name.parse::<Quality>(), Ok(quality));
+            assert_eq!(quality.name(), name);
+        }
+        let e = "best".parse::<Quality>().unwrap_err();
+        assert!(
+            e.contains("`best`") && e.contains("high, balanced, fast"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn box_mean_is_the_mean_over_the_square_with_edges_repeated() {

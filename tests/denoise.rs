@@ -2,7 +2,7 @@
 //! with `OIDN_DIR` pointing at the library.
 #![cfg(feature = "oidn")]
 
-use lumen::denoise::{self, Inputs};
+use lumen::denoise::{self, Inputs, Quality, IMAGE_QUALITY, PREFILTER_QUALITY};
 use lumen::math::{Color, Vec3};
 use lumen::rng::Rng;
 
@@ -41,6 +41,8 @@ fn denoised(
         albedo,
         normal,
         variance: None,
+        quality: IMAGE_QUALITY,
+        prefilter: PREFILTER_QUALITY,
     };
     denoise::denoise(&inputs, 2)
 }
@@ -108,6 +110,49 @@ fn the_same_input_gives_the_same_bits() {
     let run = || denoised(&color, Some(&albedo), Some(&normal)).expect("OIDN runs");
     let first = run();
     assert!(first == run(), "two runs on 2 threads differ");
+}
+
+#[test]
+fn each_quality_runs_its_own_network_and_each_denoises() {
+    // A noisy albedo, so that its prefilter has work to do.
+    let (clean, color, mut albedo, normal) = noisy(0.1, 13);
+    let mut rng = Rng::new(17);
+    for a in &mut albedo {
+        *a = (*a + Vec3::splat((rng.next_f32() - 0.5) * 0.2)).clamp(Vec3::ZERO, Vec3::ONE);
+    }
+    let run = |quality, prefilter| {
+        let inputs = Inputs {
+            width: 64,
+            height: 64,
+            color: &color,
+            albedo: Some(&albedo),
+            normal: Some(&normal),
+            variance: None,
+            quality,
+            prefilter,
+        };
+        denoise::denoise(&inputs, 2).expect("OIDN runs")
+    };
+    let before = mse(&color, &clean);
+    let mut outputs = Vec::new();
+    for (name, quality) in Quality::NAMES {
+        let out = run(quality, PREFILTER_QUALITY);
+        let after = mse(&out, &clean);
+        assert!(
+            after < before / 5.0,
+            "{name}: error {before} before, {after} after"
+        );
+        assert!(
+            out == run(quality, PREFILTER_QUALITY),
+            "{name}: two runs differ"
+        );
+        outputs.push(out);
+    }
+    assert!(outputs[0] != outputs[1] && outputs[1] != outputs[2] && outputs[0] != outputs[2]);
+    // The prefilter's quality reaches OIDN too.
+    let high = run(IMAGE_QUALITY, Quality::High);
+    assert!(high != run(IMAGE_QUALITY, Quality::Balanced));
+    assert!(mse(&high, &clean) < before / 5.0);
 }
 
 #[test]
@@ -214,6 +259,8 @@ fn with_the_variance_detail_the_filter_smooths_comes_back_and_noise_stays_away()
             albedo: Some(&albedo),
             normal: Some(&normal),
             variance,
+            quality: IMAGE_QUALITY,
+            prefilter: PREFILTER_QUALITY,
         };
         denoise::denoise(&inputs, 2).expect("OIDN runs")
     };
@@ -239,6 +286,8 @@ fn with_the_variance_detail_the_filter_smooths_comes_back_and_noise_stays_away()
         albedo: Some(&albedo),
         normal: Some(&normal),
         variance: Some(&variance),
+        quality: IMAGE_QUALITY,
+        prefilter: PREFILTER_QUALITY,
     };
     let out = denoise::denoise(&inputs, 2).expect("OIDN runs");
     let (before, after) = (mse(&color, &clean), mse(&out, &clean));

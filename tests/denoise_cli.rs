@@ -63,6 +63,17 @@ fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
     // Its own input is not replaced.
     let o = denoise(&noisy, &noisy);
     assert_refused(&o, &["cannot replace its input"]);
+    // A quality that does not exist, named with those that do.
+    let o = lumen_output(&[
+        "denoise",
+        noisy.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--prefilter",
+        "best",
+    ]);
+    assert_refused(&o, &["`best`", "high, balanced, fast"]);
+    assert!(!out.exists());
 }
 
 #[test]
@@ -157,6 +168,27 @@ mod with_oidn {
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert_eq!(std::fs::read(&again).unwrap(), exr);
+        // The render's qualities named are its own; others give another
+        // image.
+        let with = |name: &str, args: &[&str]| {
+            let path = dir.join(name);
+            let mut command = vec!["denoise", noisy.to_str().unwrap(), "-o"];
+            command.push(path.to_str().unwrap());
+            command.extend_from_slice(&["--threads", "2"]);
+            command.extend_from_slice(args);
+            let o = lumen_output(&command);
+            assert!(o.status.success(), "{}", stderr(&o));
+            std::fs::read(&path).unwrap()
+        };
+        assert_eq!(
+            with(
+                "named.exr",
+                &["--quality", "high", "--prefilter", "balanced"]
+            ),
+            exr
+        );
+        assert_ne!(with("high.exr", &["--prefilter", "high"]), exr);
+        assert_ne!(with("fast.exr", &["--quality", "fast"]), exr);
         render(&dir.join("second.exr"), &["--denoise"]);
         assert_eq!(std::fs::read(dir.join("second.exr")).unwrap(), exr);
         // Another format: the denoised image, the noisy one, the buffers.

@@ -4,15 +4,15 @@
 //! than linked: a linked library missing at run time stops the program
 //! before `main` with the system loader's message, while a library opened
 //! here that is missing, or of another major version, is a
-//! [`DenoiseError`] naming each file tried. Only the dozen functions of
-//! OIDN 2's C API that lumen calls are declared.
+//! [`DenoiseError`] naming each file tried. Only the functions of OIDN 2's
+//! C API that lumen calls are declared.
 //!
 //! Where it is looked for: with `OIDN_DIR` set, `$OIDN_DIR/lib/` (the
 //! layout of OIDN's release archives and of the `pyoidn` wheel's
 //! `pyoidn/oidn`), then `$OIDN_DIR` itself; otherwise the system's search
 //! (`LD_LIBRARY_PATH`, then the linker cache).
 
-use super::{DenoiseError, Inputs};
+use super::{DenoiseError, Inputs, Quality};
 use crate::math::Color;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
@@ -23,6 +23,14 @@ type Filter = *mut c_void;
 
 /// `OIDN_DEVICE_TYPE_CPU`.
 const DEVICE_CPU: c_int = 1;
+/// `OIDN_QUALITY_FAST`, `_BALANCED` and `_HIGH`.
+fn quality(q: Quality) -> c_int {
+    match q {
+        Quality::Fast => 4,
+        Quality::Balanced => 5,
+        Quality::High => 6,
+    }
+}
 /// `OIDN_FORMAT_FLOAT3`.
 const FORMAT_FLOAT3: c_int = 3;
 /// The major version whose API is declared here.
@@ -63,6 +71,7 @@ pub struct Library {
         usize,
     ),
     set_filter_bool: unsafe extern "C" fn(Filter, *const c_char, bool),
+    set_filter_int: unsafe extern "C" fn(Filter, *const c_char, c_int),
     commit_filter: unsafe extern "C" fn(Filter),
     execute_filter: unsafe extern "C" fn(Filter),
     release_filter: unsafe extern "C" fn(Filter),
@@ -151,6 +160,7 @@ impl Library {
             new_filter: symbol!("oidnNewFilter"),
             set_image: symbol!("oidnSetSharedFilterImage"),
             set_filter_bool: symbol!("oidnSetFilterBool"),
+            set_filter_int: symbol!("oidnSetFilterInt"),
             commit_filter: symbol!("oidnCommitFilter"),
             execute_filter: symbol!("oidnExecuteFilter"),
             release_filter: symbol!("oidnReleaseFilter"),
@@ -232,6 +242,7 @@ impl Library {
             let filter = device.filter()?;
             filter.image(name, buffer, w, h);
             filter.image(c"output", &mut clean, w, h);
+            filter.int(c"quality", quality(inputs.prefilter));
             filter.run()?;
             *buffer = clean;
             Ok(())
@@ -254,6 +265,7 @@ impl Library {
         filter.image(c"output", &mut output, w, h);
         filter.flag(c"hdr", true);
         filter.flag(c"cleanAux", albedo.is_some());
+        filter.int(c"quality", quality(inputs.quality));
         filter.run()?;
         Ok(output
             .chunks_exact(3)
@@ -327,6 +339,11 @@ impl FilterHandle<'_> {
                 0,
             )
         }
+    }
+
+    fn int(&self, name: &CStr, value: c_int) {
+        // SAFETY: `raw` is a live filter; the name is NUL-terminated.
+        unsafe { (self.device.lib.set_filter_int)(self.raw, name.as_ptr(), value) }
     }
 
     fn flag(&self, name: &CStr, value: bool) {

@@ -5,7 +5,7 @@
 use crate::render::resolved;
 use anyhow::{bail, Context, Result};
 use lumen::aov::Aov;
-use lumen::denoise::{self, ExrChannels, Inputs};
+use lumen::denoise::{self, ExrChannels, Inputs, Quality};
 use lumen::film::Film;
 use lumen::lock::RenderLock;
 use lumen::math::Color;
@@ -68,7 +68,13 @@ pub(crate) fn write_image(
 /// `lumen denoise IN.exr -o OUT`: the image of `input` denoised with its
 /// albedo and normal layers. An EXR output keeps every other channel of
 /// the input; another format holds the image alone.
-pub(crate) fn denoise_command(input: &Path, out: &Path, gamma: f32) -> Result<ExitCode> {
+pub(crate) fn denoise_command(
+    input: &Path,
+    out: &Path,
+    gamma: f32,
+    quality: Quality,
+    prefilter: Quality,
+) -> Result<ExitCode> {
     let format = ImageFormat::from_path(out)?;
     if resolved(input) == resolved(out) {
         bail!(
@@ -90,6 +96,8 @@ pub(crate) fn denoise_command(input: &Path, out: &Path, gamma: f32) -> Result<Ex
             albedo: Some(&guided.albedo),
             normal: Some(&guided.normal),
             variance: guided.variance.as_deref(),
+            quality,
+            prefilter,
         },
         rayon::current_num_threads(),
     )?;

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use lumen::denoise::Quality;
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
@@ -111,6 +112,14 @@ enum Command {
         /// the same bits for the same input and number of threads.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
         threads: Option<u32>,
+        /// The image filter's quality: high, balanced or fast (Open Image
+        /// Denoise's `quality`; a render's `--denoise` uses high).
+        #[arg(long, default_value = lumen::denoise::IMAGE_QUALITY.name(), value_parser = parse_quality)]
+        quality: Quality,
+        /// The albedo's and normal's prefilters' quality: high, balanced or
+        /// fast (a render's `--denoise` uses balanced).
+        #[arg(long, default_value = lumen::denoise::PREFILTER_QUALITY.name(), value_parser = parse_quality)]
+        prefilter: Quality,
     },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
@@ -497,6 +506,10 @@ fn parse_gamma(text: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_quality(text: &str) -> Result<Quality, String> {
+    text.parse()
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
@@ -570,7 +583,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
             output,
             gamma,
             threads,
-        } => with_threads(threads, || denoise::denoise_command(&input, &output, gamma)),
+            quality,
+            prefilter,
+        } => with_threads(threads, || {
+            denoise::denoise_command(&input, &output, gamma, quality, prefilter)
+        }),
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {
