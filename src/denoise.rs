@@ -11,7 +11,7 @@
 //! The filter is OIDN's `RT` in HDR mode, with its auxiliary images
 //! prefiltered first and then marked clean (`cleanAux`), OIDN's
 //! recommended use for final frames; the prefilters run at a lower
-//! [`Quality`] than the image's filter ([`PREFILTER_QUALITY`]). It runs on the CPU device with a
+//! [`Quality`] than the image's filter ([`PREFILTER`]). It runs on the CPU device with a
 //! fixed number of threads, which makes its output the same bits for the
 //! same input on the same machine.
 
@@ -110,12 +110,12 @@ impl std::str::FromStr for Quality {
 /// The quality of the image's filter in lumen's denoised renders.
 pub const IMAGE_QUALITY: Quality = Quality::High;
 
-/// The quality of the albedo's and normal's prefilters in lumen's
-/// denoised renders. Balanced: the guides are far less noisy than the
+/// How the albedo and normal are prefiltered in lumen's denoised renders
+/// (see [`Inputs::prefilter`]). Balanced: the guides are far less noisy than the
 /// image, and on the benchmark scenes it gives denoised images within
 /// 2.5 % of high prefilters' FLIP (the same to the fourth decimal on three
 /// of four) in about two fifths less time (docs/denoising.md, "Quality").
-pub const PREFILTER_QUALITY: Quality = Quality::Balanced;
+pub const PREFILTER: Option<Quality> = Some(Quality::Balanced);
 
 /// An image to denoise: its linear colours and, when known, its albedo and
 /// shading normals, each row-major, top row first; and how hard the
@@ -137,11 +137,29 @@ pub struct Inputs<'a> {
     /// image where the two differ by more than the noise explains (see
     /// [`blend`]).
     pub variance: Option<&'a [Color]>,
-    /// The quality of the image's filter ([`IMAGE_QUALITY`] in renders).
+    /// How hard the filters work.
+    pub options: Options,
+}
+
+/// How hard the denoiser works.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// The quality of the image's filter ([`IMAGE_QUALITY`] by default).
     pub quality: Quality,
-    /// The quality of the albedo's and normal's prefilters
-    /// ([`PREFILTER_QUALITY`] in renders).
-    pub prefilter: Quality,
+    /// The quality of the albedo's and normal's prefilters ([`PREFILTER`]
+    /// by default). `None`: they go to the image's filter as they are, and
+    /// it is not told they are clean (OIDN without `cleanAux`, Cycles'
+    /// "Fast" prefilter): one filter run in place of three.
+    pub prefilter: Option<Quality>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            quality: IMAGE_QUALITY,
+            prefilter: PREFILTER,
+        }
+    }
 }
 
 impl Inputs<'_> {
@@ -336,9 +354,13 @@ fn clean(c: Color) -> Color {
     Color::new(v(c.x), v(c.y), v(c.z))
 }
 
-/// The film's image denoised, with its albedo and normal layers as the
-/// auxiliary images when it keeps them.
-pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseError> {
+/// The film's image denoised with `options`, with its albedo and normal
+/// layers as the auxiliary images when it keeps them.
+pub fn denoise_film(
+    film: &Film,
+    threads: usize,
+    options: Options,
+) -> Result<Vec<Color>, DenoiseError> {
     let layers = film.layers();
     let layer = |l: Layer| -> Option<Vec<Vec3>> {
         layers
@@ -361,8 +383,7 @@ pub fn denoise_film(film: &Film, threads: usize) -> Result<Vec<Color>, DenoiseEr
             albedo: albedo.as_deref(),
             normal: normal.as_deref(),
             variance: variance.as_deref(),
-            quality: IMAGE_QUALITY,
-            prefilter: PREFILTER_QUALITY,
+            options,
         },
         threads,
     )

@@ -80,7 +80,11 @@ pub fn make_gallery(
         let path = dir.join(&file);
         let gamma = scene.settings.gamma;
         if scene.settings.denoise {
-            let clean = crate::denoise::denoise_film(&film, rayon::current_num_threads())?;
+            let clean = crate::denoise::denoise_film(
+                &film,
+                rayon::current_num_threads(),
+                Default::default(),
+            )?;
             let beauty = output::Beauty::Colors {
                 width: film.width(),
                 height: film.height(),

@@ -2,7 +2,7 @@
 //! with `OIDN_DIR` pointing at the library.
 #![cfg(feature = "oidn")]
 
-use lumen::denoise::{self, Inputs, Quality, IMAGE_QUALITY, PREFILTER_QUALITY};
+use lumen::denoise::{self, Inputs, Options, Quality, IMAGE_QUALITY, PREFILTER};
 use lumen::math::{Color, Vec3};
 use lumen::rng::Rng;
 
@@ -41,8 +41,7 @@ fn denoised(
         albedo,
         normal,
         variance: None,
-        quality: IMAGE_QUALITY,
-        prefilter: PREFILTER_QUALITY,
+        options: Options::default(),
     };
     denoise::denoise(&inputs, 2)
 }
@@ -128,31 +127,31 @@ fn each_quality_runs_its_own_network_and_each_denoises() {
             albedo: Some(&albedo),
             normal: Some(&normal),
             variance: None,
-            quality,
-            prefilter,
+            options: Options { quality, prefilter },
         };
         denoise::denoise(&inputs, 2).expect("OIDN runs")
     };
     let before = mse(&color, &clean);
     let mut outputs = Vec::new();
     for (name, quality) in Quality::NAMES {
-        let out = run(quality, PREFILTER_QUALITY);
+        let out = run(quality, PREFILTER);
         let after = mse(&out, &clean);
         assert!(
             after < before / 5.0,
             "{name}: error {before} before, {after} after"
         );
-        assert!(
-            out == run(quality, PREFILTER_QUALITY),
-            "{name}: two runs differ"
-        );
+        assert!(out == run(quality, PREFILTER), "{name}: two runs differ");
         outputs.push(out);
     }
     assert!(outputs[0] != outputs[1] && outputs[1] != outputs[2] && outputs[0] != outputs[2]);
-    // The prefilter's quality reaches OIDN too.
-    let high = run(IMAGE_QUALITY, Quality::High);
-    assert!(high != run(IMAGE_QUALITY, Quality::Balanced));
-    assert!(mse(&high, &clean) < before / 5.0);
+    // The prefilter's quality reaches OIDN too, and so does its absence.
+    let high = run(IMAGE_QUALITY, Some(Quality::High));
+    let none = run(IMAGE_QUALITY, None);
+    assert!(high != run(IMAGE_QUALITY, Some(Quality::Balanced)));
+    assert!(none != high && none != run(IMAGE_QUALITY, Some(Quality::Balanced)));
+    for out in [&high, &none] {
+        assert!(mse(out, &clean) < before / 5.0);
+    }
 }
 
 #[test]
@@ -259,8 +258,7 @@ fn with_the_variance_detail_the_filter_smooths_comes_back_and_noise_stays_away()
             albedo: Some(&albedo),
             normal: Some(&normal),
             variance,
-            quality: IMAGE_QUALITY,
-            prefilter: PREFILTER_QUALITY,
+            options: Options::default(),
         };
         denoise::denoise(&inputs, 2).expect("OIDN runs")
     };
@@ -286,8 +284,7 @@ fn with_the_variance_detail_the_filter_smooths_comes_back_and_noise_stays_away()
         albedo: Some(&albedo),
         normal: Some(&normal),
         variance: Some(&variance),
-        quality: IMAGE_QUALITY,
-        prefilter: PREFILTER_QUALITY,
+        options: Options::default(),
     };
     let out = denoise::denoise(&inputs, 2).expect("OIDN runs");
     let (before, after) = (mse(&color, &clean), mse(&out, &clean));

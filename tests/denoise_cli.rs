@@ -77,12 +77,31 @@ fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
 }
 
 #[test]
-fn denoised_previews_need_a_denoised_render() {
+fn denoised_previews_and_the_denoisers_options_need_a_denoised_render() {
     let dir = temp_dir("denoise-previews");
-    let (status, err) = run(SMALL, &dir.join("out.png"), &["--denoise-previews"]);
+    for option in [
+        &["--denoise-previews"][..],
+        &["--denoise-quality", "fast"],
+        &["--denoise-prefilter", "none"],
+    ] {
+        let (status, err) = run(SMALL, &dir.join("out.png"), option);
+        assert_eq!(status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!(
+                "{}: the render is not denoised; add --denoise",
+                option[0]
+            )),
+            "{err}"
+        );
+        assert!(!dir.join("out.png").exists());
+    }
+    // A quality that does not exist, named with those that do.
+    let (status, err) = run(SMALL, &dir.join("out.png"), &["--denoise-quality", "none"]);
     assert_eq!(status.code(), Some(2), "{err}");
-    assert!(err.contains("add --denoise"), "{err}");
-    assert!(!dir.join("out.png").exists());
+    assert!(
+        err.contains("no quality `none`; it is one of high, balanced, fast"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -189,6 +208,22 @@ mod with_oidn {
         );
         assert_ne!(with("high.exr", &["--prefilter", "high"]), exr);
         assert_ne!(with("fast.exr", &["--quality", "fast"]), exr);
+        // A render asks for them as `lumen denoise` does.
+        let none = with(
+            "none.exr",
+            &["--prefilter", "none", "--quality", "balanced"],
+        );
+        assert_ne!(none, exr);
+        let asked = dir.join("asked.exr");
+        let extra = [
+            "--denoise",
+            "--denoise-prefilter",
+            "none",
+            "--denoise-quality",
+            "balanced",
+        ];
+        render(&asked, &extra);
+        assert_eq!(std::fs::read(&asked).unwrap(), none);
         render(&dir.join("second.exr"), &["--denoise"]);
         assert_eq!(std::fs::read(dir.join("second.exr")).unwrap(), exr);
         // Another format: the denoised image, the noisy one, the buffers.

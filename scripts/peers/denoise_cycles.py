@@ -86,8 +86,12 @@ renders, as lumen's zsobol), pixel filter box 1 px (lumen's), no clamping,
 light tree on, bounces max_depth - 2 (the same paths as lumen's
 max_depth), view transform Standard, exposure 0 (the EXR is linear). When
 denoised: use_denoising, denoiser OPENIMAGEDENOISE on the CPU, input passes
-RGB_ALBEDO_NORMAL, prefilter ACCURATE, quality HIGH: the filter lumen runs
-(OIDN RT, HDR, albedo and normal prefiltered and then clean).
+RGB_ALBEDO_NORMAL, prefilter ACCURATE, quality HIGH: OIDN RT, HDR, albedo
+and normal prefiltered and then clean, as lumen's (whose prefilters run at
+balanced quality). --cycles-prefilter FAST (the guides go to the image's
+filter as they are: one filter run where ACCURATE makes three) and
+--cycles-quality BALANCED measure Cycles' cheaper settings; --lumen-prefilter
+none lumen's (`--denoise-prefilter none`: one filter run, as Cycles' FAST).
 
 usage: scripts/peers/denoise_cycles.py LUMEN [--scenes cornell-box,gltf-models]
        [--width 320] [--spp 16,64,256] [--reference-spp 16384] [--cache DIR]
@@ -159,9 +163,9 @@ def cycles_render(job):
     scene.view_layers[0].cycles.use_denoising = job["denoise"]
     c.denoiser = "OPENIMAGEDENOISE"
     c.denoising_input_passes = "RGB_ALBEDO_NORMAL"
-    c.denoising_prefilter = "ACCURATE"
+    c.denoising_prefilter = job.get("prefilter", "ACCURATE")
     if hasattr(c, "denoising_quality"):
-        c.denoising_quality = "HIGH"
+        c.denoising_quality = job.get("quality", "HIGH")
     if hasattr(c, "denoising_use_gpu"):
         c.denoising_use_gpu = False
     if job.get("warm"):
@@ -208,6 +212,8 @@ def run_lumen(a, name, spp, out, denoise, seed=None, nice=False, extra=()):
         command += ["--seed", str(seed)]
     if denoise:
         command.append("--denoise")
+        if a.lumen_prefilter:
+            command += ["--denoise-prefilter", a.lumen_prefilter]
     if a.nice or nice:
         command = ["nice", "-n", "19"] + command
     t0 = time.perf_counter()
@@ -244,7 +250,8 @@ def run_cycles(a, name, spp, out, denoise, seed=0, nice=False):
            "seed": seed, "threads": a.threads, "pattern": a.cycles_pattern, "denoise": denoise,
            "out": os.path.abspath(out), "warm": a.cycles_warm,
            "distribution": a.cycles_distribution, "linear_textures": a.cycles_linear_textures,
-           "world_map": a.cycles_world_map}
+           "world_map": a.cycles_world_map, "prefilter": a.cycles_prefilter,
+           "quality": a.cycles_quality}
     command = [a.cycles_python, str(Path(__file__).resolve()), "--cycles-render", json.dumps(job)]
     if a.nice or nice:
         command = ["nice", "-n", "19"] + command
@@ -332,6 +339,13 @@ def main():
     p.add_argument("--cycles-world-map", type=int, default=0,
                    help="glTF scenes: the sky's importance map MANUAL at this resolution (0: Cycles' "
                         "default, AUTOMATIC, whose map costs seconds in every render call here)")
+    p.add_argument("--lumen-prefilter", choices=["high", "balanced", "fast", "none"],
+                   help="lumen's --denoise-prefilter (default: lumen's, balanced)")
+    p.add_argument("--cycles-prefilter", default="ACCURATE", choices=["ACCURATE", "FAST", "NONE"],
+                   help="Cycles' denoising prefilter (ACCURATE: albedo and normal prefiltered, "
+                        "as lumen's; FAST: passed to the image's filter as they are)")
+    p.add_argument("--cycles-quality", default="HIGH", choices=["HIGH", "BALANCED", "FAST"],
+                   help="Cycles' denoising quality (OIDN's, for every filter it runs)")
     p.add_argument("--cycles-warm", action="store_true",
                    help="a warm-up Cycles render before each timed one, in the same process")
     p.add_argument("--prepare", action="store_true",

@@ -237,21 +237,23 @@ impl Library {
         let mut normal = inputs.normal.map(flat);
         // Prefiltered auxiliary images: each cleaned by a filter of its own
         // (written in place), so that the image's filter can trust them.
-        let prefilter = |name: &CStr, buffer: &mut Vec<f32>| -> Result<(), DenoiseError> {
+        let prefilter = |name: &CStr, buffer: &mut Vec<f32>, q: Quality| {
             let mut clean = vec![0.0; buffer.len()];
             let filter = device.filter()?;
             filter.image(name, buffer, w, h);
             filter.image(c"output", &mut clean, w, h);
-            filter.int(c"quality", quality(inputs.prefilter));
+            filter.int(c"quality", quality(q));
             filter.run()?;
             *buffer = clean;
-            Ok(())
+            Ok::<_, DenoiseError>(())
         };
-        if let Some(albedo) = albedo.as_mut() {
-            prefilter(c"albedo", albedo)?;
-        }
-        if let Some(normal) = normal.as_mut() {
-            prefilter(c"normal", normal)?;
+        if let Some(q) = inputs.options.prefilter {
+            if let Some(albedo) = albedo.as_mut() {
+                prefilter(c"albedo", albedo, q)?;
+            }
+            if let Some(normal) = normal.as_mut() {
+                prefilter(c"normal", normal, q)?;
+            }
         }
         let mut output = vec![0.0; color.len()];
         let filter = device.filter()?;
@@ -264,8 +266,11 @@ impl Library {
         }
         filter.image(c"output", &mut output, w, h);
         filter.flag(c"hdr", true);
-        filter.flag(c"cleanAux", albedo.is_some());
-        filter.int(c"quality", quality(inputs.quality));
+        filter.flag(
+            c"cleanAux",
+            albedo.is_some() && inputs.options.prefilter.is_some(),
+        );
+        filter.int(c"quality", quality(inputs.options.quality));
         filter.run()?;
         Ok(output
             .chunks_exact(3)

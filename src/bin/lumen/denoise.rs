@@ -5,7 +5,7 @@
 use crate::render::resolved;
 use anyhow::{bail, Context, Result};
 use lumen::aov::Aov;
-use lumen::denoise::{self, ExrChannels, Inputs, Quality};
+use lumen::denoise::{self, ExrChannels, Inputs, Options};
 use lumen::film::Film;
 use lumen::lock::RenderLock;
 use lumen::math::Color;
@@ -22,7 +22,7 @@ pub(crate) fn announce() -> Result<()> {
 }
 
 /// Writes the film to `out` with its feature buffers; when `denoise`, the
-/// image denoised, and the noisy one beside it (see
+/// image denoised with those options, and the noisy one beside it (see
 /// [`output::noisy_path`]), written first so that a failed denoise loses
 /// nothing. Returns the denoised image, if it made one.
 pub(crate) fn write_image(
@@ -30,12 +30,12 @@ pub(crate) fn write_image(
     film: &Film,
     gamma: f32,
     aovs: &[Aov],
-    denoise: bool,
+    denoise: Option<Options>,
 ) -> Result<Option<Vec<Color>>> {
-    if !denoise {
+    let Some(options) = denoise else {
         output::write_image(out, film, gamma, aovs)?;
         return Ok(None);
-    }
+    };
     let noisy = output::noisy_path(out);
     // Another format's feature buffers are files of their own, written
     // once, beside the denoised image.
@@ -45,12 +45,13 @@ pub(crate) fn write_image(
     };
     output::write_image(&noisy, film, gamma, noisy_aovs)?;
     let start = Instant::now();
-    let clean = denoise::denoise_film(film, rayon::current_num_threads()).with_context(|| {
-        format!(
-            "cannot denoise the image; the noisy image is in {}",
-            noisy.display()
-        )
-    })?;
+    let clean =
+        denoise::denoise_film(film, rayon::current_num_threads(), options).with_context(|| {
+            format!(
+                "cannot denoise the image; the noisy image is in {}",
+                noisy.display()
+            )
+        })?;
     let beauty = Beauty::Colors {
         width: film.width(),
         height: film.height(),
@@ -72,8 +73,7 @@ pub(crate) fn denoise_command(
     input: &Path,
     out: &Path,
     gamma: f32,
-    quality: Quality,
-    prefilter: Quality,
+    options: Options,
 ) -> Result<ExitCode> {
     let format = ImageFormat::from_path(out)?;
     if resolved(input) == resolved(out) {
@@ -96,8 +96,7 @@ pub(crate) fn denoise_command(
             albedo: Some(&guided.albedo),
             normal: Some(&guided.normal),
             variance: guided.variance.as_deref(),
-            quality,
-            prefilter,
+            options,
         },
         rayon::current_num_threads(),
     )?;

@@ -90,6 +90,8 @@ enum Command {
         /// every part records].
         #[arg(long, value_parser = parse_gamma)]
         gamma: Option<f32>,
+        #[command(flatten)]
+        denoise: DenoiseArgs,
     },
     /// Denoise an OpenEXR image that has albedo and normal layers (as
     /// `render --aov albedo,normal` or `--denoise` writes them) with Open
@@ -117,9 +119,10 @@ enum Command {
         #[arg(long, default_value = lumen::denoise::IMAGE_QUALITY.name(), value_parser = parse_quality)]
         quality: Quality,
         /// The albedo's and normal's prefilters' quality: high, balanced or
-        /// fast (a render's `--denoise` uses balanced).
-        #[arg(long, default_value = lumen::denoise::PREFILTER_QUALITY.name(), value_parser = parse_quality)]
-        prefilter: Quality,
+        /// fast; or none: not prefiltered, passed to the image's filter as
+        /// they are (a render's `--denoise` uses balanced).
+        #[arg(long, default_value = prefilter_name(lumen::denoise::PREFILTER), value_parser = parse_prefilter)]
+        prefilter: PrefilterArg,
     },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
@@ -408,6 +411,8 @@ struct ProgressiveArgs {
     /// images saved between passes too, not only the finished one.
     #[arg(long)]
     denoise_previews: bool,
+    #[command(flatten)]
+    denoise: DenoiseArgs,
     /// Serve the image so far on a local web page (http://127.0.0.1:PORT,
     /// printed at start), updated after every pass: docs/preview.md.
     #[arg(long)]
@@ -510,6 +515,60 @@ fn parse_quality(text: &str) -> Result<Quality, String> {
     text.parse()
 }
 
+/// How a denoised render's image is denoised (`render`, `merge`).
+#[derive(Args, Clone, Default)]
+struct DenoiseArgs {
+    /// With --denoise: the quality of the image's filter, high, balanced
+    /// or fast (Open Image Denoise's `quality`) [default: high].
+    #[arg(long, value_name = "Q", value_parser = parse_quality)]
+    denoise_quality: Option<Quality>,
+    /// With --denoise: the quality of the albedo's and normal's
+    /// prefilters, high, balanced or fast; or none: passed to the image's
+    /// filter as they are [default: balanced].
+    #[arg(long, value_name = "Q", value_parser = parse_prefilter)]
+    denoise_prefilter: Option<PrefilterArg>,
+}
+
+impl DenoiseArgs {
+    /// Whether any is given.
+    fn any(&self) -> Option<&'static str> {
+        if self.denoise_quality.is_some() {
+            Some("--denoise-quality")
+        } else if self.denoise_prefilter.is_some() {
+            Some("--denoise-prefilter")
+        } else {
+            None
+        }
+    }
+
+    /// The denoiser's options these arguments ask for.
+    fn options(&self) -> lumen::denoise::Options {
+        let default = lumen::denoise::Options::default();
+        lumen::denoise::Options {
+            quality: self.denoise_quality.unwrap_or(default.quality),
+            prefilter: self.denoise_prefilter.map_or(default.prefilter, |p| p.0),
+        }
+    }
+}
+
+/// A prefilter's quality, or none (`--prefilter`, `--denoise-prefilter`).
+#[derive(Clone, Copy, Debug)]
+struct PrefilterArg(Option<Quality>);
+
+fn parse_prefilter(text: &str) -> Result<PrefilterArg, String> {
+    match text {
+        "none" => Ok(PrefilterArg(None)),
+        _ => text
+            .parse()
+            .map(|q| PrefilterArg(Some(q)))
+            .map_err(|e| format!("{e}, or none")),
+    }
+}
+
+fn prefilter_name(prefilter: Option<Quality>) -> &'static str {
+    prefilter.map_or("none", Quality::name)
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
@@ -577,7 +636,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
             output,
             partial,
             gamma,
-        } => merge::merge_command(&parts, &output, partial, gamma),
+            denoise,
+        } => merge::merge_command(&parts, &output, partial, gamma, &denoise),
         Command::Denoise {
             input,
             output,
@@ -586,7 +646,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
             quality,
             prefilter,
         } => with_threads(threads, || {
-            denoise::denoise_command(&input, &output, gamma, quality, prefilter)
+            let options = lumen::denoise::Options {
+                quality,
+                prefilter: prefilter.0,
+            };
+            denoise::denoise_command(&input, &output, gamma, options)
         }),
         Command::Scenes { action: None } => {
             let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);

@@ -13,6 +13,7 @@ pub(crate) fn merge_command(
     out: &Path,
     partial: bool,
     gamma: Option<f32>,
+    denoise_args: &crate::DenoiseArgs,
 ) -> Result<ExitCode> {
     output::ImageFormat::from_path(out)?;
     let place = resolved(out);
@@ -28,6 +29,9 @@ pub(crate) fn merge_command(
     if merged.samples_held == 0 {
         bail!("the parts hold no samples yet: nothing to merge");
     }
+    if let (false, Some(option)) = (merged.denoise, denoise_args.any()) {
+        bail!("{option}: the parts' render is not denoised; `lumen denoise` denoises an EXR image");
+    }
     // A partial merge is a preview: denoised only once complete.
     let denoise = merged.denoise && merged.is_complete();
     if denoise {
@@ -38,7 +42,7 @@ pub(crate) fn merge_command(
         &merged.film,
         gamma.unwrap_or(merged.gamma),
         &merged.aovs,
-        denoise,
+        denoise.then_some(denoise_args.options()),
     )?;
     if merged.is_complete() {
         errln!(

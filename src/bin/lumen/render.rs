@@ -124,11 +124,16 @@ pub(crate) fn render_command(
     let denoise = scene.settings.denoise && image.is_some();
     if scene.settings.denoise && image.is_none() {
         errln!("lumen: note: a part is not denoised; `lumen merge` denoises the merged image");
-    } else if !denoise && prog.denoise_previews {
-        return Err(
-            Usage("--denoise-previews: the render is not denoised; add --denoise".into()).into(),
-        );
+    } else if !denoise {
+        let previews = prog.denoise_previews.then_some("--denoise-previews");
+        if let Some(option) = previews.or(prog.denoise.any()) {
+            return Err(Usage(format!(
+                "{option}: the render is not denoised; add --denoise"
+            ))
+            .into());
+        }
     }
+    let options = prog.denoise.options();
     let noisy = output::noisy_path(out);
     let mut targets: Vec<&Path> = match image {
         Some(image) => vec![image, &ckpt_path],
@@ -236,7 +241,9 @@ pub(crate) fn render_command(
         let mut denoised = None;
         if let Some(image) = image {
             let now = denoise && (last || prog.denoise_previews);
-            denoised = crate::denoise::write_image(image, session.film(), s.gamma, &s.aovs, now)?;
+            let denoise = now.then_some(options);
+            denoised =
+                crate::denoise::write_image(image, session.film(), s.gamma, &s.aovs, denoise)?;
         }
         if image.is_none() || !session.is_complete() {
             session
