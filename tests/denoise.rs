@@ -34,14 +34,25 @@ fn denoised(
     albedo: Option<&[Vec3]>,
     normal: Option<&[Vec3]>,
 ) -> Result<Vec<Color>, denoise::DenoiseError> {
+    denoised_with(color, albedo, normal, None, Options::default())
+}
+
+/// [`denoised`], with a variance buffer and the filters' options.
+fn denoised_with(
+    color: &[Color],
+    albedo: Option<&[Vec3]>,
+    normal: Option<&[Vec3]>,
+    variance: Option<&[Color]>,
+    options: Options,
+) -> Result<Vec<Color>, denoise::DenoiseError> {
     let inputs = Inputs {
         width: 64,
         height: 64,
         color,
         albedo,
         normal,
-        variance: None,
-        options: Options::default(),
+        variance,
+        options,
     };
     denoise::denoise(&inputs, 2)
 }
@@ -120,16 +131,8 @@ fn each_quality_runs_its_own_network_and_each_denoises() {
         *a = (*a + Vec3::splat((rng.next_f32() - 0.5) * 0.2)).clamp(Vec3::ZERO, Vec3::ONE);
     }
     let run = |quality, prefilter| {
-        let inputs = Inputs {
-            width: 64,
-            height: 64,
-            color: &color,
-            albedo: Some(&albedo),
-            normal: Some(&normal),
-            variance: None,
-            options: Options { quality, prefilter },
-        };
-        denoise::denoise(&inputs, 2).expect("OIDN runs")
+        let options = Options { quality, prefilter };
+        denoised_with(&color, Some(&albedo), Some(&normal), None, options).expect("OIDN runs")
     };
     let before = mse(&color, &clean);
     let mut outputs = Vec::new();
@@ -277,16 +280,14 @@ fn with_the_variance_detail_the_filter_smooths_comes_back_and_noise_stays_away()
     // test, its true variance given), the blend keeps its work.
     let (clean, color, albedo, normal) = noisy_flat();
     let variance = vec![Color::splat(0.01); color.len()];
-    let inputs = Inputs {
-        width: 64,
-        height: 64,
-        color: &color,
-        albedo: Some(&albedo),
-        normal: Some(&normal),
-        variance: Some(&variance),
-        options: Options::default(),
-    };
-    let out = denoise::denoise(&inputs, 2).expect("OIDN runs");
+    let out = denoised_with(
+        &color,
+        Some(&albedo),
+        Some(&normal),
+        Some(&variance),
+        Options::default(),
+    )
+    .expect("OIDN runs");
     let (before, after) = (mse(&color, &clean), mse(&out, &clean));
     assert!(after < before / 5.0, "error {before} before, {after} after");
 }

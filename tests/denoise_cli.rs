@@ -27,12 +27,15 @@ fn render(out: &Path, extra: &[&str]) {
 
 /// `lumen denoise INPUT -o OUT`.
 fn denoise(input: &Path, out: &Path) -> Output {
-    lumen_output(&[
-        "denoise",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ])
+    denoise_with(input, out, &[])
+}
+
+/// `lumen denoise INPUT -o OUT EXTRA...`.
+fn denoise_with(input: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["denoise", input.to_str().unwrap(), "-o"];
+    args.push(out.to_str().unwrap());
+    args.extend_from_slice(extra);
+    lumen_output(&args)
 }
 
 #[test]
@@ -64,14 +67,7 @@ fn an_image_without_albedo_or_normal_is_refused_naming_its_channels() {
     let o = denoise(&noisy, &noisy);
     assert_refused(&o, &["cannot replace its input"]);
     // A quality that does not exist, named with those that do.
-    let o = lumen_output(&[
-        "denoise",
-        noisy.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--prefilter",
-        "best",
-    ]);
+    let o = denoise_with(&noisy, &out, &["--prefilter", "best"]);
     assert_refused(&o, &["`best`", "high, balanced, fast"]);
     assert!(!out.exists());
 }
@@ -176,29 +172,16 @@ mod with_oidn {
         }
         // The same input gives the same bits, from the render or from its
         // noisy image.
-        let again = dir.join("again.exr");
-        let o = lumen_output(&[
-            "denoise",
-            noisy.to_str().unwrap(),
-            "-o",
-            again.to_str().unwrap(),
-            "--threads",
-            "2",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        assert_eq!(std::fs::read(&again).unwrap(), exr);
-        // The render's qualities named are its own; others give another
-        // image.
         let with = |name: &str, args: &[&str]| {
             let path = dir.join(name);
-            let mut command = vec!["denoise", noisy.to_str().unwrap(), "-o"];
-            command.push(path.to_str().unwrap());
-            command.extend_from_slice(&["--threads", "2"]);
-            command.extend_from_slice(args);
-            let o = lumen_output(&command);
+            let extra = [&["--threads", "2"], args].concat();
+            let o = denoise_with(&noisy, &path, &extra);
             assert!(o.status.success(), "{}", stderr(&o));
             std::fs::read(&path).unwrap()
         };
+        assert_eq!(with("again.exr", &[]), exr);
+        // The render's qualities named are its own; others give another
+        // image.
         assert_eq!(
             with(
                 "named.exr",
