@@ -39,6 +39,15 @@ impl RenderStats {
         self.dropped = self.dropped.saturating_add(other.dropped);
     }
 
+    /// Counts a camera sample, as dropped unless the film `added` it.
+    #[inline(always)]
+    fn count(&mut self, added: bool) {
+        self.samples += 1;
+        if !added {
+            self.dropped += 1;
+        }
+    }
+
     /// A warning when more than [`DROPPED_WARNING`] of the samples were
     /// dropped (NaN, infinite or too large), with their count and the
     /// likely causes.
@@ -368,10 +377,7 @@ fn add_samples<'f>(
 ) {
     if row.layers.is_empty() {
         for (index, c, _) in samples {
-            stats.samples += 1;
-            if !row.add(x, index, c) {
-                stats.dropped += 1;
-            }
+            stats.count(row.add(x, index, c));
         }
         return;
     }
@@ -389,10 +395,7 @@ fn add_samples_with_features<'f>(
 ) {
     let mut unit = UnitFeatures::default();
     for (index, c, f) in samples {
-        stats.samples += 1;
-        if !row.add_with(x, index, c, f, &mut unit) {
-            stats.dropped += 1;
-        }
+        stats.count(row.add_with(x, index, c, f, &mut unit));
     }
     row.add_unit_features(x, &unit);
 }

@@ -115,14 +115,14 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
         threads: Option<u32>,
         /// The image filter's quality: high, balanced or fast (Open Image
-        /// Denoise's `quality`; a render's `--denoise` uses high).
-        #[arg(long, default_value = lumen::denoise::IMAGE_QUALITY.name(), value_parser = parse_quality)]
-        quality: Quality,
+        /// Denoise's `quality`) [default: high, as a render's `--denoise`].
+        #[arg(long, value_name = "Q", value_parser = parse_quality)]
+        quality: Option<Quality>,
         /// The albedo's and normal's prefilters' quality: high, balanced or
         /// fast; or none: not prefiltered, passed to the image's filter as
-        /// they are (a render's `--denoise` uses balanced).
-        #[arg(long, default_value = prefilter_name(lumen::denoise::PREFILTER), value_parser = parse_prefilter)]
-        prefilter: PrefilterArg,
+        /// they are [default: balanced, as a render's `--denoise`].
+        #[arg(long, value_name = "Q", value_parser = parse_prefilter)]
+        prefilter: Option<PrefilterArg>,
     },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
@@ -543,11 +543,19 @@ impl DenoiseArgs {
 
     /// The denoiser's options these arguments ask for.
     fn options(&self) -> lumen::denoise::Options {
-        let default = lumen::denoise::Options::default();
-        lumen::denoise::Options {
-            quality: self.denoise_quality.unwrap_or(default.quality),
-            prefilter: self.denoise_prefilter.map_or(default.prefilter, |p| p.0),
-        }
+        denoise_options(self.denoise_quality, self.denoise_prefilter)
+    }
+}
+
+/// The denoiser's options with those given in place of the defaults.
+fn denoise_options(
+    quality: Option<Quality>,
+    prefilter: Option<PrefilterArg>,
+) -> lumen::denoise::Options {
+    let default = lumen::denoise::Options::default();
+    lumen::denoise::Options {
+        quality: quality.unwrap_or(default.quality),
+        prefilter: prefilter.map_or(default.prefilter, |p| p.0),
     }
 }
 
@@ -563,10 +571,6 @@ fn parse_prefilter(text: &str) -> Result<PrefilterArg, String> {
             .map(|q| PrefilterArg(Some(q)))
             .map_err(|e| format!("{e}, or none")),
     }
-}
-
-fn prefilter_name(prefilter: Option<Quality>) -> &'static str {
-    prefilter.map_or("none", Quality::name)
 }
 
 fn main() -> ExitCode {
@@ -646,10 +650,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             quality,
             prefilter,
         } => with_threads(threads, || {
-            let options = lumen::denoise::Options {
-                quality,
-                prefilter: prefilter.0,
-            };
+            let options = denoise_options(quality, prefilter);
             denoise::denoise_command(&input, &output, gamma, options)
         }),
         Command::Scenes { action: None } => {
