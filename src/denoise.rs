@@ -1,6 +1,7 @@
 //! Denoising: a noisy image and its albedo and normal buffers
-//! ([`crate::aov`]) in, a clean image out, by Intel Open Image Denoise
-//! (OIDN).
+//! ([`crate::aov`]) in, a clean image out, by one of two [`Denoiser`]s:
+//! Intel Open Image Denoise (OIDN), the default, or lumen's own
+//! [`atrous`] filter, which every build has.
 //!
 //! OIDN is a C++ library, so it is never part of the default build: the
 //! cargo feature `oidn` compiles [`oidn`], which loads the library when a
@@ -20,6 +21,8 @@
 #[allow(unsafe_code)]
 pub mod oidn;
 
+pub mod atrous;
+
 use crate::aov::Layer;
 use crate::film::Film;
 use crate::light::luminance;
@@ -30,11 +33,12 @@ use thiserror::Error;
 /// What kept an image from being denoised.
 #[derive(Clone, Debug, Error)]
 pub enum DenoiseError {
-    /// This build has no denoiser.
+    /// This build has no OIDN.
     #[error(
-        "this lumen was built without the denoiser; build it with \
+        "this lumen was built without Open Image Denoise; build it with \
          `OIDN_DIR=/path/to/oidn cargo build --release --features oidn` \
-         (see docs/denoising.md)"
+         (see docs/denoising.md), or choose the built-in filter, \
+         `--denoiser atrous`"
     )]
     NotBuilt,
     /// The OIDN library was not found, or would not load.
@@ -85,10 +89,7 @@ impl Quality {
 
     /// Its name (see [`Quality::NAMES`]).
     pub fn name(self) -> &'static str {
-        Self::NAMES
-            .iter()
-            .find(|(_, q)| *q == self)
-            .map_or("high", |(name, _)| name)
+        name_in(&Self::NAMES, self)
     }
 }
 
@@ -96,15 +97,59 @@ impl std::str::FromStr for Quality {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::NAMES
-            .iter()
-            .find(|(name, _)| *name == s)
-            .map(|&(_, q)| q)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Self::NAMES.iter().map(|(name, _)| *name).collect();
-                format!("no quality `{s}`; it is one of {}", names.join(", "))
-            })
+        parse_in(&Self::NAMES, s, "quality")
     }
+}
+
+/// Which filter denoises the image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Denoiser {
+    /// Intel Open Image Denoise (builds with the `oidn` feature): a neural
+    /// network trained on rendered images, the best there is on a CPU.
+    #[default]
+    Oidn,
+    /// lumen's own edge-avoiding à-trous filter ([`atrous`]): in every
+    /// build, much quicker and much less clean.
+    Atrous,
+}
+
+impl Denoiser {
+    /// Each denoiser with its name, as options and messages spell it.
+    pub const NAMES: [(&'static str, Denoiser); 2] =
+        [("oidn", Denoiser::Oidn), ("atrous", Denoiser::Atrous)];
+
+    /// Its name (see [`Denoiser::NAMES`]).
+    pub fn name(self) -> &'static str {
+        name_in(&Self::NAMES, self)
+    }
+}
+
+impl std::str::FromStr for Denoiser {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        parse_in(&Self::NAMES, s, "denoiser")
+    }
+}
+
+/// The name of `value` in `names`.
+fn name_in<T: Copy + PartialEq>(names: &[(&'static str, T)], value: T) -> &'static str {
+    names
+        .iter()
+        .find(|(_, v)| *v == value)
+        .map_or("", |(name, _)| name)
+}
+
+/// The value named `s` in `names`, or a message naming them all.
+fn parse_in<T: Copy>(names: &[(&'static str, T)], s: &str, what: &str) -> Result<T, String> {
+    names
+        .iter()
+        .find(|(name, _)| *name == s)
+        .map(|&(_, v)| v)
+        .ok_or_else(|| {
+            let all: Vec<&str> = names.iter().map(|(name, _)| *name).collect();
+            format!("no {what} `{s}`; it is one of {}", all.join(", "))
+        })
 }
 
 /// The quality of the image's filter in lumen's denoised renders.
@@ -141,9 +186,12 @@ pub struct Inputs<'a> {
     pub options: Options,
 }
 
-/// How hard the denoiser works.
+/// Which denoiser runs, and how hard it works.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Options {
+    /// The filter ([`Denoiser::Oidn`] by default); the qualities below
+    /// are OIDN's, and the built-in filter has none.
+    pub denoiser: Denoiser,
     /// The quality of the image's filter ([`IMAGE_QUALITY`] by default).
     pub quality: Quality,
     /// The quality of the albedo's and normal's prefilters ([`PREFILTER`]
@@ -156,6 +204,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
+            denoiser: Denoiser::Oidn,
             quality: IMAGE_QUALITY,
             prefilter: PREFILTER,
         }
@@ -189,11 +238,14 @@ impl Inputs<'_> {
     }
 }
 
-/// Whether this build has a denoiser and its library loads: asked before
+/// Whether this build has `denoiser` and its library loads: asked before
 /// a render that ends in a denoise starts, so that a missing library is
 /// found out at once and not after hours of rendering. Returns the
-/// library's description (its path and version).
-pub fn check_available() -> Result<String, DenoiseError> {
+/// denoiser's description (OIDN's path and version).
+pub fn check_available(denoiser: Denoiser) -> Result<String, DenoiseError> {
+    if denoiser == Denoiser::Atrous {
+        return Ok("lumen's à-trous filter".into());
+    }
     #[cfg(feature = "oidn")]
     {
         oidn::Library::get().map(|lib| lib.describe())
@@ -220,30 +272,36 @@ pub const HIGHLIGHT_FACTOR: f64 = 10.0;
 /// pixels (docs/denoising.md, "Means").
 pub fn denoise(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseError> {
     inputs.check()?;
+    let (base, highlights) = split_highlights(inputs.color);
+    let base = Inputs {
+        color: &base,
+        ..*inputs
+    };
+    let mut out = match inputs.options.denoiser {
+        Denoiser::Oidn => oidn_filter(&base, threads)?,
+        Denoiser::Atrous => atrous::filter(&base),
+    };
+    // The HDR filter can leave tiny negative values and, given values it
+    // cannot represent, NaN, and a highlight is NaN where the input was:
+    // neither belongs in an image.
+    for (c, h) in out.iter_mut().zip(&highlights) {
+        *c = clean(clean(*c) + *h);
+    }
+    if let Some(variance) = inputs.variance {
+        blend(&mut out, inputs.color, variance, inputs.width);
+    }
+    Ok(out)
+}
+
+/// `inputs` through OIDN's filter, if this build has it.
+fn oidn_filter(inputs: &Inputs, threads: usize) -> Result<Vec<Color>, DenoiseError> {
     #[cfg(feature = "oidn")]
     {
-        let (base, highlights) = split_highlights(inputs.color);
-        let mut out = oidn::Library::get()?.denoise(
-            &Inputs {
-                color: &base,
-                ..*inputs
-            },
-            threads,
-        )?;
-        // The HDR filter can leave tiny negative values and, given
-        // values it cannot represent, NaN, and a highlight is NaN where
-        // the input was: neither belongs in an image.
-        for (c, h) in out.iter_mut().zip(&highlights) {
-            *c = clean(clean(*c) + *h);
-        }
-        if let Some(variance) = inputs.variance {
-            blend(&mut out, inputs.color, variance, inputs.width);
-        }
-        Ok(out)
+        oidn::Library::get()?.denoise(inputs, threads)
     }
     #[cfg(not(feature = "oidn"))]
     {
-        let _ = threads;
+        let _ = (inputs, threads);
         Err(DenoiseError::NotBuilt)
     }
 }

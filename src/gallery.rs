@@ -48,7 +48,7 @@ pub fn make_gallery(
         message: e.to_string(),
     })?;
     if overrides.denoise {
-        crate::denoise::check_available()?;
+        crate::denoise::check_available(crate::denoise::Denoiser::Oidn)?;
     }
     // Compile everything first so that a bad override fails before any render.
     let mut scenes = Vec::with_capacity(BUILTINS.len());

@@ -131,7 +131,11 @@ fn each_quality_runs_its_own_network_and_each_denoises() {
         *a = (*a + Vec3::splat((rng.next_f32() - 0.5) * 0.2)).clamp(Vec3::ZERO, Vec3::ONE);
     }
     let run = |quality, prefilter| {
-        let options = Options { quality, prefilter };
+        let options = Options {
+            quality,
+            prefilter,
+            ..Options::default()
+        };
         denoised_with(&color, Some(&albedo), Some(&normal), None, options).expect("OIDN runs")
     };
     let before = mse(&color, &clean);

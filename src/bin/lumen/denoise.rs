@@ -5,7 +5,7 @@
 use crate::render::resolved;
 use anyhow::{bail, Context, Result};
 use lumen::aov::Aov;
-use lumen::denoise::{self, ExrChannels, Inputs, Options};
+use lumen::denoise::{self, Denoiser, ExrChannels, Inputs, Options};
 use lumen::film::Film;
 use lumen::lock::RenderLock;
 use lumen::math::Color;
@@ -15,8 +15,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 /// Says which denoiser a render will use, or refuses before it starts.
-pub(crate) fn announce() -> Result<()> {
-    let library = denoise::check_available().context("--denoise")?;
+pub(crate) fn announce(denoiser: Denoiser) -> Result<()> {
+    let library = denoise::check_available(denoiser).context("--denoise")?;
     errln!("denoising with {library}");
     Ok(())
 }
@@ -85,7 +85,7 @@ pub(crate) fn denoise_command(
     output::check_writable(out)?;
     let image = ExrChannels::read(input)?;
     let guided = image.denoiser_layers(input)?;
-    let library = denoise::check_available()?;
+    let library = denoise::check_available(options.denoiser)?;
     let _lock = RenderLock::acquire(out)?;
     let start = Instant::now();
     let clean = denoise::denoise(

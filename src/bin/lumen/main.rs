@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use lumen::denoise::Quality;
+use lumen::denoise::{Denoiser, Quality};
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
@@ -95,7 +95,8 @@ enum Command {
     },
     /// Denoise an OpenEXR image that has albedo and normal layers (as
     /// `render --aov albedo,normal` or `--denoise` writes them) with Open
-    /// Image Denoise: for split renders, merged first and denoised once.
+    /// Image Denoise or lumen's own filter: for split renders, merged
+    /// first and denoised once.
     /// With a variance layer the result is blended back towards the
     /// samples where the filter changed more than the noise explains.
     /// See docs/denoising.md.
@@ -114,6 +115,11 @@ enum Command {
         /// the same bits for the same input and number of threads.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_THREADS))]
         threads: Option<u32>,
+        /// The denoiser: oidn (Open Image Denoise, in builds with the
+        /// `oidn` feature) or atrous (lumen's own filter, in every build)
+        /// [default: oidn].
+        #[arg(long, value_name = "NAME", value_parser = parse_denoiser)]
+        denoiser: Option<Denoiser>,
         /// The image filter's quality: high, balanced or fast (Open Image
         /// Denoise's `quality`) [default: high, as a render's `--denoise`].
         #[arg(long, value_name = "Q", value_parser = parse_quality)]
@@ -518,6 +524,11 @@ fn parse_quality(text: &str) -> Result<Quality, String> {
 /// How a denoised render's image is denoised (`render`, `merge`).
 #[derive(Args, Clone, Default)]
 struct DenoiseArgs {
+    /// With --denoise: the denoiser, oidn (Open Image Denoise, in builds
+    /// with the `oidn` feature) or atrous (lumen's own filter, in every
+    /// build) [default: oidn].
+    #[arg(long, value_name = "NAME", value_parser = parse_denoiser)]
+    denoiser: Option<Denoiser>,
     /// With --denoise: the quality of the image's filter, high, balanced
     /// or fast (Open Image Denoise's `quality`) [default: high].
     #[arg(long, value_name = "Q", value_parser = parse_quality)]
@@ -532,7 +543,9 @@ struct DenoiseArgs {
 impl DenoiseArgs {
     /// Whether any is given.
     fn any(&self) -> Option<&'static str> {
-        if self.denoise_quality.is_some() {
+        if self.denoiser.is_some() {
+            Some("--denoiser")
+        } else if self.denoise_quality.is_some() {
             Some("--denoise-quality")
         } else if self.denoise_prefilter.is_some() {
             Some("--denoise-prefilter")
@@ -542,21 +555,47 @@ impl DenoiseArgs {
     }
 
     /// The denoiser's options these arguments ask for.
-    fn options(&self) -> lumen::denoise::Options {
-        denoise_options(self.denoise_quality, self.denoise_prefilter)
+    fn options(&self) -> Result<lumen::denoise::Options, Usage> {
+        let names = ["--denoise-quality", "--denoise-prefilter"];
+        denoise_options(
+            self.denoiser,
+            self.denoise_quality,
+            self.denoise_prefilter,
+            names,
+        )
     }
 }
 
-/// The denoiser's options with those given in place of the defaults.
+/// The denoiser's options with those given in place of the defaults;
+/// refused when OIDN's qualities (given as the options `names`) are
+/// given for the built-in filter, which has none.
 fn denoise_options(
+    denoiser: Option<Denoiser>,
     quality: Option<Quality>,
     prefilter: Option<PrefilterArg>,
-) -> lumen::denoise::Options {
+    names: [&str; 2],
+) -> Result<lumen::denoise::Options, Usage> {
     let default = lumen::denoise::Options::default();
-    lumen::denoise::Options {
+    let denoiser = denoiser.unwrap_or(default.denoiser);
+    if denoiser != Denoiser::Oidn {
+        let given = [quality.is_some(), prefilter.is_some()];
+        if let Some(i) = given.iter().position(|&g| g) {
+            return Err(Usage(format!(
+                "{}: a quality of Open Image Denoise; the {} denoiser has none",
+                names[i],
+                denoiser.name()
+            )));
+        }
+    }
+    Ok(lumen::denoise::Options {
+        denoiser,
         quality: quality.unwrap_or(default.quality),
         prefilter: prefilter.map_or(default.prefilter, |p| p.0),
-    }
+    })
+}
+
+fn parse_denoiser(text: &str) -> Result<Denoiser, String> {
+    text.parse()
 }
 
 /// A prefilter's quality, or none (`--prefilter`, `--denoise-prefilter`).
@@ -647,10 +686,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             output,
             gamma,
             threads,
+            denoiser,
             quality,
             prefilter,
         } => with_threads(threads, || {
-            let options = denoise_options(quality, prefilter);
+            let options =
+                denoise_options(denoiser, quality, prefilter, ["--quality", "--prefilter"])?;
             denoise::denoise_command(&input, &output, gamma, options)
         }),
         Command::Scenes { action: None } => {

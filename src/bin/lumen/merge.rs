@@ -34,15 +34,16 @@ pub(crate) fn merge_command(
     }
     // A partial merge is a preview: denoised only once complete.
     let denoise = merged.denoise && merged.is_complete();
+    let options = denoise_args.options()?;
     if denoise {
-        crate::denoise::announce()?;
+        crate::denoise::announce(options.denoiser)?;
     }
     crate::denoise::write_image(
         out,
         &merged.film,
         gamma.unwrap_or(merged.gamma),
         &merged.aovs,
-        denoise.then_some(denoise_args.options()),
+        denoise.then_some(options),
     )?;
     if merged.is_complete() {
         errln!(

@@ -133,7 +133,7 @@ pub(crate) fn render_command(
             .into());
         }
     }
-    let options = prog.denoise.options();
+    let options = prog.denoise.options()?;
     let noisy = output::noisy_path(out);
     let mut targets: Vec<&Path> = match image {
         Some(image) => vec![image, &ckpt_path],
@@ -142,7 +142,7 @@ pub(crate) fn render_command(
     if denoise {
         // Refused before the render, not after it: a build or a machine
         // without the denoiser.
-        crate::denoise::announce()?;
+        crate::denoise::announce(options.denoiser)?;
         output::check_writable(&noisy)?;
         targets.push(&noisy);
     }
