@@ -13,8 +13,9 @@ noisy image beside the denoised one) and reports, for both:
   - the render's and the denoiser's seconds, from lumen's own report.
 
 usage: scripts/denoise-bench.py LUMEN [--scenes cornell-box,...] [--width W]
+       [--denoiser oidn|atrous]
        [--spp 16,64,256] [--reference-spp 16384] [--cache DIR]
-Needs a lumen built with the `oidn` feature and OIDN_DIR set
+Needs, for OIDN (the default), a lumen built with the `oidn` feature and OIDN_DIR set
 (docs/denoising.md), and numpy, mitsuba (to read EXR) and flip-evaluator:
 scripts/peers/setup.sh makes such a Python ($LUMEN_PEERS_PYTHON).
 """
@@ -87,6 +88,7 @@ def main():
     p.add_argument("--spp", default="16,64,256")
     p.add_argument("--reference-spp", type=int, default=16384)
     p.add_argument("--cache", default="denoise-bench")
+    p.add_argument("--denoiser", default="oidn", help="oidn or atrous (lumen's own filter)")
     a = p.parse_args()
     os.makedirs(a.cache, exist_ok=True)
     print(f"relMSE eps = {EPS}; PSNR of gamma-2.2 images clamped to [0, 1]; HDR-FLIP; "
@@ -102,7 +104,7 @@ def main():
         reference = rgb(ref_path)
         for spp in [int(s) for s in a.spp.split(",")]:
             out = os.path.join(a.cache, f"{name}-{a.width}-{spp}.exr")
-            t, td = render(a.lumen, scene, extra + ["--denoise"], a.width, spp, out)
+            t, td = render(a.lumen, scene, extra + ["--denoise", "--denoiser", a.denoiser], a.width, spp, out)
             noisy = out[:-4] + ".noisy.exr"
             for label, path, seconds in [("noisy", noisy, None), ("denoised", out, td)]:
                 rel, psnr, flip, means = metrics(rgb(path), reference)
