@@ -102,7 +102,8 @@ impl std::str::FromStr for Quality {
 }
 
 /// Which filter denoises the image.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Denoiser {
     /// Intel Open Image Denoise (builds with the `oidn` feature): a neural
     /// network trained on rendered images, the best there is on a CPU.

@@ -166,6 +166,7 @@ fn the_built_in_filter_denoises_in_every_build_the_same_bits_on_any_threads() {
 #[test]
 fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
     use lumen::aov::Aov;
+    use lumen::denoise::Denoiser;
     let dir = temp_dir("denoise-toml");
     let path = dir.join("s.toml");
     std::fs::write(&path, "[render]\ndenoise = true\naovs = [\"depth\"]\n").unwrap();
@@ -175,6 +176,18 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
         file.desc.render.written_aovs(),
         [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance]
     );
+    assert_eq!(file.desc.render.denoiser, None);
+    std::fs::write(&path, "[render]\ndenoise = true\ndenoiser = \"atrous\"\n").unwrap();
+    let file = lumen::scene::file::SceneFile::read(&path).unwrap();
+    assert_eq!(file.desc.render.denoiser, Some(Denoiser::Atrous));
+    std::fs::write(&path, "[render]\ndenoiser = \"nfor\"\n").unwrap();
+    let err = lumen::scene::file::SceneFile::read(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("s.toml:2:") && err.contains("render.denoiser") && err.contains("atrous"),
+        "{err}"
+    );
     std::fs::write(&path, "[render]\ndenoise = 1\n").unwrap();
     let err = lumen::scene::file::SceneFile::read(&path)
         .unwrap_err()
@@ -183,6 +196,63 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
         err.contains("s.toml:2:") && err.contains("render.denoise"),
         "{err}"
     );
+}
+
+#[test]
+fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwise() {
+    let dir = temp_dir("denoise-scene-atrous");
+    let scene = dir.join("s.toml");
+    let o = lumen_output(&[
+        "scenes",
+        "export",
+        "cornell-box",
+        "-o",
+        scene.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let text = text.replace(
+        "[render]\n",
+        "[render]\ndenoise = true\ndenoiser = \"atrous\"\n",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let args = [
+        scene.to_str().unwrap(),
+        "--width",
+        "48",
+        "--spp",
+        "8",
+        "--threads",
+        "2",
+    ];
+    let (status, err) = run(&[&["render"][..], &args].concat(), &dir.join("a.exr"), &[]);
+    assert!(status.success(), "{err}");
+    assert!(
+        err.contains("denoising with lumen's à-trous filter"),
+        "{err}"
+    );
+    // The file it gives is `lumen denoise --denoiser atrous`'s of its noisy
+    // image.
+    let again = dir.join("again.exr");
+    let o = denoise_with(&dir.join("a.noisy.exr"), &again, &["--denoiser", "atrous"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&again).unwrap(),
+        std::fs::read(dir.join("a.exr")).unwrap()
+    );
+    // The command line's --denoiser wins: OIDN, where the build has it.
+    let (status, err) = run(
+        &[&["render"][..], &args].concat(),
+        &dir.join("b.exr"),
+        &["--denoiser", "oidn"],
+    );
+    if cfg!(feature = "oidn") {
+        assert!(status.success(), "{err}");
+        assert!(err.contains("denoising with Open Image Denoise"), "{err}");
+    } else {
+        assert_eq!(status.code(), Some(1), "{err}");
+        assert!(err.contains("built without Open Image Denoise"), "{err}");
+    }
 }
 
 #[cfg(not(feature = "oidn"))]

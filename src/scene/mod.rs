@@ -169,6 +169,9 @@ pub struct Settings {
     pub layers: crate::aov::Layers,
     /// Whether the finished image is denoised (see [`crate::denoise`]).
     pub denoise: bool,
+    /// The denoiser the scene asks for (`render.denoiser`; OIDN when it
+    /// names none).
+    pub denoiser: crate::denoise::Denoiser,
     /// Shadow-acne epsilon: how far along a ray leaving a surface that
     /// surface is not met again (0 when the scene gives none); see
     /// [`Scene::intersect_leaving`].

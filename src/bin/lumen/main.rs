@@ -554,11 +554,12 @@ impl DenoiseArgs {
         }
     }
 
-    /// The denoiser's options these arguments ask for.
-    fn options(&self) -> Result<lumen::denoise::Options, Usage> {
+    /// The denoiser's options these arguments ask for, with the scene's
+    /// denoiser, `scene`, unless they name another.
+    fn options(&self, scene: Denoiser) -> Result<lumen::denoise::Options, Usage> {
         let names = ["--denoise-quality", "--denoise-prefilter"];
         denoise_options(
-            self.denoiser,
+            Some(self.denoiser.unwrap_or(scene)),
             self.denoise_quality,
             self.denoise_prefilter,
             names,

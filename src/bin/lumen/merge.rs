@@ -34,7 +34,7 @@ pub(crate) fn merge_command(
     }
     // A partial merge is a preview: denoised only once complete.
     let denoise = merged.denoise && merged.is_complete();
-    let options = denoise_args.options()?;
+    let options = denoise_args.options(merged.denoiser)?;
     if denoise {
         crate::denoise::announce(options.denoiser)?;
     }

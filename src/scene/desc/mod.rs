@@ -292,6 +292,10 @@ pub struct RenderDesc {
     /// [`RenderDesc::written_aovs`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub denoise: bool,
+    /// Which denoiser a denoised render uses (OIDN when absent); the
+    /// command line's `--denoiser` overrides it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoiser: Option<crate::denoise::Denoiser>,
 }
 
 /// A pixel filter (see [`crate::filter`]).
@@ -366,6 +370,7 @@ impl Default for RenderDesc {
             filter_stddev: None,
             aovs: Vec::new(),
             denoise: false,
+            denoiser: None,
         }
     }
 }

@@ -556,6 +556,7 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "crop",
             "aovs",
             "denoise",
+            "denoiser",
         ],
         &[],
     )?;
@@ -593,6 +594,9 @@ fn render(node: &Node) -> Result<RenderDesc> {
         filter_stddev: t.optional("filter_stddev", float)?,
         aovs: t.optional("aovs", aovs)?.unwrap_or_default(),
         denoise: t.optional("denoise", boolean)?.unwrap_or(false),
+        denoiser: t.optional("denoiser", |n, p| {
+            keyword(n, p, &crate::denoise::Denoiser::NAMES)
+        })?,
     })
 }
 
