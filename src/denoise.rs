@@ -37,8 +37,8 @@ pub enum DenoiseError {
     #[error(
         "this lumen was built without Open Image Denoise; build it with \
          `OIDN_DIR=/path/to/oidn cargo build --release --features oidn` \
-         (see docs/denoising.md), or choose the built-in filter, \
-         `--denoiser atrous`"
+         (see docs/denoising.md), or choose lumen's own filter \
+         (`--denoiser atrous` of render, merge and denoise)"
     )]
     NotBuilt,
     /// The OIDN library was not found, or would not load.
@@ -261,8 +261,9 @@ pub fn check_available(denoiser: Denoiser) -> Result<String, DenoiseError> {
 /// highlight, which [`denoise`] keeps out of the filter.
 pub const HIGHLIGHT_FACTOR: f64 = 10.0;
 
-/// The denoised image of `inputs`, with `threads` threads. Its values are
-/// finite and non-negative.
+/// The denoised image of `inputs`, OIDN with `threads` threads (the
+/// built-in filter runs on the current rayon pool). Its values are finite
+/// and non-negative.
 ///
 /// Highlights are kept out of the filter: what a channel holds beyond
 /// [`HIGHLIGHT_FACTOR`] times the image's mean luminance is taken off

@@ -240,6 +240,55 @@ fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwis
         std::fs::read(&again).unwrap(),
         std::fs::read(dir.join("a.exr")).unwrap()
     );
+    // Its parts are merged and denoised with it; a part is not denoised,
+    // so the denoiser's options are refused for one.
+    let mut parts = Vec::new();
+    for k in ["0/2", "1/2"] {
+        let part = dir.join(format!("p{}.lumen-part", &k[..1]));
+        let (status, err) = run(
+            &[&["render"][..], &args, &["--part", k]].concat(),
+            &part,
+            &[],
+        );
+        assert!(status.success(), "{err}");
+        parts.push(part.to_str().unwrap().to_string());
+    }
+    let (status, err) = run(
+        &[
+            &["render"][..],
+            &args,
+            &["--part", "0/2", "--denoiser", "atrous"],
+        ]
+        .concat(),
+        &dir.join("p.lumen-part"),
+        &[],
+    );
+    assert_eq!(status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--denoiser: a part is not denoised; give it to `lumen merge`"),
+        "{err}"
+    );
+    let merged = dir.join("m.exr");
+    let o = lumen_output(&[
+        "merge",
+        &parts[0],
+        &parts[1],
+        "-o",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("denoising with lumen's à-trous filter"),
+        "{}",
+        stderr(&o)
+    );
+    let again = dir.join("m-again.exr");
+    let o = denoise_with(&dir.join("m.noisy.exr"), &again, &["--denoiser", "atrous"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&again).unwrap(),
+        std::fs::read(&merged).unwrap()
+    );
     // The command line's --denoiser wins: OIDN, where the build has it.
     let (status, err) = run(
         &[&["render"][..], &args].concat(),

@@ -242,14 +242,16 @@ fn the_command_line_splits_and_merges_to_the_bit() {
     );
     assert!(dir.join("some.png").exists());
     // The denoiser's options of a render that is not denoised: refused.
-    let out = merge(&["--denoise-prefilter", "none"], &[3, 1, 0, 2], "d.pfm");
-    assert_eq!(out.status.code(), Some(1));
-    let said = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        said.contains("--denoise-prefilter: the parts' render is not denoised"),
-        "{said}"
-    );
-    assert!(!dir.join("d.pfm").exists());
+    for option in [["--denoise-prefilter", "none"], ["--denoiser", "atrous"]] {
+        let out = merge(&option, &[3, 1, 0, 2], "d.pfm");
+        assert_eq!(out.status.code(), Some(2));
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            said.contains(&format!("{}: the parts' render is not denoised", option[0])),
+            "{said}"
+        );
+        assert!(!dir.join("d.pfm").exists());
+    }
 
     // A part needs a part file, and a part file needs --part: option mistakes,
     // exit status 2.

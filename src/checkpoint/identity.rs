@@ -2,9 +2,11 @@
 //! which a checkpoint records and a resumed render must match, and the
 //! words that say how two of them differ.
 //!
-//! Only what changes the samples is part of it. The caption does not, and
-//! neither does the display gamma, which is applied when the image is
-//! written: a resumed render writes its image with its own gamma.
+//! Only what changes the samples is part of it, and the scene's own
+//! `denoiser`, which parts carry to `lumen merge` in it (the command
+//! line's `--denoiser` is not). The caption is not, and neither is the
+//! display gamma, which is applied when the image is written: a resumed
+//! render writes its image with its own gamma.
 
 use crate::scene::{MeshSource, SceneDesc};
 use serde_json::Value;

@@ -359,7 +359,8 @@ struct SettingArgs {
     #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
     aov: Option<AovList>,
     /// Denoise the finished image with Open Image Denoise (builds with the
-    /// `oidn` feature; see docs/denoising.md), then blended back towards
+    /// `oidn` feature; see docs/denoising.md) or lumen's own filter
+    /// (`--denoiser atrous`), then blended back towards
     /// the samples where the filter changed more than their noise
     /// explains. The albedo, normal and variance buffers are kept and
     /// written, and the noisy image is written beside it as NAME.noisy.EXT.

@@ -30,7 +30,10 @@ pub(crate) fn merge_command(
         bail!("the parts hold no samples yet: nothing to merge");
     }
     if let (false, Some(option)) = (merged.denoise, denoise_args.any()) {
-        bail!("{option}: the parts' render is not denoised; `lumen denoise` denoises an EXR image");
+        return Err(crate::Usage(format!(
+            "{option}: the parts' render is not denoised; `lumen denoise` denoises an EXR image"
+        ))
+        .into());
     }
     // A partial merge is a preview: denoised only once complete.
     let denoise = merged.denoise && merged.is_complete();

@@ -123,6 +123,13 @@ pub(crate) fn render_command(
     };
     let denoise = scene.settings.denoise && image.is_some();
     if scene.settings.denoise && image.is_none() {
+        // How the merged image is denoised is `lumen merge`'s to say.
+        if let Some(option) = prog.denoise.any() {
+            return Err(Usage(format!(
+                "{option}: a part is not denoised; give it to `lumen merge`"
+            ))
+            .into());
+        }
         errln!("lumen: note: a part is not denoised; `lumen merge` denoises the merged image");
     } else if !denoise {
         let previews = prog.denoise_previews.then_some("--denoise-previews");
