@@ -186,16 +186,22 @@ impl Image {
                 let w = if q == p {
                     spline
                 } else {
+                    let normal = normal_weight(np, normals[q]);
+                    if normal == 0.0 {
+                        continue;
+                    }
+                    // The luminance's and the albedo's terms, in one
+                    // exponential.
                     let difference = (lp - luma(self.light[q])).abs();
-                    let edge = if difference == 0.0 {
-                        1.0
-                    } else if vp + smoothed[q] > 0.0 {
-                        (-difference / (SIGMA_LUMINANCE * (vp + smoothed[q]).sqrt())).exp()
-                    } else {
+                    let luminance = if difference == 0.0 {
                         0.0
+                    } else if vp + smoothed[q] > 0.0 {
+                        difference / (SIGMA_LUMINANCE * (vp + smoothed[q]).sqrt())
+                    } else {
+                        continue;
                     };
-                    let albedo = (-(ap - albedos[q]).abs().element_sum() / SIGMA_ALBEDO).exp();
-                    spline * normal_weight(np, normals[q]) * edge * albedo
+                    let albedo = (ap - albedos[q]).abs().element_sum() / SIGMA_ALBEDO;
+                    spline * normal * (-(luminance + albedo)).exp()
                 };
                 sum += self.light[q] * w;
                 weights += w;
