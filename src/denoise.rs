@@ -69,7 +69,8 @@ pub enum DenoiseError {
 
 /// How much work OIDN puts into a filter: its `quality` parameter, and
 /// Cycles' "Quality" setting. A lower quality runs a smaller network.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Quality {
     /// OIDN's "high performance", for interactive previews.
     Fast,
@@ -98,6 +99,81 @@ impl std::str::FromStr for Quality {
 
     fn from_str(s: &str) -> Result<Self, String> {
         parse_in(&Self::NAMES, s, "quality")
+    }
+}
+
+/// How the albedo and normal are prefiltered: at a quality, or not at all
+/// (`none`; see [`Options::prefilter`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Prefilter(pub Option<Quality>);
+
+impl Prefilter {
+    /// Each prefilter with its name, as options and messages spell it.
+    pub const NAMES: [(&'static str, Prefilter); 4] = [
+        ("high", Prefilter(Some(Quality::High))),
+        ("balanced", Prefilter(Some(Quality::Balanced))),
+        ("fast", Prefilter(Some(Quality::Fast))),
+        ("none", Prefilter(None)),
+    ];
+
+    /// Its name (see [`Prefilter::NAMES`]).
+    pub fn name(self) -> &'static str {
+        name_in(&Self::NAMES, self)
+    }
+}
+
+impl std::str::FromStr for Prefilter {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        parse_in(&Self::NAMES, s, "prefilter")
+    }
+}
+
+impl serde::Serialize for Prefilter {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Prefilter {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// The denoiser's settings a scene or a command line chooses, each absent
+/// where it chooses none.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Choices {
+    /// The denoiser.
+    pub denoiser: Option<Denoiser>,
+    /// OIDN's image filter's quality.
+    pub quality: Option<Quality>,
+    /// OIDN's prefilters.
+    pub prefilter: Option<Prefilter>,
+}
+
+impl Choices {
+    /// These choices, with `base`'s where these make none.
+    pub fn over(self, base: Choices) -> Choices {
+        Choices {
+            denoiser: self.denoiser.or(base.denoiser),
+            quality: self.quality.or(base.quality),
+            prefilter: self.prefilter.or(base.prefilter),
+        }
+    }
+
+    /// The options chosen, the defaults ([`Options::default`]) where none
+    /// is.
+    pub fn options(self) -> Options {
+        let default = Options::default();
+        Options {
+            denoiser: self.denoiser.unwrap_or(default.denoiser),
+            quality: self.quality.unwrap_or(default.quality),
+            prefilter: self.prefilter.map_or(default.prefilter, |p| p.0),
+        }
     }
 }
 

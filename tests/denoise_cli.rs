@@ -166,7 +166,7 @@ fn the_built_in_filter_denoises_in_every_build_the_same_bits_on_any_threads() {
 #[test]
 fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
     use lumen::aov::Aov;
-    use lumen::denoise::Denoiser;
+    use lumen::denoise::{Denoiser, Quality};
     let dir = temp_dir("denoise-toml");
     let path = dir.join("s.toml");
     std::fs::write(&path, "[render]\ndenoise = true\naovs = [\"depth\"]\n").unwrap();
@@ -180,6 +180,21 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
     std::fs::write(&path, "[render]\ndenoise = true\ndenoiser = \"atrous\"\n").unwrap();
     let file = lumen::scene::file::SceneFile::read(&path).unwrap();
     assert_eq!(file.desc.render.denoiser, Some(Denoiser::Atrous));
+    let text = "[render]\ndenoise_quality = \"fast\"\ndenoise_prefilter = \"none\"\n";
+    std::fs::write(&path, text).unwrap();
+    let file = lumen::scene::file::SceneFile::read(&path).unwrap();
+    let options = file.desc.render.denoise_choices().options();
+    assert_eq!((options.quality, options.prefilter), (Quality::Fast, None));
+    std::fs::write(&path, "[render]\ndenoise_prefilter = \"low\"\n").unwrap();
+    let err = lumen::scene::file::SceneFile::read(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("s.toml:2:")
+            && err.contains("render.denoise_prefilter")
+            && err.contains("none"),
+        "{err}"
+    );
     std::fs::write(&path, "[render]\ndenoiser = \"nfor\"\n").unwrap();
     let err = lumen::scene::file::SceneFile::read(&path)
         .unwrap_err()
@@ -390,6 +405,39 @@ mod with_oidn {
         ];
         render(&asked, &extra);
         assert_eq!(std::fs::read(&asked).unwrap(), none);
+        // So does a scene file.
+        let scene = dir.join("s.toml");
+        let o = lumen_output(&[
+            "scenes",
+            "export",
+            "cornell-box",
+            "-o",
+            scene.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let keys = "[render]\ndenoise = true\ndenoise_prefilter = \"none\"\ndenoise_quality = \"balanced\"\n";
+        let text = std::fs::read_to_string(&scene)
+            .unwrap()
+            .replace("[render]\n", keys);
+        std::fs::write(&scene, text).unwrap();
+        let from_file = dir.join("from-file.exr");
+        let args = [&["render", scene.to_str().unwrap()][..], &SMALL[2..]].concat();
+        let (status, err) = run(&args, &from_file, &[]);
+        assert!(status.success(), "{err}");
+        assert_eq!(std::fs::read(&from_file).unwrap(), none);
+        // The command line's options win over the file's.
+        let (status, err) = run(
+            &args,
+            &dir.join("cli.exr"),
+            &[
+                "--denoise-prefilter",
+                "balanced",
+                "--denoise-quality",
+                "high",
+            ],
+        );
+        assert!(status.success(), "{err}");
+        assert_eq!(std::fs::read(dir.join("cli.exr")).unwrap(), exr);
         render(&dir.join("second.exr"), &["--denoise"]);
         assert_eq!(std::fs::read(dir.join("second.exr")).unwrap(), exr);
         // Another format: the denoised image, the noisy one, the buffers.

@@ -3,8 +3,9 @@
 //! words that say how two of them differ.
 //!
 //! Only what changes the samples is part of it, and the scene's own
-//! `denoiser`, which parts carry to `lumen merge` in it (the command
-//! line's `--denoiser` is not). The caption is not, and neither is the
+//! denoiser settings (`denoiser`, `denoise_quality`, `denoise_prefilter`),
+//! which parts carry to `lumen merge` in it (the command line's options
+//! are not). The caption is not, and neither is the
 //! display gamma, which is applied when the image is written: a resumed
 //! render writes its image with its own gamma.
 

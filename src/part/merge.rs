@@ -162,8 +162,8 @@ pub struct Merged {
     pub aovs: Vec<crate::aov::Aov>,
     /// Whether the render's description asks for its image denoised.
     pub denoise: bool,
-    /// The denoiser its description asks for.
-    pub denoiser: crate::denoise::Denoiser,
+    /// The denoiser's settings its description chooses.
+    pub denoise_choices: crate::denoise::Choices,
     /// [`crate::checkpoint::RENDERER_ID`] of the lumen that rendered the
     /// parts.
     pub renderer_id: String,
@@ -452,7 +452,7 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
         gamma: part.gamma,
         aovs,
         denoise: render.denoise,
-        denoiser: render.denoiser.unwrap_or_default(),
+        denoise_choices: render.denoise_choices(),
         renderer_id: part.renderer_id.clone(),
         description: part.description.clone(),
     })

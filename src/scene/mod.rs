@@ -169,9 +169,9 @@ pub struct Settings {
     pub layers: crate::aov::Layers,
     /// Whether the finished image is denoised (see [`crate::denoise`]).
     pub denoise: bool,
-    /// The denoiser the scene asks for (`render.denoiser`; OIDN when it
-    /// names none).
-    pub denoiser: crate::denoise::Denoiser,
+    /// The denoiser's settings the scene chooses (`render.denoiser`,
+    /// `denoise_quality`, `denoise_prefilter`).
+    pub denoise_choices: crate::denoise::Choices,
     /// Shadow-acne epsilon: how far along a ray leaving a surface that
     /// surface is not met again (0 when the scene gives none); see
     /// [`Scene::intersect_leaving`].

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use lumen::denoise::{Denoiser, Quality};
+use lumen::denoise::{Choices, Denoiser, Prefilter, Quality};
 use lumen::progressive::parse_duration;
 use lumen::render::RenderStats;
 use lumen::scene::builtin::BUILTINS;
@@ -118,17 +118,17 @@ enum Command {
         /// The denoiser: oidn (Open Image Denoise, in builds with the
         /// `oidn` feature) or atrous (lumen's own filter, in every build)
         /// [default: oidn].
-        #[arg(long, value_name = "NAME", value_parser = parse_denoiser)]
+        #[arg(long, value_name = "NAME", value_parser = parse_named::<Denoiser>)]
         denoiser: Option<Denoiser>,
         /// The image filter's quality: high, balanced or fast (Open Image
         /// Denoise's `quality`) [default: high, as a render's `--denoise`].
-        #[arg(long, value_name = "Q", value_parser = parse_quality)]
+        #[arg(long, value_name = "Q", value_parser = parse_named::<Quality>)]
         quality: Option<Quality>,
         /// The albedo's and normal's prefilters' quality: high, balanced or
         /// fast; or none: not prefiltered, passed to the image's filter as
         /// they are [default: balanced, as a render's `--denoise`].
-        #[arg(long, value_name = "Q", value_parser = parse_prefilter)]
-        prefilter: Option<PrefilterArg>,
+        #[arg(long, value_name = "Q", value_parser = parse_named::<Prefilter>)]
+        prefilter: Option<Prefilter>,
     },
     /// List the built-in scenes with their captions, or export one as a file.
     Scenes {
@@ -518,27 +518,23 @@ fn parse_gamma(text: &str) -> Result<f32, String> {
     }
 }
 
-fn parse_quality(text: &str) -> Result<Quality, String> {
-    text.parse()
-}
-
 /// How a denoised render's image is denoised (`render`, `merge`).
 #[derive(Args, Clone, Default)]
 struct DenoiseArgs {
     /// With --denoise: the denoiser, oidn (Open Image Denoise, in builds
     /// with the `oidn` feature) or atrous (lumen's own filter, in every
     /// build) [default: oidn].
-    #[arg(long, value_name = "NAME", value_parser = parse_denoiser)]
+    #[arg(long, value_name = "NAME", value_parser = parse_named::<Denoiser>)]
     denoiser: Option<Denoiser>,
     /// With --denoise: the quality of the image's filter, high, balanced
     /// or fast (Open Image Denoise's `quality`) [default: high].
-    #[arg(long, value_name = "Q", value_parser = parse_quality)]
+    #[arg(long, value_name = "Q", value_parser = parse_named::<Quality>)]
     denoise_quality: Option<Quality>,
     /// With --denoise: the quality of the albedo's and normal's
     /// prefilters, high, balanced or fast; or none: passed to the image's
     /// filter as they are [default: balanced].
-    #[arg(long, value_name = "Q", value_parser = parse_prefilter)]
-    denoise_prefilter: Option<PrefilterArg>,
+    #[arg(long, value_name = "Q", value_parser = parse_named::<Prefilter>)]
+    denoise_prefilter: Option<Prefilter>,
 }
 
 impl DenoiseArgs {
@@ -555,63 +551,43 @@ impl DenoiseArgs {
         }
     }
 
-    /// The denoiser's options these arguments ask for, with the scene's
-    /// denoiser, `scene`, unless they name another.
-    fn options(&self, scene: Denoiser) -> Result<lumen::denoise::Options, Usage> {
-        let names = ["--denoise-quality", "--denoise-prefilter"];
-        denoise_options(
-            Some(self.denoiser.unwrap_or(scene)),
-            self.denoise_quality,
-            self.denoise_prefilter,
-            names,
-        )
+    /// The denoiser's options these arguments ask for, over the scene's
+    /// `scene`.
+    fn options(&self, scene: Choices) -> Result<lumen::denoise::Options, Usage> {
+        let given = Choices {
+            denoiser: self.denoiser,
+            quality: self.denoise_quality,
+            prefilter: self.denoise_prefilter,
+        };
+        denoise_options(given, scene, ["--denoise-quality", "--denoise-prefilter"])
     }
 }
 
-/// The denoiser's options with those given in place of the defaults;
-/// refused when OIDN's qualities (given as the options `names`) are
-/// given for the built-in filter, which has none.
+/// The denoiser's options `given` on the command line chooses, over
+/// `scene`'s; refused when OIDN's qualities (given as the options `names`)
+/// are given for the built-in filter, which has none.
 fn denoise_options(
-    denoiser: Option<Denoiser>,
-    quality: Option<Quality>,
-    prefilter: Option<PrefilterArg>,
+    given: Choices,
+    scene: Choices,
     names: [&str; 2],
 ) -> Result<lumen::denoise::Options, Usage> {
-    let default = lumen::denoise::Options::default();
-    let denoiser = denoiser.unwrap_or(default.denoiser);
-    if denoiser != Denoiser::Oidn {
-        let given = [quality.is_some(), prefilter.is_some()];
-        if let Some(i) = given.iter().position(|&g| g) {
+    let options = given.over(scene).options();
+    if options.denoiser != Denoiser::Oidn {
+        let asked = [given.quality.is_some(), given.prefilter.is_some()];
+        if let Some(i) = asked.iter().position(|&g| g) {
             return Err(Usage(format!(
                 "{}: a quality of Open Image Denoise; the {} denoiser has none",
                 names[i],
-                denoiser.name()
+                options.denoiser.name()
             )));
         }
     }
-    Ok(lumen::denoise::Options {
-        denoiser,
-        quality: quality.unwrap_or(default.quality),
-        prefilter: prefilter.map_or(default.prefilter, |p| p.0),
-    })
+    Ok(options)
 }
 
-fn parse_denoiser(text: &str) -> Result<Denoiser, String> {
+/// A denoiser's, a quality's or a prefilter's name, parsed.
+fn parse_named<T: std::str::FromStr<Err = String>>(text: &str) -> Result<T, String> {
     text.parse()
-}
-
-/// A prefilter's quality, or none (`--prefilter`, `--denoise-prefilter`).
-#[derive(Clone, Copy, Debug)]
-struct PrefilterArg(Option<Quality>);
-
-fn parse_prefilter(text: &str) -> Result<PrefilterArg, String> {
-    match text {
-        "none" => Ok(PrefilterArg(None)),
-        _ => text
-            .parse()
-            .map(|q| PrefilterArg(Some(q)))
-            .map_err(|e| format!("{e}, or none")),
-    }
 }
 
 fn main() -> ExitCode {
@@ -692,8 +668,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             quality,
             prefilter,
         } => with_threads(threads, || {
-            let options =
-                denoise_options(denoiser, quality, prefilter, ["--quality", "--prefilter"])?;
+            let given = Choices {
+                denoiser,
+                quality,
+                prefilter,
+            };
+            let options = denoise_options(given, Choices::default(), ["--quality", "--prefilter"])?;
             denoise::denoise_command(&input, &output, gamma, options)
         }),
         Command::Scenes { action: None } => {

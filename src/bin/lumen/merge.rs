@@ -37,7 +37,7 @@ pub(crate) fn merge_command(
     }
     // A partial merge is a preview: denoised only once complete.
     let denoise = merged.denoise && merged.is_complete();
-    let options = denoise_args.options(merged.denoiser)?;
+    let options = denoise_args.options(merged.denoise_choices)?;
     if denoise {
         crate::denoise::announce(options.denoiser)?;
     }

@@ -140,7 +140,7 @@ pub(crate) fn render_command(
             .into());
         }
     }
-    let options = prog.denoise.options(scene.settings.denoiser)?;
+    let options = prog.denoise.options(scene.settings.denoise_choices)?;
     let noisy = output::noisy_path(out);
     let mut targets: Vec<&Path> = match image {
         Some(image) => vec![image, &ckpt_path],

@@ -1561,7 +1561,7 @@ fn compile_settings(desc: &SceneDesc) -> Result<Settings, SceneError> {
         aovs: r.written_aovs(),
         layers: crate::aov::Layers::for_aovs(&r.written_aovs()),
         denoise: r.denoise,
-        denoiser: r.denoiser.unwrap_or_default(),
+        denoise_choices: r.denoise_choices(),
         epsilon: r.epsilon.map_or(0.0, |e| e as f32),
         offset: r.epsilon != Some(0.0),
         shading: r.shading,

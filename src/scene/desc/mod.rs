@@ -296,6 +296,13 @@ pub struct RenderDesc {
     /// command line's `--denoiser` overrides it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub denoiser: Option<crate::denoise::Denoiser>,
+    /// OIDN's image filter's quality (`--denoise-quality` overrides it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoise_quality: Option<crate::denoise::Quality>,
+    /// OIDN's prefilters' quality, or none (`--denoise-prefilter`
+    /// overrides it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoise_prefilter: Option<crate::denoise::Prefilter>,
 }
 
 /// A pixel filter (see [`crate::filter`]).
@@ -314,6 +321,15 @@ fn is_box(f: &PixelFilterDesc) -> bool {
 }
 
 impl RenderDesc {
+    /// The denoiser's settings the description chooses.
+    pub fn denoise_choices(&self) -> crate::denoise::Choices {
+        crate::denoise::Choices {
+            denoiser: self.denoiser,
+            quality: self.denoise_quality,
+            prefilter: self.denoise_prefilter,
+        }
+    }
+
     /// The feature buffers the render keeps and writes: `aovs`, with the
     /// albedo, normal and variance a denoised render needs, in
     /// [`Aov::ALL`](crate::aov::Aov::ALL)'s order.
@@ -371,6 +387,8 @@ impl Default for RenderDesc {
             aovs: Vec::new(),
             denoise: false,
             denoiser: None,
+            denoise_quality: None,
+            denoise_prefilter: None,
         }
     }
 }

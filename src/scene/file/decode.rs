@@ -557,6 +557,8 @@ fn render(node: &Node) -> Result<RenderDesc> {
             "aovs",
             "denoise",
             "denoiser",
+            "denoise_quality",
+            "denoise_prefilter",
         ],
         &[],
     )?;
@@ -596,6 +598,12 @@ fn render(node: &Node) -> Result<RenderDesc> {
         denoise: t.optional("denoise", boolean)?.unwrap_or(false),
         denoiser: t.optional("denoiser", |n, p| {
             keyword(n, p, &crate::denoise::Denoiser::NAMES)
+        })?,
+        denoise_quality: t.optional("denoise_quality", |n, p| {
+            keyword(n, p, &crate::denoise::Quality::NAMES)
+        })?,
+        denoise_prefilter: t.optional("denoise_prefilter", |n, p| {
+            keyword(n, p, &crate::denoise::Prefilter::NAMES)
         })?,
     })
 }
