@@ -25,6 +25,27 @@ fn render(out: &Path, extra: &[&str]) {
     assert!(status.success(), "{err}");
 }
 
+/// The built-in Cornell box as a scene file `s.toml` in `dir`, with `keys`
+/// (TOML lines) added to its `[render]` table.
+fn cornell_box_file(dir: &Path, keys: &str) -> std::path::PathBuf {
+    let scene = dir.join("s.toml");
+    let o = lumen_output(&[
+        "scenes",
+        "export",
+        "cornell-box",
+        "-o",
+        scene.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace("[render]\n", &format!("[render]\n{keys}")),
+    )
+    .unwrap();
+    scene
+}
+
 /// `lumen denoise INPUT -o OUT`.
 fn denoise(input: &Path, out: &Path) -> Output {
     denoise_with(input, out, &[])
@@ -216,21 +237,7 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
 #[test]
 fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwise() {
     let dir = temp_dir("denoise-scene-atrous");
-    let scene = dir.join("s.toml");
-    let o = lumen_output(&[
-        "scenes",
-        "export",
-        "cornell-box",
-        "-o",
-        scene.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&scene).unwrap();
-    let text = text.replace(
-        "[render]\n",
-        "[render]\ndenoise = true\ndenoiser = \"atrous\"\n",
-    );
-    std::fs::write(&scene, text).unwrap();
+    let scene = cornell_box_file(&dir, "denoise = true\ndenoiser = \"atrous\"\n");
     let args = [
         scene.to_str().unwrap(),
         "--width",
@@ -406,20 +413,8 @@ mod with_oidn {
         render(&asked, &extra);
         assert_eq!(std::fs::read(&asked).unwrap(), none);
         // So does a scene file.
-        let scene = dir.join("s.toml");
-        let o = lumen_output(&[
-            "scenes",
-            "export",
-            "cornell-box",
-            "-o",
-            scene.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let keys = "[render]\ndenoise = true\ndenoise_prefilter = \"none\"\ndenoise_quality = \"balanced\"\n";
-        let text = std::fs::read_to_string(&scene)
-            .unwrap()
-            .replace("[render]\n", keys);
-        std::fs::write(&scene, text).unwrap();
+        let keys = "denoise = true\ndenoise_prefilter = \"none\"\ndenoise_quality = \"balanced\"\n";
+        let scene = cornell_box_file(&dir, keys);
         let from_file = dir.join("from-file.exr");
         let args = [&["render", scene.to_str().unwrap()][..], &SMALL[2..]].concat();
         let (status, err) = run(&args, &from_file, &[]);
