@@ -206,48 +206,34 @@ fn a_scene_file_asks_for_denoising_and_gets_the_buffers_it_needs() {
     let file = lumen::scene::file::SceneFile::read(&path).unwrap();
     let options = file.desc.render.denoise_choices().options();
     assert_eq!((options.quality, options.prefilter), (Quality::Fast, None));
-    std::fs::write(&path, "[render]\ndenoise_prefilter = \"low\"\n").unwrap();
-    let err = lumen::scene::file::SceneFile::read(&path)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("s.toml:2:")
-            && err.contains("render.denoise_prefilter")
-            && err.contains("none"),
-        "{err}"
-    );
-    std::fs::write(&path, "[render]\ndenoiser = \"nfor\"\n").unwrap();
-    let err = lumen::scene::file::SceneFile::read(&path)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("s.toml:2:") && err.contains("render.denoiser") && err.contains("atrous"),
-        "{err}"
-    );
-    std::fs::write(&path, "[render]\ndenoise = 1\n").unwrap();
-    let err = lumen::scene::file::SceneFile::read(&path)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("s.toml:2:") && err.contains("render.denoise"),
-        "{err}"
-    );
+    // A wrong value is refused naming the file's line, the key and (for a
+    // name) the valid ones.
+    for (value, key, valid) in [
+        (
+            "denoise_prefilter = \"low\"",
+            "render.denoise_prefilter",
+            "none",
+        ),
+        ("denoiser = \"nfor\"", "render.denoiser", "atrous"),
+        ("denoise = 1", "render.denoise", "true or false"),
+    ] {
+        std::fs::write(&path, format!("[render]\n{value}\n")).unwrap();
+        let err = lumen::scene::file::SceneFile::read(&path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("s.toml:2:") && err.contains(key) && err.contains(valid),
+            "{err}"
+        );
+    }
 }
 
 #[test]
 fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwise() {
     let dir = temp_dir("denoise-scene-atrous");
     let scene = cornell_box_file(&dir, "denoise = true\ndenoiser = \"atrous\"\n");
-    let args = [
-        scene.to_str().unwrap(),
-        "--width",
-        "48",
-        "--spp",
-        "8",
-        "--threads",
-        "2",
-    ];
-    let (status, err) = run(&[&["render"][..], &args].concat(), &dir.join("a.exr"), &[]);
+    let args = [&["render", scene.to_str().unwrap()][..], &SMALL[2..]].concat();
+    let (status, err) = run(&args, &dir.join("a.exr"), &[]);
     assert!(status.success(), "{err}");
     assert!(
         err.contains("denoising with lumen's à-trous filter"),
@@ -267,21 +253,12 @@ fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwis
     let mut parts = Vec::new();
     for k in ["0/2", "1/2"] {
         let part = dir.join(format!("p{}.lumen-part", &k[..1]));
-        let (status, err) = run(
-            &[&["render"][..], &args, &["--part", k]].concat(),
-            &part,
-            &[],
-        );
+        let (status, err) = run(&[&args[..], &["--part", k]].concat(), &part, &[]);
         assert!(status.success(), "{err}");
         parts.push(part.to_str().unwrap().to_string());
     }
     let (status, err) = run(
-        &[
-            &["render"][..],
-            &args,
-            &["--part", "0/2", "--denoiser", "atrous"],
-        ]
-        .concat(),
+        &[&args[..], &["--part", "0/2", "--denoiser", "atrous"]].concat(),
         &dir.join("p.lumen-part"),
         &[],
     );
@@ -312,11 +289,7 @@ fn a_scene_that_names_the_built_in_filter_is_denoised_by_it_unless_told_otherwis
         std::fs::read(&merged).unwrap()
     );
     // The command line's --denoiser wins: OIDN, where the build has it.
-    let (status, err) = run(
-        &[&["render"][..], &args].concat(),
-        &dir.join("b.exr"),
-        &["--denoiser", "oidn"],
-    );
+    let (status, err) = run(&args, &dir.join("b.exr"), &["--denoiser", "oidn"]);
     if cfg!(feature = "oidn") {
         assert!(status.success(), "{err}");
         assert!(err.contains("denoising with Open Image Denoise"), "{err}");
