@@ -41,6 +41,9 @@ SCENES = {
     "cornell-box": ("cornell-box", ["--integrator", "path", "--sampler", "zsobol"]),
     "bunny-sky": ("examples/bunny-sky.toml", []),
     "materials": ("examples/materials.toml", []),
+    # Textured, normal-mapped glTF models under a sky (not in the default
+    # set: its reference takes longest).
+    "gltf-models": ("examples/gltf-models.toml", []),
 }
 
 
