@@ -138,7 +138,7 @@ impl Image {
             .into_par_iter()
             .map(|y| {
                 (0..width)
-                    .map(|x| self.pixel(normals, albedos, &smoothed, width, (x, y), step))
+                    .map(|x| self.pixel(normals, albedos, &smoothed, (width, height), (x, y), step))
                     .unzip()
             })
             .collect();
@@ -160,11 +160,10 @@ impl Image {
         normals: &[Vec3],
         albedos: &[Color],
         smoothed: &[f32],
-        width: usize,
+        (width, height): (usize, usize),
         (x, y): (usize, usize),
         step: usize,
     ) -> (Color, f32) {
-        let height = self.light.len() / width;
         let p = y * width + x;
         let (lp, np, vp) = (luma(self.light[p]), normals[p], smoothed[p]);
         let ap = albedos[p];

@@ -118,16 +118,16 @@ enum Command {
         /// The denoiser: oidn (Open Image Denoise, in builds with the
         /// `oidn` feature) or atrous (lumen's own filter, in every build)
         /// [default: oidn].
-        #[arg(long, value_name = "NAME", value_parser = parse_named::<Denoiser>)]
+        #[arg(long, value_name = "NAME", value_parser = str::parse::<Denoiser>)]
         denoiser: Option<Denoiser>,
         /// The image filter's quality: high, balanced or fast (Open Image
         /// Denoise's `quality`) [default: high, as a render's `--denoise`].
-        #[arg(long, value_name = "Q", value_parser = parse_named::<Quality>)]
+        #[arg(long, value_name = "Q", value_parser = str::parse::<Quality>)]
         quality: Option<Quality>,
         /// The albedo's and normal's prefilters' quality: high, balanced or
         /// fast; or none: not prefiltered, passed to the image's filter as
         /// they are [default: balanced, as a render's `--denoise`].
-        #[arg(long, value_name = "Q", value_parser = parse_named::<Prefilter>)]
+        #[arg(long, value_name = "Q", value_parser = str::parse::<Prefilter>)]
         prefilter: Option<Prefilter>,
     },
     /// List the built-in scenes with their captions, or export one as a file.
@@ -524,16 +524,16 @@ struct DenoiseArgs {
     /// With --denoise: the denoiser, oidn (Open Image Denoise, in builds
     /// with the `oidn` feature) or atrous (lumen's own filter, in every
     /// build) [default: oidn].
-    #[arg(long, value_name = "NAME", value_parser = parse_named::<Denoiser>)]
+    #[arg(long, value_name = "NAME", value_parser = str::parse::<Denoiser>)]
     denoiser: Option<Denoiser>,
     /// With --denoise: the quality of the image's filter, high, balanced
     /// or fast (Open Image Denoise's `quality`) [default: high].
-    #[arg(long, value_name = "Q", value_parser = parse_named::<Quality>)]
+    #[arg(long, value_name = "Q", value_parser = str::parse::<Quality>)]
     denoise_quality: Option<Quality>,
     /// With --denoise: the quality of the albedo's and normal's
     /// prefilters, high, balanced or fast; or none: passed to the image's
     /// filter as they are [default: balanced].
-    #[arg(long, value_name = "Q", value_parser = parse_named::<Prefilter>)]
+    #[arg(long, value_name = "Q", value_parser = str::parse::<Prefilter>)]
     denoise_prefilter: Option<Prefilter>,
 }
 
@@ -583,11 +583,6 @@ fn denoise_options(
         }
     }
     Ok(options)
-}
-
-/// A denoiser's, a quality's or a prefilter's name, parsed.
-fn parse_named<T: std::str::FromStr<Err = String>>(text: &str) -> Result<T, String> {
-    text.parse()
 }
 
 fn main() -> ExitCode {
