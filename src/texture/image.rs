@@ -65,6 +65,56 @@ fn kept_bytes(color: ::image::ColorType) -> u64 {
     }
 }
 
+/// How the texels of an 8-bit colour type become RGBA in place: its
+/// channels a texel and what each RGBA channel takes of them (`None`:
+/// opaque); `None` for other colour types. Grey goes to all three colour
+/// channels, as `image`'s conversions do.
+type Expand = (usize, [Option<usize>; 4]);
+
+fn expand_to_rgba8(color: ::image::ColorType) -> Option<Expand> {
+    use ::image::ColorType as C;
+    Some(match color {
+        C::L8 => (1, [Some(0), Some(0), Some(0), None]),
+        C::La8 => (2, [Some(0), Some(0), Some(0), Some(1)]),
+        C::Rgb8 => (3, [Some(0), Some(1), Some(2), None]),
+        C::Rgba8 => (4, [Some(0), Some(1), Some(2), Some(3)]),
+        _ => return None,
+    })
+}
+
+/// The texels of an 8-bit image, decoded straight into the RGBA array
+/// that keeps them and spread out in place: a texture is allocated and
+/// written once, where decoding to `image`'s buffer, converting it and
+/// collecting it took three of its size (a 2048 × 2048 texture is 16 MB,
+/// and fresh pages cost a fault each).
+fn decode_rgba8(
+    decoder: impl ::image::ImageDecoder,
+    (channels, take): Expand,
+) -> Result<Vec<[u8; 4]>, String> {
+    let (w, h) = ::image::ImageDecoder::dimensions(&decoder);
+    let n = w as usize * h as usize;
+    let mut texels: Vec<[u8; 4]> = Vec::new();
+    texels
+        .try_reserve_exact(n)
+        .map_err(|_| format!("its {w}x{h} texels do not fit in memory"))?;
+    texels.resize(n, [0; 4]);
+    let bytes = texels.as_flattened_mut();
+    decoder
+        .read_image(&mut bytes[..n * channels])
+        .map_err(|e| e.to_string())?;
+    if channels < 4 {
+        // From the last texel back, each written no earlier than where
+        // its source lies, so that no source is overwritten before it is
+        // read.
+        for i in (0..n).rev() {
+            let source = i * channels;
+            let texel = take.map(|c| c.map_or(u8::MAX, |c| bytes[source + c]));
+            bytes[4 * i..4 * i + 4].copy_from_slice(&texel);
+        }
+    }
+    Ok(texels)
+}
+
 /// The file extensions [`Image::read`] accepts.
 pub const IMAGE_EXTENSIONS: &[&str] = &["exr", "hdr", "png", "jpg", "jpeg", "bmp"];
 
@@ -160,11 +210,19 @@ impl Image {
         let mut limits = ::image::Limits::no_limits();
         limits.max_alloc = Some(peak);
         ::image::ImageDecoder::set_limits(&mut decoder, limits).map_err(|e| fail(e.to_string()))?;
-        let decoded = D::from_decoder(decoder).map_err(|e| fail(e.to_string()))?;
-        let (width, height) = (decoded.width() as usize, decoded.height() as usize);
-        if width == 0 || height == 0 {
+        if w == 0 || h == 0 {
             return Err(fail("the image is empty".into()));
         }
+        let color = ::image::ImageDecoder::color_type(&decoder);
+        if let Some(expand) = expand_to_rgba8(color) {
+            return Ok(Image {
+                width: w as usize,
+                height: h as usize,
+                texels: Texels::Rgba8(decode_rgba8(decoder, expand).map_err(fail)?),
+            });
+        }
+        let decoded = D::from_decoder(decoder).map_err(|e| fail(e.to_string()))?;
+        let (width, height) = (decoded.width() as usize, decoded.height() as usize);
         let texels = match decoded {
             D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
                 Texels::Rgba8(decoded.into_rgba8().pixels().map(|p| p.0).collect())
@@ -391,6 +449,59 @@ mod tests {
         assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
         assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
         assert!((srgb_to_linear(0.04) - 0.04 / 12.92).abs() < 1e-9);
+    }
+
+    /// Every 8-bit colour type, in each format that holds it, decodes to
+    /// the texels `image`'s own conversion to RGBA gives.
+    #[test]
+    fn eight_bit_images_decode_to_what_images_conversion_gives() {
+        use ::image::{ColorType as C, DynamicImage, ImageFormat as F};
+        let (w, h) = (37u32, 11u32);
+        let value = |i: u32, k: u32| ((i * 7 + k * 91 + i / 5 * 13) % 256) as u8;
+        let bytes = |channels: u32| -> Vec<u8> {
+            (0..w * h * channels)
+                .map(|j| value(j / channels, j % channels))
+                .collect()
+        };
+        let images = [
+            (
+                C::L8,
+                DynamicImage::ImageLuma8(::image::ImageBuffer::from_raw(w, h, bytes(1)).unwrap()),
+            ),
+            (
+                C::La8,
+                DynamicImage::ImageLumaA8(::image::ImageBuffer::from_raw(w, h, bytes(2)).unwrap()),
+            ),
+            (
+                C::Rgb8,
+                DynamicImage::ImageRgb8(::image::ImageBuffer::from_raw(w, h, bytes(3)).unwrap()),
+            ),
+            (
+                C::Rgba8,
+                DynamicImage::ImageRgba8(::image::ImageBuffer::from_raw(w, h, bytes(4)).unwrap()),
+            ),
+        ];
+        let mut checked = 0;
+        for (color, image) in &images {
+            for format in [F::Png, F::Jpeg, F::Bmp] {
+                let mut file = std::io::Cursor::new(Vec::new());
+                if image.write_to(&mut file, format).is_err() {
+                    continue; // a type the format cannot hold
+                }
+                let file = file.into_inner();
+                let reference = ::image::load_from_memory(&file).unwrap();
+                let want: Vec<[u8; 4]> = reference.to_rgba8().pixels().map(|p| p.0).collect();
+                let got = Image::decode(&file, "t").unwrap();
+                assert_eq!((got.width(), got.height()), (w as usize, h as usize));
+                let Texels::Rgba8(got) = &got.texels else {
+                    panic!("{color:?} as {format:?}: not 8-bit RGBA");
+                };
+                assert_eq!(got, &want, "{color:?} as {format:?}");
+                checked += 1;
+            }
+        }
+        // PNG holds all four; JPEG and BMP some.
+        assert!(checked >= 6, "{checked}");
     }
 }
 
