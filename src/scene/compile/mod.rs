@@ -146,6 +146,7 @@ impl Scene {
             instances: Vec::new(),
             media: Vec::new(),
             models: HashMap::new(),
+            read_ahead: read_mesh_files(desc, base),
             placements: Vec::new(),
             sources,
             stats: SceneStats::default(),
@@ -390,6 +391,66 @@ fn compile_filter(desc: &(PixelFilterDesc, Option<f64>)) -> Result<PixelFilter, 
     }
 }
 
+/// The key of a mesh file read with `options` among the loaded models.
+/// A file read with its texture coordinates turned over is another model
+/// (no file's name holds a NUL).
+fn model_key(path: &Path, options: mesh::LoadOptions) -> PathBuf {
+    if options.flip_v {
+        let mut key = path.to_path_buf().into_os_string();
+        key.push("\0flip_v");
+        PathBuf::from(key)
+    } else {
+        path.to_path_buf()
+    }
+}
+
+/// The load options of a mesh object (`None` for other objects).
+fn mesh_options(object: &ObjectDesc) -> Option<(&str, mesh::LoadOptions)> {
+    match object {
+        ObjectDesc::Mesh {
+            file,
+            allow_outside,
+            flip_v,
+            ..
+        } => Some((
+            file,
+            mesh::LoadOptions {
+                allow_outside: *allow_outside,
+                flip_v: *flip_v,
+            },
+        )),
+        _ => None,
+    }
+}
+
+/// The scene's mesh files read on all threads at once, by their key,
+/// when it names more than one: a file's own reading is only partly
+/// parallel (its textures are decoded together, its JSON and meshes are
+/// not). Each is taken by [`Objects::load`] when its first object is
+/// compiled, so that what goes wrong is still reported in the objects'
+/// order.
+fn read_mesh_files(
+    desc: &SceneDesc,
+    base: &Path,
+) -> HashMap<PathBuf, Result<Model, mesh::MeshError>> {
+    use rayon::prelude::*;
+    let mut files: Vec<(PathBuf, PathBuf, mesh::LoadOptions)> = Vec::new();
+    for (file, options) in desc.objects.iter().filter_map(mesh_options) {
+        let path = model_path(base, file);
+        let key = model_key(&path, options);
+        if !files.iter().any(|(k, _, _)| *k == key) {
+            files.push((key, path, options));
+        }
+    }
+    if files.len() < 2 {
+        return HashMap::new();
+    }
+    files
+        .into_par_iter()
+        .map(|(key, path, options)| (key, mesh::load_with(&path, options)))
+        .collect()
+}
+
 /// A loaded mesh file, shared by every object that names it.
 struct LoadedModel {
     model: Model,
@@ -443,6 +504,8 @@ struct Objects<'a> {
     instances: Vec<PlacedGroup>,
     media: Vec<Medium>,
     models: HashMap<PathBuf, LoadedModel>,
+    /// Mesh files read before the objects are compiled, not yet taken.
+    read_ahead: HashMap<PathBuf, Result<Model, mesh::MeshError>>,
     placements: Vec<Placement>,
     sources: Vec<MeshSource>,
     stats: SceneStats,
@@ -732,9 +795,7 @@ impl<'a> Objects<'a> {
                 file,
                 material,
                 smooth,
-                allow_outside,
                 part,
-                flip_v,
                 flip_normals,
                 ..
             } => {
@@ -742,10 +803,7 @@ impl<'a> Objects<'a> {
                     .as_deref()
                     .map(|name| self.material(i, name))
                     .transpose()?;
-                let options = mesh::LoadOptions {
-                    allow_outside: *allow_outside,
-                    flip_v: *flip_v,
-                };
+                let (_, options) = mesh_options(object).expect("a mesh object");
                 let path = self.load(i, file, options)?;
                 self.place(
                     i,
@@ -934,20 +992,16 @@ impl<'a> Objects<'a> {
         options: mesh::LoadOptions,
     ) -> Result<PathBuf, SceneError> {
         let path = model_path(self.base, file);
-        // A file read with its texture coordinates turned over is another
-        // model (no file's name holds a NUL).
-        let key = if options.flip_v {
-            let mut key = path.clone().into_os_string();
-            key.push("\0flip_v");
-            PathBuf::from(key)
-        } else {
-            path.clone()
-        };
+        let key = model_key(&path, options);
         if self.models.contains_key(&key) {
             return Ok(key);
         }
         let fail = |message: String| invalid(format!("objects[{i}].file"), message);
-        let model = mesh::load_with(&path, options).map_err(|e| fail(e.to_string()))?;
+        let read = match self.read_ahead.remove(&key) {
+            Some(read) => read,
+            None => mesh::load_with(&path, options),
+        };
+        let model = read.map_err(|e| fail(e.to_string()))?;
         self.sources.push(MeshSource {
             file: file.to_string(),
             crc: model.file_crc,
