@@ -55,6 +55,7 @@ import argparse
 import json
 import math
 import sys
+import time
 import tomllib
 from pathlib import Path
 
@@ -118,11 +119,19 @@ def world_image(scene, path, rotation_deg, intensity):
     return env.image
 
 
+# Seconds spent in Blender's glTF importer so far (denoise_cycles.py reports
+# them beside the render call's).
+IMPORT_SECONDS = 0.0
+
+
 def import_gltf(path, matrix):
     """Import a glTF file; place its root objects by `matrix` (Blender
     coordinates). Returns the new objects."""
+    global IMPORT_SECONDS
     before = set(bpy.data.objects)
+    t0 = time.perf_counter()
     bpy.ops.import_scene.gltf(filepath=str(path))
+    IMPORT_SECONDS += time.perf_counter() - t0
     new = [ob for ob in bpy.data.objects if ob not in before]
     for ob in new:
         if ob.parent is None:

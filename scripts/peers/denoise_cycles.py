@@ -175,7 +175,8 @@ def cycles_render(job):
     seconds = time.perf_counter() - t0
     bpy.data.images["Render Result"].save_render(filepath=job["out"], scene=scene)
     print(json.dumps({
-        "render_s": seconds, "blender": bpy.app.version_string,
+        "render_s": seconds, "import_s": getattr(m, "IMPORT_SECONDS", 0.0),
+        "blender": bpy.app.version_string,
         "settings": {"samples": c.samples, "seed": c.seed, "adaptive": c.use_adaptive_sampling,
                      "pattern": c.sampling_pattern, "filter": [c.pixel_filter_type, c.filter_width],
                      "max_bounces": c.max_bounces, "light_tree": c.use_light_tree,
@@ -264,7 +265,7 @@ def run_cycles(a, name, spp, out, denoise, seed=0, nice=False):
     r = json.loads(lines[-1])
     a.cycles_settings = r["settings"]
     a.blender = r["blender"]
-    return {"render_s": r["render_s"], "process_wall_s": wall}
+    return {"render_s": r["render_s"], "import_s": r.get("import_s", 0.0), "process_wall_s": wall}
 
 
 def cached(path, make):
@@ -528,12 +529,20 @@ def report(a, name, res, spps, targets, own_target):
     print(f"\n### {name}: time for the same FLIP (Cycles' time interpolated over its denoised ladder)\n")
     print("| lumen spp | lumen denoised FLIP | lumen wall s | lumen time + denoise s | "
           "Cycles s for that FLIP | wall / Cycles | (time + denoise) / Cycles |"
-          + (" Cycles s, own ref | wall / Cycles, own ref |" if own_target is not None else ""))
-    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |" + (" ---: | ---: |" if own_target is not None else ""))
+          + (" Cycles s, own ref | wall / Cycles, own ref |" if own_target is not None else "")
+          + " Cycles import + render s | wall / that |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |" + (" ---: | ---: |" if own_target is not None else "")
+          + " ---: | ---: |")
     res["same_flip"] = []
     cyc = [(p["denoised"]["lumen_ref"]["flip"], p["times"]["render_s"]) for p in cycles_pts]
     cyc_own = [(p["denoised"]["cycles_ref"]["flip"], p["times"]["render_s"]) for p in cycles_pts] \
         if own_target is not None else None
+    # From the files to the image, as lumen's wall clock: Cycles' glTF import
+    # (the glTF parsed, meshes and materials built; textures are decoded in
+    # the render call) and its render call; its own reference if it has one.
+    full_ref = "cycles_ref" if own_target is not None else "lumen_ref"
+    cyc_full = [(p["denoised"][full_ref]["flip"], p["times"]["render_s"] + p["times"].get("import_s", 0.0))
+                for p in cycles_pts]
     for lp in lumen_pts:
         f = lp["denoised"]["lumen_ref"]["flip"]
         wall = lp["times"]["wall_s"]
@@ -550,6 +559,11 @@ def report(a, name, res, spps, targets, own_target):
             row.update(cycles_own_s=to, cycles_own_how=how_o, ratio_wall_own=wall / to)
             line += (f" {({'interpolated': '', 'at most': '≤ ', 'more than': '> '})[how_o]}{to:.2f} | "
                      f"{({'interpolated': '', 'at most': '≥ ', 'more than': '< '})[how_o]}{wall / to:.2f} |")
+        tf, how_f = interpolate_time(cyc_full, f)
+        row.update(cycles_import_render_s=tf, cycles_import_render_how=how_f,
+                   ratio_wall_import_render=wall / tf)
+        line += (f" {({'interpolated': '', 'at most': '≤ ', 'more than': '> '})[how_f]}{tf:.2f} | "
+                 f"{({'interpolated': '', 'at most': '≥ ', 'more than': '< '})[how_f]}{wall / tf:.2f} |")
         res["same_flip"].append(row)
         print(line, flush=True)
 
