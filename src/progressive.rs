@@ -106,7 +106,10 @@ pub enum SaveSchedule {
     /// After a pass once the time since the last save is at least
     /// [`SAVE_SPACING`] times what that save took, so that saving takes at
     /// most about a twentieth of the render's time however short its passes
-    /// and however large its image; the first pass is always saved.
+    /// and however large its image. The first pass is saved, so that an
+    /// image is there at once, unless the rest of the render is predicted
+    /// to take less than [`QUICK_RENDER`]: then the finished image comes as
+    /// soon, and an interrupt still saves what is done.
     #[default]
     Bounded,
     /// After every pass.
@@ -114,6 +117,12 @@ pub enum SaveSchedule {
     /// After a pass once this long has passed since the last save.
     Every(Duration),
 }
+
+/// What is left of a render after its first pass, predicted, below which
+/// [`SaveSchedule::Bounded`] does not save that pass: a render of a few
+/// samples a pixel saved its image and checkpoint after the first pass
+/// only to write the image again a tenth of a second later.
+pub const QUICK_RENDER: Duration = Duration::from_secs(1);
 
 /// How many times as long as its last save a render with
 /// [`SaveSchedule::Bounded`] renders before it saves again: saves then take
@@ -123,10 +132,11 @@ pub const SAVE_SPACING: u32 = 19;
 impl SaveSchedule {
     /// Whether a pass that ends `since` after the last save ended (or the
     /// run started), which took `took` (`None` before the run's first save),
-    /// is saved.
-    pub fn due(self, since: Duration, took: Option<Duration>) -> bool {
+    /// is saved, when the rest of the render is predicted to take `left`.
+    pub fn due(self, since: Duration, took: Option<Duration>, left: Duration) -> bool {
         match (self, took) {
-            (SaveSchedule::EveryPass, _) | (SaveSchedule::Bounded, None) => true,
+            (SaveSchedule::EveryPass, _) => true,
+            (SaveSchedule::Bounded, None) => left >= QUICK_RENDER,
             (SaveSchedule::Every(every), _) => since >= every,
             (SaveSchedule::Bounded, Some(took)) => since >= took * SAVE_SPACING,
         }
@@ -649,11 +659,18 @@ mod tests {
     fn bounded_saves_take_at_most_a_twentieth_of_the_time() {
         let ms = Duration::from_millis;
         let bounded = SaveSchedule::Bounded;
-        // The first pass is saved, however short.
-        assert!(bounded.due(ms(1), None));
-        // Then only once 19 times the last save's duration has passed.
-        assert!(!bounded.due(ms(1899), Some(ms(100))));
-        assert!(bounded.due(ms(1900), Some(ms(100))));
+        let long = Duration::from_secs(3600);
+        // The first pass is saved, however short, unless the render is
+        // about to end.
+        assert!(bounded.due(ms(1), None, long));
+        assert!(bounded.due(ms(1), None, QUICK_RENDER));
+        assert!(!bounded.due(ms(1), None, QUICK_RENDER - ms(1)));
+        assert!(!bounded.due(ms(1), None, ms(0)));
+        // Then only once 19 times the last save's duration has passed,
+        // whatever is left.
+        assert!(!bounded.due(ms(1899), Some(ms(100)), long));
+        assert!(bounded.due(ms(1900), Some(ms(100)), long));
+        assert!(bounded.due(ms(1900), Some(ms(100)), ms(0)));
         // A simulated render after its first save: passes of 10 ms, saves
         // of 40 ms.
         let (pass, save) = (ms(10), ms(40));
@@ -661,7 +678,7 @@ mod tests {
         for _ in 0..10_000 {
             rendering += pass;
             since += pass;
-            if bounded.due(since, took) {
+            if bounded.due(since, took, long) {
                 saving += save;
                 (since, took) = (ms(0), Some(save));
             }
@@ -669,9 +686,10 @@ mod tests {
         let share = saving.as_secs_f64() / (saving + rendering).as_secs_f64();
         assert!(share <= 0.05 && share > 0.049, "{share}");
         // Every pass, or at most every interval, counted from the start.
-        assert!(SaveSchedule::EveryPass.due(ms(0), Some(ms(100))));
+        assert!(SaveSchedule::EveryPass.due(ms(0), Some(ms(100)), ms(0)));
+        assert!(SaveSchedule::EveryPass.due(ms(0), None, ms(0)));
         let every = SaveSchedule::Every(Duration::from_secs(60));
-        assert!(!every.due(ms(59_999), None) && every.due(ms(60_000), Some(ms(1))));
+        assert!(!every.due(ms(59_999), None, long) && every.due(ms(60_000), Some(ms(1)), ms(0)));
     }
 
     #[test]

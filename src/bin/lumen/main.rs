@@ -22,7 +22,8 @@ const MAX_THREADS: i64 = 1024;
 /// status (see `render.rs` and `signals.rs`).
 const RENDER_HELP: &str = "\
 The image and a checkpoint (OUTPUT.lumen-ckpt unless --checkpoint says
-otherwise) are saved after the first pass, then after a pass once saving
+otherwise) are saved after the first pass (unless the render is predicted
+to end within a second), then after a pass once saving
 takes at most 5 % of the time (or every --checkpoint-interval; 0: after
 every pass); the checkpoint is removed when the render completes. While it
 runs, the render holds a lock file beside each (.NAME.lumen-lock): a second

@@ -305,10 +305,15 @@ pub(crate) fn render_command(
             )
         });
         // The finished image is written once, below.
-        let due = prog
-            .checkpoint_interval
-            .unwrap_or_default()
-            .due(last_save.elapsed(), last_save_took);
+        let left = session.spp_total() - session.spp_done();
+        let predicted = pass
+            .duration
+            .mul_f64(f64::from(left) / pass.samples.len().max(1) as f64);
+        let due = prog.checkpoint_interval.unwrap_or_default().due(
+            last_save.elapsed(),
+            last_save_took,
+            predicted,
+        );
         let mut denoised = None;
         if !session.is_complete() && due {
             let saving = Instant::now();
