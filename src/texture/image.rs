@@ -93,10 +93,8 @@ fn decode_rgba8(
 ) -> Result<Vec<[u8; 4]>, String> {
     let (w, h) = ::image::ImageDecoder::dimensions(&decoder);
     let n = w as usize * h as usize;
-    let mut texels: Vec<[u8; 4]> = Vec::new();
-    texels
-        .try_reserve_exact(n)
-        .map_err(|_| format!("its {w}x{h} texels do not fit in memory"))?;
+    let mut texels: Vec<[u8; 4]> = crate::memory::huge_vec(n)
+        .ok_or_else(|| format!("its {w}x{h} texels do not fit in memory"))?;
     texels.resize(n, [0; 4]);
     let bytes = texels.as_flattened_mut();
     decoder
@@ -223,16 +221,22 @@ impl Image {
         }
         let decoded = D::from_decoder(decoder).map_err(|e| fail(e.to_string()))?;
         let (width, height) = (decoded.width() as usize, decoded.height() as usize);
+        // The texels' array, in huge pages where the system has them.
+        fn room<T>(n: usize) -> Result<Vec<T>, String> {
+            crate::memory::huge_vec(n).ok_or_else(|| format!("its {n} texels do not fit in memory"))
+        }
         let texels = match decoded {
             D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
                 Texels::Rgba8(decoded.into_rgba8().pixels().map(|p| p.0).collect())
             }
             D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
-                Texels::Rgba16(decoded.into_rgba16().pixels().map(|p| p.0).collect())
+                let mut texels = room(width * height).map_err(fail)?;
+                texels.extend(decoded.into_rgba16().pixels().map(|p| p.0));
+                Texels::Rgba16(texels)
             }
             _ => {
                 let rgb = decoded.into_rgb32f();
-                let mut texels = Vec::with_capacity(width * height);
+                let mut texels = room(width * height).map_err(fail)?;
                 for (i, p) in rgb.pixels().enumerate() {
                     let value = p.0;
                     if value.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
