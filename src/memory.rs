@@ -139,44 +139,6 @@ pub fn filled<T: Clone>(n: u64, value: T, what: &str) -> Result<Vec<T>, MemoryEr
     Ok(v)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn huge_page_vectors_hold_what_is_put_in_them_and_refuse_the_impossible() {
-        // 8 MiB, over several huge pages whatever the allocation's start.
-        let n = 1 << 20;
-        let mut v: Vec<u64> = huge_vec(n).expect("8 MiB");
-        assert!(v.is_empty() && v.capacity() >= n);
-        v.extend((0..n as u64).map(|i| i.wrapping_mul(0x9e37_79b9_7f4a_7c15)));
-        assert!(v
-            .iter()
-            .enumerate()
-            .all(|(i, &x)| x == (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)));
-        // A size no allocator grants is refused, not an abort.
-        assert!(huge_vec::<u64>(usize::MAX / 4).is_none());
-        // Small and empty ones are ordinary vectors.
-        assert!(huge_vec::<u8>(0).is_some_and(|v| v.is_empty()));
-        assert!(huge_vec::<u8>(100).is_some_and(|v| v.capacity() >= 100));
-    }
-
-    #[test]
-    fn small_amounts_are_had_and_impossible_ones_refused() {
-        let v: Vec<u64> = filled(1000, 7, "a test").unwrap();
-        assert_eq!((v.len(), v[999]), (1000, 7));
-        let e = vec_for::<u8>(1 << 62, "the film").unwrap_err();
-        assert_eq!(e.bytes, 1 << 62);
-        assert!(e.to_string().starts_with("the film needs"), "{e}");
-        let e = vec_for::<[u64; 4]>(u64::MAX / 2, "x").unwrap_err();
-        assert_eq!(e.bytes, u64::MAX);
-        if let Some(free) = available() {
-            assert!(free > 0);
-            assert!(check(free + (1 << 30), "more than free").is_err());
-        }
-    }
-}
-
 /// Bytes of a huge page (x86-64, AArch64 with 4 KB pages): 2 MiB.
 const HUGE_PAGE: usize = 2 << 20;
 
@@ -223,3 +185,41 @@ fn advise_huge_pages(start: *mut u8, len: usize) {
 
 #[cfg(not(target_os = "linux"))]
 fn advise_huge_pages(_start: *mut u8, _len: usize) {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn huge_page_vectors_hold_what_is_put_in_them_and_refuse_the_impossible() {
+        // 8 MiB, over several huge pages whatever the allocation's start.
+        let n = 1 << 20;
+        let mut v: Vec<u64> = huge_vec(n).expect("8 MiB");
+        assert!(v.is_empty() && v.capacity() >= n);
+        v.extend((0..n as u64).map(|i| i.wrapping_mul(0x9e37_79b9_7f4a_7c15)));
+        assert!(v
+            .iter()
+            .enumerate()
+            .all(|(i, &x)| x == (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)));
+        // A size no allocator grants is refused, not an abort.
+        assert!(huge_vec::<u64>(usize::MAX / 4).is_none());
+        // Small and empty ones are ordinary vectors.
+        assert!(huge_vec::<u8>(0).is_some_and(|v| v.is_empty()));
+        assert!(huge_vec::<u8>(100).is_some_and(|v| v.capacity() >= 100));
+    }
+
+    #[test]
+    fn small_amounts_are_had_and_impossible_ones_refused() {
+        let v: Vec<u64> = filled(1000, 7, "a test").unwrap();
+        assert_eq!((v.len(), v[999]), (1000, 7));
+        let e = vec_for::<u8>(1 << 62, "the film").unwrap_err();
+        assert_eq!(e.bytes, 1 << 62);
+        assert!(e.to_string().starts_with("the film needs"), "{e}");
+        let e = vec_for::<[u64; 4]>(u64::MAX / 2, "x").unwrap_err();
+        assert_eq!(e.bytes, u64::MAX);
+        if let Some(free) = available() {
+            assert!(free > 0);
+            assert!(check(free + (1 << 30), "more than free").is_err());
+        }
+    }
+}
