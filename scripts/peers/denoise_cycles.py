@@ -52,8 +52,13 @@ reference (denoise-bench.py's metrics), and its times:
     s; at 256: 0.02 s): that fixed cost dominates Cycles' low-spp times on
     gltf-models. It is Cycles' default and is kept; --cycles-world-map N
     measures without it.
+  - Cycles' glTF import (bpy.ops.import_scene.gltf, timed in the Cycles
+    process: the JSON, meshes and materials; textures are decoded in the
+    render call), reported as import_s.
 The times compared: lumen wall against Cycles' render call (lumen carries
-its process start, scene parsing and image writing, Cycles does not), and
+its process start, scene parsing and image writing, Cycles does not),
+lumen wall against Cycles' import + render call (both from the files to
+the image, but for Cycles' scene construction and Blender's start), and
 lumen time + denoise against the same Cycles call (Cycles carries its sync
 and BVH build, lumen does not). The truth is between the two ratios.
 
