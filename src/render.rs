@@ -244,8 +244,7 @@ fn render_row_generic(
             for index in samples.clone() {
                 let (ray, _) = camera_sample(scene, column, y, &pixel_sampler, index);
                 let c = first_hit_view(scene, ray, s.shading, &mut stats.rays);
-                let sample = (index, c, &Features::default());
-                add_samples(&mut row, &mut stats, x, std::iter::once(sample));
+                add_sample(&mut row, &mut stats, (x, index), c, &Features::default());
             }
         }
         return stats;
@@ -354,50 +353,64 @@ impl SideBySide {
             halt,
         );
         let per_pixel = samples.len().max(1);
-        let colours = self.colours[..n].chunks(per_pixel);
-        let searches = self.searches[..n].chunks(per_pixel);
-        for ((&(x, _), colours), searches) in pixels.iter().zip(colours).zip(searches) {
-            let pixel = samples.clone().zip(colours).zip(searches);
-            add_samples(row, stats, x, pixel.map(|((i, &c), s)| (i, c, &s.features)));
+        if !row.layers.is_empty() {
+            let searches = &self.searches[..n];
+            add_samples_with_features(row, stats, pixels, samples, &self.colours[..n], searches);
+            return;
+        }
+        for (&(x, _), colours) in pixels.iter().zip(self.colours[..n].chunks(per_pixel)) {
+            for (index, &c) in samples.clone().zip(colours) {
+                stats.count(row.add(x, index, c));
+            }
         }
     }
 }
 
-/// Adds samples of pixel `x`, each its index, colour and features, to
-/// `row`, in order, and counts them in `stats`, as dropped if the film
-/// leaves them out; their albedos and normals are gathered and added at
-/// the end (see [`UnitFeatures`]). A function marked to be inlined rather
-/// than a closure, which the compiler may call out of line.
-#[inline(always)]
-fn add_samples<'f>(
+/// Adds sample `index` of pixel `x`, of colour `c` (and `features`, when
+/// the film keeps layers), to `row`, and counts it in `stats`: a sample
+/// traced alone.
+fn add_sample(
     row: &mut RowMut,
     stats: &mut RenderStats,
-    x: usize,
-    samples: impl Iterator<Item = (u32, Color, &'f Features)>,
+    (x, index): (usize, u32),
+    c: Color,
+    features: &Features,
 ) {
     if row.layers.is_empty() {
-        for (index, c, _) in samples {
-            stats.count(row.add(x, index, c));
-        }
+        stats.count(row.add(x, index, c));
         return;
     }
-    add_samples_with_features(row, stats, x, samples);
+    let mut unit = UnitFeatures::default();
+    stats.count(row.add_with(x, index, c, features, &mut unit));
+    row.add_unit_features(x, &unit);
 }
 
-/// [`add_samples`] to a film that keeps layers: out of line, so that the
-/// layers' code does not weigh on the registers of the loop around it.
+/// Adds the samples `samples` of each pixel `(x, _)` of `pixels`, their
+/// colours and features side by side in `colours` and `searches`, to
+/// `row` in sample order, and counts them in `stats`, as dropped if the
+/// film leaves them out; each pixel's albedos and normals are gathered and
+/// added at its end (see [`UnitFeatures`]). Out of line, and once for all
+/// the pixels traced together, so that the layers' code does not weigh on
+/// the registers of the loop around it.
 #[inline(never)]
-fn add_samples_with_features<'f>(
+fn add_samples_with_features(
     row: &mut RowMut,
     stats: &mut RenderStats,
-    x: usize,
-    samples: impl Iterator<Item = (u32, Color, &'f Features)>,
+    pixels: &[(usize, u32)],
+    samples: Range<u32>,
+    colours: &[Color],
+    searches: &[FeatureSearch],
 ) {
-    let mut unit = UnitFeatures::default();
-    for (index, c, f) in samples {
-        stats.count(row.add_with(x, index, c, f, &mut unit));
+    let per_pixel = samples.len().max(1);
+    let colours = colours.chunks(per_pixel);
+    for ((&(x, _), colours), searches) in pixels.iter().zip(colours).zip(searches.chunks(per_pixel))
+    {
+        let mut unit = UnitFeatures::default();
+        for ((index, &c), s) in samples.clone().zip(colours).zip(searches) {
+            stats.count(row.add_with(x, index, c, &s.features, &mut unit));
+        }
+        row.add_unit_features(x, &unit);
     }
-    row.add_unit_features(x, &unit);
 }
 
 /// The camera ray of sample `index` of pixel `(x, y)`, whose sampler is
@@ -528,8 +541,7 @@ mod tests {
                                 &mut sampler,
                                 &mut expected.rays,
                             );
-                            let sample = std::iter::once((index, c, &f));
-                            add_samples(&mut row, &mut expected, x, sample);
+                            add_sample(&mut row, &mut expected, (x, index), c, &f);
                         }
                     }
                     assert_eq!(stats, expected, "{}: {samples:?}, row {y}", desc.caption);
