@@ -140,6 +140,7 @@ pub fn filled<T: Clone>(n: u64, value: T, what: &str) -> Result<Vec<T>, MemoryEr
 }
 
 /// Bytes of a huge page (x86-64, AArch64 with 4 KB pages): 2 MiB.
+#[cfg(target_os = "linux")]
 const HUGE_PAGE: usize = 2 << 20;
 
 /// An empty vector with room for `n` elements, taken without aborting
@@ -173,10 +174,10 @@ fn advise_huge_pages(start: *mut u8, len: usize) {
     let end = (start as usize).saturating_add(len) / HUGE_PAGE * HUGE_PAGE;
     if end > first {
         // SAFETY: [first, end) lies within an allocation this process owns
-        // and has not yet written (a vector's reserved capacity); madvise
-        // with MADV_HUGEPAGE changes how pages are backed, never their
-        // content, and its failure (a kernel without transparent huge
-        // pages) leaves the memory as it was.
+        // (a vector's reserved capacity); madvise with MADV_HUGEPAGE
+        // changes how pages are backed, never their content, and its
+        // failure (a kernel without transparent huge pages) leaves the
+        // memory as it was.
         unsafe {
             libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
         }

@@ -111,6 +111,23 @@ fn cases() -> Vec<Case> {
             &["objects[1].file", "n.obj:3:"],
         )
         .with("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n"),
+        // Files read at once: still reported in the objects' order.
+        case(
+            "first-of-two-bad-files",
+            mesh("a.obj") + &mesh("b.obj"),
+            "file = \"a.obj\"",
+            &["objects[1].file", "a.obj:3:"],
+        )
+        .with("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n")
+        .with("b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+        case(
+            "second-of-two-files",
+            mesh("good.obj") + &mesh("bad.obj"),
+            "file = \"bad.obj\"",
+            &["objects[2].file", "bad.obj:4:", "out of range"],
+        )
+        .with("good.obj", TRI)
+        .with("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"),
         case(
             "index-range",
             mesh("r.obj"),

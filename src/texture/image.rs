@@ -202,8 +202,14 @@ impl Image {
                 "it declares {w}x{h} texels, more than the {MAX_TEXELS} (16384x16384) lumen reads from an image"
             )));
         }
-        let kept = texels * kept_bytes(::image::ImageDecoder::color_type(&decoder));
-        let peak = ::image::ImageDecoder::total_bytes(&decoder).saturating_add(2 * kept);
+        let color = ::image::ImageDecoder::color_type(&decoder);
+        let kept = texels * kept_bytes(color);
+        // 8-bit texels are decoded into the array that keeps them; others
+        // into `image`'s buffer, then converted and collected.
+        let peak = match expand_to_rgba8(color) {
+            Some(_) => kept,
+            None => ::image::ImageDecoder::total_bytes(&decoder).saturating_add(2 * kept),
+        };
         crate::memory::check(peak, "decoding it").map_err(|e| fail(e.to_string()))?;
         let mut limits = ::image::Limits::no_limits();
         limits.max_alloc = Some(peak);
@@ -211,7 +217,6 @@ impl Image {
         if w == 0 || h == 0 {
             return Err(fail("the image is empty".into()));
         }
-        let color = ::image::ImageDecoder::color_type(&decoder);
         if let Some(expand) = expand_to_rgba8(color) {
             return Ok(Image {
                 width: w as usize,

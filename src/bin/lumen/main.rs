@@ -34,7 +34,8 @@ Ctrl-C (or SIGTERM) stops the render: the pass in flight is abandoned and the
 image and checkpoint of the passes finished so far are saved; continue with
 --resume. Interrupted before the first pass finished, nothing is written. A
 second Ctrl-C quits at once, leaving the files of the last save (a save in
-progress is given up to two seconds to finish).
+progress is given up to two seconds to finish; a render that ends within a
+second of its first pass may have made none).
 
 Exit status:
   0    the image is complete, or --time-limit stopped the render (saved)

@@ -267,7 +267,7 @@ pub(crate) fn render_command(
     // The page's status after a pass: the ETA from this run's pace.
     let status = |session: &Session, pass: u32, elapsed: std::time::Duration| {
         let done = session.spp_done() - resumed_from;
-        let left = session.spp_total() - session.spp_done();
+        let left = session.share().end.saturating_sub(session.spp_done());
         Status {
             pass,
             spp_done: session.spp_done(),

@@ -423,26 +423,45 @@ fn mesh_options(object: &ObjectDesc) -> Option<(&str, mesh::LoadOptions)> {
     }
 }
 
+/// Most bytes of mesh files [`read_mesh_files`] reads at once: beyond,
+/// they are read one at a time, as the objects are compiled, so that a
+/// mistake in an earlier object is reported before gigabytes are read.
+const READ_AHEAD_MAX_BYTES: u64 = 256 << 20;
+
+/// How many times its size on disk a mesh file is counted as taking once
+/// read (a glTF file's textures decode to some 25 times their size), for
+/// [`read_mesh_files`]' bound: the memory checks of files read at once all
+/// see the same free memory, so together they must fit in it with room.
+const READ_AHEAD_GROWTH: u64 = 64;
+
 /// The scene's mesh files read on all threads at once, by their key,
-/// when it names more than one: a file's own reading is only partly
-/// parallel (its textures are decoded together, its JSON and meshes are
-/// not). Each is taken by [`Objects::load`] when its first object is
-/// compiled, so that what goes wrong is still reported in the objects'
-/// order.
+/// when it names more than one and they are small enough (see
+/// [`READ_AHEAD_MAX_BYTES`], [`READ_AHEAD_GROWTH`]): a file's own reading
+/// is only partly parallel (its textures are decoded together, its JSON
+/// and meshes are not). Each is taken by [`Objects::load`] when its first
+/// object is compiled, so that what goes wrong is still reported in the
+/// objects' order.
 fn read_mesh_files(
     desc: &SceneDesc,
     base: &Path,
 ) -> HashMap<PathBuf, Result<Model, mesh::MeshError>> {
     use rayon::prelude::*;
+    let mut seen = std::collections::HashSet::new();
     let mut files: Vec<(PathBuf, PathBuf, mesh::LoadOptions)> = Vec::new();
+    let mut bytes = 0u64;
     for (file, options) in desc.objects.iter().filter_map(mesh_options) {
         let path = model_path(base, file);
         let key = model_key(&path, options);
-        if !files.iter().any(|(k, _, _)| *k == key) {
+        if seen.insert(key.clone()) {
+            bytes = bytes.saturating_add(std::fs::metadata(&path).map_or(0, |m| m.len()));
+            if bytes > READ_AHEAD_MAX_BYTES {
+                return HashMap::new();
+            }
             files.push((key, path, options));
         }
     }
-    if files.len() < 2 {
+    let room = crate::memory::available().unwrap_or(u64::MAX);
+    if files.len() < 2 || bytes.saturating_mul(READ_AHEAD_GROWTH) > room {
         return HashMap::new();
     }
     files
