@@ -478,6 +478,11 @@ impl Session {
         self.scene.settings.samples_per_pixel
     }
 
+    /// Samples per pixel of this session's share not yet rendered.
+    pub fn spp_left(&self) -> u32 {
+        self.share.end.saturating_sub(self.spp_done)
+    }
+
     /// Whether every sample is rendered (with adaptive sampling: every
     /// sample of the pixels that have not stopped).
     pub fn is_complete(&self) -> bool {

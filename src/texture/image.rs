@@ -82,6 +82,12 @@ fn expand_to_rgba8(color: ::image::ColorType) -> Option<Expand> {
     })
 }
 
+/// An empty array with room for `n` texels, in huge pages where the
+/// system has them (see [`crate::memory::huge_vec`]).
+fn texel_room<T>(n: usize) -> Result<Vec<T>, String> {
+    crate::memory::huge_vec(n).ok_or_else(|| format!("its {n} texels do not fit in memory"))
+}
+
 /// The texels of an 8-bit image, decoded straight into the RGBA array
 /// that keeps them and spread out in place: a texture is allocated and
 /// written once, where decoding to `image`'s buffer, converting it and
@@ -93,8 +99,7 @@ fn decode_rgba8(
 ) -> Result<Vec<[u8; 4]>, String> {
     let (w, h) = ::image::ImageDecoder::dimensions(&decoder);
     let n = w as usize * h as usize;
-    let mut texels: Vec<[u8; 4]> = crate::memory::huge_vec(n)
-        .ok_or_else(|| format!("its {w}x{h} texels do not fit in memory"))?;
+    let mut texels: Vec<[u8; 4]> = texel_room(n)?;
     texels.resize(n, [0; 4]);
     let bytes = texels.as_flattened_mut();
     decoder
@@ -206,7 +211,8 @@ impl Image {
         let kept = texels * kept_bytes(color);
         // 8-bit texels are decoded into the array that keeps them; others
         // into `image`'s buffer, then converted and collected.
-        let peak = match expand_to_rgba8(color) {
+        let expand = expand_to_rgba8(color);
+        let peak = match expand {
             Some(_) => kept,
             None => ::image::ImageDecoder::total_bytes(&decoder).saturating_add(2 * kept),
         };
@@ -217,7 +223,7 @@ impl Image {
         if w == 0 || h == 0 {
             return Err(fail("the image is empty".into()));
         }
-        if let Some(expand) = expand_to_rgba8(color) {
+        if let Some(expand) = expand {
             return Ok(Image {
                 width: w as usize,
                 height: h as usize,
@@ -226,22 +232,18 @@ impl Image {
         }
         let decoded = D::from_decoder(decoder).map_err(|e| fail(e.to_string()))?;
         let (width, height) = (decoded.width() as usize, decoded.height() as usize);
-        // The texels' array, in huge pages where the system has them.
-        fn room<T>(n: usize) -> Result<Vec<T>, String> {
-            crate::memory::huge_vec(n).ok_or_else(|| format!("its {n} texels do not fit in memory"))
-        }
         let texels = match decoded {
             D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
                 Texels::Rgba8(decoded.into_rgba8().pixels().map(|p| p.0).collect())
             }
             D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
-                let mut texels = room(width * height).map_err(fail)?;
+                let mut texels = texel_room(width * height).map_err(fail)?;
                 texels.extend(decoded.into_rgba16().pixels().map(|p| p.0));
                 Texels::Rgba16(texels)
             }
             _ => {
                 let rgb = decoded.into_rgb32f();
-                let mut texels = room(width * height).map_err(fail)?;
+                let mut texels = texel_room(width * height).map_err(fail)?;
                 for (i, p) in rgb.pixels().enumerate() {
                     let value = p.0;
                     if value.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {

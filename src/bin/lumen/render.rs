@@ -267,7 +267,7 @@ pub(crate) fn render_command(
     // The page's status after a pass: the ETA from this run's pace.
     let status = |session: &Session, pass: u32, elapsed: std::time::Duration| {
         let done = session.spp_done() - resumed_from;
-        let left = session.share().end.saturating_sub(session.spp_done());
+        let left = session.spp_left();
         Status {
             pass,
             spp_done: session.spp_done(),
@@ -305,10 +305,9 @@ pub(crate) fn render_command(
             )
         });
         // The finished image is written once, below.
-        let left = session.spp_total() - session.spp_done();
         let predicted = pass
             .duration
-            .mul_f64(f64::from(left) / pass.samples.len().max(1) as f64);
+            .mul_f64(f64::from(session.spp_left()) / pass.samples.len().max(1) as f64);
         let due = prog.checkpoint_interval.unwrap_or_default().due(
             last_save.elapsed(),
             last_save_took,
