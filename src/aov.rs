@@ -29,8 +29,9 @@
 //!
 //! Each is averaged over the pixel's samples, the beauty's own, so it is
 //! filtered as the image is; its sums are fixed-point like the image's
-//! ([`crate::film::Sum`]; the albedo and normal to 2⁻³⁰, see
-//! [`UnitFeatures`](crate::film::UnitFeatures), the depth and position to
+//! ([`crate::film::Sum`]; the albedo and normal to 2⁻³⁰ in 64 bits, see
+//! [`UnitFeatures`](crate::film::UnitFeatures) and
+//! [`UnitSums`](crate::film::UnitSums), the depth and position to
 //! 2⁻³² within ±2³¹, see
 //! [`Sum::of_feature`](crate::film::Sum::of_feature)), so an image split
 //! into passes, threads, parts or resumed runs has bit-identical features.

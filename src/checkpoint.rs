@@ -410,7 +410,7 @@ mod tests {
         let layered = |film: Film| {
             let n = film.len();
             let moment = (0..n).map(|i| Sum([i as i128, 0, -1])).collect();
-            film.with_layer(Layer::Albedo, vec![Sum([5, 6, 7]); n])
+            film.with_layer(Layer::Albedo, vec![Sum([5 << 34, -6 << 34, 7 << 34]); n])
                 .and_then(|f| f.with_layer(Layer::Moment, moment))
                 .unwrap()
         };

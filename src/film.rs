@@ -4,6 +4,7 @@
 use crate::aov::{Features, Layer, Layers, LAYERS};
 use crate::math::{Color, Vec3};
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// The sum of some samples of a pixel, a number per channel, in 64.64 fixed
 /// point: integers counting 2⁻⁶⁴.
@@ -176,16 +177,41 @@ impl UnitFeatures {
             *sum = sum.wrapping_add(round_to_integer(f64::from(x) * UNIT));
         }
     }
+}
 
-    /// The albedos' and the normals' sums as [`Sum`]s (in 2⁻⁶⁴, exactly).
-    #[inline(always)]
-    fn sums(&self) -> [Sum; 2] {
-        let wide = |c: usize| i128::from(self.0[c]) << 34;
-        [
-            Sum([wide(0), wide(1), wide(2)]),
-            Sum([wide(3), wide(4), wide(5)]),
-        ]
+/// A pixel's sums of albedos (its first three channels) and normals (the
+/// last three) as the film keeps them: in 2⁻³⁰, as [`UnitFeatures`]
+/// gathers them, a quarter of the room and none of the conversions of
+/// [`Sum`]s. A pixel holds fewer than 2³² samples (its count is a `u32`),
+/// each channel within ±2 (2³¹ in 2⁻³⁰), so a channel's sum stays within
+/// ±2⁶³: it never wraps. A film's files hold them as [`Sum`]s
+/// ([`unit_to_sum`], [`sum_to_unit`]), as they hold every layer.
+pub type UnitSums = [i64; 6];
+
+/// The place of `layer`'s channels in a pixel's [`UnitSums`], if they are
+/// kept there.
+fn unit_offset(layer: Layer) -> Option<usize> {
+    match layer {
+        Layer::Albedo => Some(0),
+        Layer::Normal => Some(3),
+        _ => None,
     }
+}
+
+/// A channel of [`UnitSums`] as the channel of a [`Sum`] (in 2⁻⁶⁴):
+/// exact.
+#[inline]
+fn unit_to_sum(v: i64) -> i128 {
+    i128::from(v) << 34
+}
+
+/// The channel of [`UnitSums`] that a channel `v` of a [`Sum`] of `count`
+/// samples is, if it is one: a multiple of 2⁻³⁰, within ±2 a sample
+/// (what [`UnitFeatures`] gathers).
+fn sum_to_unit(v: i128, count: u32) -> Option<i64> {
+    let unit = v >> 34;
+    let whole = unit << 34 == v;
+    (whole && unit.unsigned_abs() <= u128::from(count) << 31).then_some(unit as i64)
 }
 
 /// Makes `dst` a copy of `src`, on all threads when it already has its
@@ -253,9 +279,15 @@ pub struct Film {
     odd_sums: Vec<Sum>,
     odd_counts: Vec<u32>,
     /// The sums of the samples' features (see [`crate::aov`]), a vector a
-    /// layer kept (empty for the others), in [`Layer::ALL`]'s order; their
-    /// counts are the image's.
+    /// layer kept (empty for the others, and for the albedo and normal,
+    /// which are in `unit_sums`), in [`Layer::ALL`]'s order; their counts
+    /// are the image's.
     layer_sums: [Vec<Sum>; LAYERS],
+    /// The sums of the albedos and normals, when the film keeps either
+    /// (empty otherwise).
+    unit_sums: Vec<UnitSums>,
+    /// The layers the film keeps.
+    layers: Layers,
 }
 
 /// One row of a film, to add samples to (see [`Film::rows_mut`]).
@@ -270,8 +302,16 @@ pub struct RowMut<'a> {
     /// Numbers of finite samples of odd index (empty likewise).
     pub odd_counts: &'a mut [u32],
     /// The sums of the samples' features, a slice a layer the film keeps
-    /// (empty for the others), in [`Layer::ALL`]'s order.
+    /// (empty for the others, and for the albedo and normal), in
+    /// [`Layer::ALL`]'s order.
     pub layer_sums: [&'a mut [Sum]; LAYERS],
+    /// The sums of the albedos and normals (empty if the film keeps
+    /// neither).
+    pub unit_sums: &'a mut [UnitSums],
+    /// Of the channels of `unit_sums`, the ones of the layers the film
+    /// keeps (all bits set) and the others (none): a film that keeps the
+    /// albedo alone has no sums of normals.
+    pub unit_mask: UnitSums,
     /// The layers the film keeps.
     pub layers: Layers,
 }
@@ -353,10 +393,10 @@ impl RowMut<'_> {
     /// them.
     #[inline(always)]
     pub fn add_unit_features(&mut self, x: usize, unit: &UnitFeatures) {
-        for (layer, add) in [Layer::Albedo, Layer::Normal].into_iter().zip(unit.sums()) {
-            if self.layers.has(layer) {
-                let sum = &mut self.layer_sums[layer as usize][x];
-                *sum = sum.plus(add);
+        if let Some(sums) = self.unit_sums.get_mut(x) {
+            // No wrap: see `UnitSums`.
+            for ((sum, add), mask) in sums.iter_mut().zip(unit.0).zip(self.unit_mask) {
+                *sum = sum.wrapping_add(add & mask);
             }
         }
     }
@@ -381,6 +421,8 @@ impl Film {
             odd_sums: Vec::new(),
             odd_counts: Vec::new(),
             layer_sums: Default::default(),
+            unit_sums: Vec::new(),
+            layers: Layers::NONE,
         }
     }
 
@@ -391,11 +433,17 @@ impl Film {
         for layer in Layer::ALL {
             let sums = &mut self.layer_sums[layer as usize];
             sums.clear();
-            if layers.has(layer) {
+            if layers.has(layer) && unit_offset(layer).is_none() {
                 sums.try_reserve_exact(n).ok()?;
                 sums.resize(n, Sum::ZERO);
             }
         }
+        self.unit_sums.clear();
+        if layers.meets(UNIT_LAYERS) {
+            self.unit_sums.try_reserve_exact(n).ok()?;
+            self.unit_sums.resize(n, [0; 6]);
+        }
+        self.layers = layers;
         Some(self)
     }
 
@@ -407,34 +455,102 @@ impl Film {
 
     /// The layers of features the film keeps.
     pub fn layers(&self) -> Layers {
-        Layer::ALL
-            .into_iter()
-            .filter(|&l| !self.layer_sums[l as usize].is_empty())
-            .fold(Layers::NONE, |all, l| all.with(Layers::of(l)))
+        self.layers
     }
 
     /// The raw per-pixel sums of `layer` (empty if the film does not keep
-    /// it).
-    pub fn raw_layer(&self, layer: Layer) -> &[Sum] {
-        &self.layer_sums[layer as usize]
+    /// it), as its files hold them.
+    pub fn raw_layer(&self, layer: Layer) -> Cow<'_, [Sum]> {
+        match unit_offset(layer) {
+            Some(_) if !self.layers.has(layer) => Cow::Borrowed(&[]),
+            Some(_) => Cow::Owned((0..self.len()).map(|i| self.layer_sum(layer, i)).collect()),
+            None => Cow::Borrowed(&self.layer_sums[layer as usize]),
+        }
+    }
+
+    /// The sum of `layer` over pixel `i`'s samples, if the film keeps it.
+    fn layer_sum(&self, layer: Layer, i: usize) -> Sum {
+        match unit_offset(layer) {
+            Some(at) => match self.unit_sums.get(i) {
+                Some(sums) if self.layers.has(layer) => {
+                    Sum([0, 1, 2].map(|c| unit_to_sum(sums[at + c])))
+                }
+                _ => Sum::ZERO,
+            },
+            None => self.layer_sums[layer as usize]
+                .get(i)
+                .copied()
+                .unwrap_or(Sum::ZERO),
+        }
     }
 
     /// This film with `sums` as the sums of `layer`; `None` if their number
-    /// is not the film's pixels'.
+    /// is not the film's pixels', or (for the albedo and normal) a sum is
+    /// not one that the film's samples could have made: of multiples of
+    /// 2⁻³⁰, within ±2 a sample.
     pub fn with_layer(mut self, layer: Layer, sums: Vec<Sum>) -> Option<Self> {
-        (sums.len() == self.len()).then(|| {
-            self.layer_sums[layer as usize] = sums;
-            self
-        })
+        let n = self.len();
+        if sums.len() != n {
+            return None;
+        }
+        match unit_offset(layer) {
+            None => self.layer_sums[layer as usize] = sums,
+            Some(at) => {
+                if self.unit_sums.is_empty() {
+                    self.unit_sums = vec![[0; 6]; n];
+                }
+                for ((unit, sum), &count) in self.unit_sums.iter_mut().zip(&sums).zip(&self.counts)
+                {
+                    for c in 0..3 {
+                        unit[at + c] = sum_to_unit(sum.0[c], count)?;
+                    }
+                }
+            }
+        }
+        self.layers = self.layers.with(Layers::of(layer));
+        Some(self)
+    }
+
+    /// Whether the film keeps `layer` in its [`UnitSums`] (the albedo and
+    /// normal), where [`RowMut::layer_sums`] holds nothing of it.
+    pub fn packs(layer: Layer) -> bool {
+        unit_offset(layer).is_some()
+    }
+
+    /// Adds `sums`, sums of `layer` (one [`Film::packs`]) over a block of
+    /// pixels `width` wide whose top left pixel is `origin`, of `counts`
+    /// samples each, to this film's (which keeps the layer). An error
+    /// names the block's first pixel, `(x, y)` within it, whose sum is not
+    /// one samples could have made (see [`Film::with_layer`]) or would
+    /// pass what a sum holds; the pixels before it are added.
+    pub fn add_packed_layer(
+        &mut self,
+        layer: Layer,
+        (origin, width): ((usize, usize), usize),
+        sums: &[Sum],
+        counts: &[u32],
+    ) -> Result<(), (usize, usize)> {
+        let at = unit_offset(layer).expect("a layer the film packs");
+        let film_width = self.width as usize;
+        for (i, (sum, &count)) in sums.iter().zip(counts).enumerate() {
+            let (x, y) = (i % width.max(1), i / width.max(1));
+            let unit = &mut self.unit_sums[(origin.1 + y) * film_width + origin.0 + x];
+            for c in 0..3 {
+                unit[at + c] = sum_to_unit(sum.0[c], count)
+                    .and_then(|v| unit[at + c].checked_add(v))
+                    .ok_or((x, y))?;
+            }
+        }
+        Ok(())
     }
 
     /// The mean of `layer` over pixel `i`'s samples (0 without samples or
     /// without the layer).
     pub fn feature(&self, layer: Layer, i: usize) -> Vec3 {
-        match self.layer_sums[layer as usize].get(i) {
-            Some(&sum) => feature_mean(sum, self.counts[i]),
-            None => Vec3::ZERO,
+        if !self.layers.has(layer) || i >= self.len() {
+            return Vec3::ZERO;
         }
+        feature_mean(self.layer_sum(layer, i), self.counts[i])
     }
 
     /// The variance of pixel `i`'s estimate, per channel: the unbiased
@@ -484,10 +600,14 @@ impl Film {
     }
 
     /// Bytes of the sums of `layers` in a `width`×`height` film: 48 a pixel
-    /// a layer.
+    /// a layer, and 48 for the albedo and normal together.
     pub fn layer_bytes(width: u32, height: u32, layers: Layers) -> u64 {
-        let kept = Layer::ALL.iter().filter(|&&l| layers.has(l)).count() as u64;
-        u64::from(width) * u64::from(height) * kept * std::mem::size_of::<Sum>() as u64
+        let kept = Layer::ALL
+            .iter()
+            .filter(|&&l| layers.has(l) && unit_offset(l).is_none())
+            .count()
+            + usize::from(layers.meets(UNIT_LAYERS));
+        u64::from(width) * u64::from(height) * kept as u64 * std::mem::size_of::<Sum>() as u64
     }
 
     /// [`Film::with_halves`], or `None` if this machine's memory cannot
@@ -533,9 +653,14 @@ impl Film {
         let w = (self.width as usize).max(1);
         let layers = self.layers();
         // What only some films keep, row by row (empty slices elsewhere).
-        type Kept<'a> = (&'a mut [Sum], &'a mut [u32], [&'a mut [Sum]; LAYERS]);
+        type Kept<'a> = (
+            &'a mut [Sum],
+            &'a mut [u32],
+            [&'a mut [Sum]; LAYERS],
+            &'a mut [UnitSums],
+        );
         let mut kept: Vec<Kept> = (0..self.sums.len() / w)
-            .map(|_| (&mut [][..], &mut [][..], Default::default()))
+            .map(|_| (&mut [][..], &mut [][..], Default::default(), &mut [][..]))
             .collect();
         let halves = self
             .odd_sums
@@ -549,17 +674,28 @@ impl Film {
                 row.2[l] = sums;
             }
         }
+        for (row, sums) in kept.iter_mut().zip(self.unit_sums.chunks_mut(w)) {
+            row.3 = sums;
+        }
+        let mut unit_mask = [0; 6];
+        for layer in [Layer::Albedo, Layer::Normal] {
+            if let (Some(at), true) = (unit_offset(layer), layers.has(layer)) {
+                unit_mask[at..at + 3].fill(-1);
+            }
+        }
         self.sums
             .par_chunks_mut(w)
             .zip(self.counts.par_chunks_mut(w))
             .zip(kept)
             .map(
-                move |((sums, counts), (odd_sums, odd_counts, layer_sums))| RowMut {
+                move |((sums, counts), (odd_sums, odd_counts, layer_sums, unit_sums))| RowMut {
                     sums,
                     counts,
                     odd_sums,
                     odd_counts,
                     layer_sums,
+                    unit_sums,
+                    unit_mask,
                     layers,
                 },
             )
@@ -599,6 +735,13 @@ impl Film {
                 }
             }
         }
+        // Within a sum's bounds: the counts were added without passing
+        // what they hold (see `UnitSums`).
+        for (a, b) in self.unit_sums.iter_mut().zip(&other.unit_sums) {
+            for (a, b) in a.iter_mut().zip(b) {
+                *a = a.wrapping_add(*b);
+            }
+        }
         true
     }
 
@@ -619,6 +762,8 @@ impl Film {
         for (mine, theirs) in self.layer_sums.iter_mut().zip(&other.layer_sums) {
             copy_vec(mine, theirs);
         }
+        copy_vec(&mut self.unit_sums, &other.unit_sums);
+        self.layers = other.layers;
     }
 
     /// The raw per-pixel sums and counts (for checkpoints).
@@ -644,6 +789,8 @@ impl Film {
             odd_sums: Vec::new(),
             odd_counts: Vec::new(),
             layer_sums: Default::default(),
+            unit_sums: Vec::new(),
+            layers: Layers::NONE,
         })
     }
 
@@ -781,6 +928,15 @@ pub fn to_display(linear: f32, gamma: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// The albedos' and the normals' sums `unit` gathered, as [`Sum`]s.
+    fn sums_of(unit: &UnitFeatures) -> [Sum; 2] {
+        let wide = |c: usize| unit_to_sum(unit.0[c]);
+        [
+            Sum([wide(0), wide(1), wide(2)]),
+            Sum([wide(3), wide(4), wide(5)]),
+        ]
+    }
+
     #[test]
     fn sums_convert_to_f64_as_the_compiler_converts() {
         let mut edges = vec![0i128, 1, -1, i128::MAX, i128::MIN, i128::MIN + 1];
@@ -831,7 +987,7 @@ mod tests {
                 .unwrap()
                 .0[0]
             };
-            let [albedo, normal] = unit.sums();
+            let [albedo, normal] = sums_of(&unit);
             assert_eq!(albedo.0, [to_unit(x), 0, to_unit(-x)], "{v:e}");
             assert_eq!(normal.0, [to_unit(y), 1 << 64, 0], "{v:e}");
         }
@@ -845,7 +1001,7 @@ mod tests {
             Color::new(odd[0], odd[1], 2.0),
             Vec3::new(odd[2], odd[3], -2.0),
         );
-        let [albedo, normal] = unit.sums();
+        let [albedo, normal] = sums_of(&unit);
         assert_eq!(albedo.0, [0, 0, 2 << 64]);
         assert_eq!(normal.0, [0, 0, -2 << 64]);
     }
@@ -871,6 +1027,88 @@ mod tests {
         }
         assert_eq!(Sum::of_square(Color::new(f32::NAN, 0.0, 0.0)), None);
         assert_eq!(Sum::of_square(Color::new(0.0, f32::INFINITY, 0.0)), None);
+    }
+
+    /// The albedo and normal, kept packed, read and write as the other
+    /// layers do (as `Sum`s), and a sum no samples could have made is
+    /// refused rather than kept.
+    #[test]
+    fn packed_albedos_and_normals_read_as_sums_and_refuse_what_samples_cannot_make() {
+        let mut film = Film::new(3, 2).with_layers(UNIT_LAYERS.with(Layers::of(Layer::Depth)));
+        let features = |i: usize| Features {
+            albedo: Color::new(0.25 * i as f32, 1.0, 0.1),
+            normal: Vec3::new(-0.6, 0.0, 0.8),
+            depth: i as f32,
+            ..Features::default()
+        };
+        for (y, mut row) in film.rows_mut().collect::<Vec<_>>().into_iter().enumerate() {
+            for x in 0..3 {
+                let mut unit = UnitFeatures::default();
+                for index in 0..3 {
+                    let f = features(y * 3 + x);
+                    assert!(row.add_with(x, index, Color::ONE, &f, &mut unit));
+                }
+                row.add_unit_features(x, &unit);
+            }
+        }
+        // What a sum of the layer gives, to the bit: as a `Sum` of the
+        // rounded values.
+        for i in 0..6 {
+            let f = features(i);
+            let rounded = |v: f32| (3 * round_to_integer(f64::from(v) * UNIT) as i128) << 34;
+            let want = |v: Vec3| Sum([rounded(v.x), rounded(v.y), rounded(v.z)]);
+            assert_eq!(film.raw_layer(Layer::Albedo)[i], want(f.albedo));
+            assert_eq!(film.raw_layer(Layer::Normal)[i], want(f.normal));
+            assert_eq!(
+                film.feature(Layer::Albedo, i),
+                feature_mean(want(f.albedo), 3)
+            );
+        }
+        // Rebuilt from those sums, the film is the same.
+        let (sums, counts) = film.raw();
+        let mut rebuilt = Film::from_raw(3, 2, sums.to_vec(), counts.to_vec()).unwrap();
+        for layer in [Layer::Albedo, Layer::Normal, Layer::Depth] {
+            let sums = film.raw_layer(layer).into_owned();
+            rebuilt = rebuilt.with_layer(layer, sums).unwrap();
+        }
+        assert_eq!(rebuilt, film);
+        // Not a multiple of 2⁻³⁰, or beyond 2 a sample: refused.
+        let bare = || Film::from_raw(3, 2, sums.to_vec(), counts.to_vec()).unwrap();
+        let two_each = (3i128 * 2) << 30 << 34;
+        for bad in [
+            Sum([1, 0, 0]),
+            Sum([0, two_each + (1 << 34), 0]),
+            Sum([0, 0, -two_each - (1 << 34)]),
+        ] {
+            let mut layer = film.raw_layer(Layer::Normal).into_owned();
+            layer[4] = bad;
+            assert!(bare().with_layer(Layer::Normal, layer).is_none(), "{bad:?}");
+        }
+        let mut at_most = film.raw_layer(Layer::Normal).into_owned();
+        at_most[4] = Sum([two_each, -two_each, 0]);
+        assert!(bare().with_layer(Layer::Normal, at_most).is_some());
+    }
+
+    /// A block of a layer's sums (a tile of a part) adds at its place; a
+    /// sum no samples could have made is named by its place in the block.
+    #[test]
+    fn packed_blocks_add_at_their_place_and_name_a_bad_pixel() {
+        let layers = UNIT_LAYERS;
+        let mut film = Film::new(4, 3).with_layers(layers);
+        let one = 1i128 << 30 << 34;
+        let block = vec![Sum([one, 2 * one, -one]); 4];
+        film.add_packed_layer(Layer::Normal, ((1, 1), 2), &block, &[2; 4])
+            .unwrap();
+        for i in 0..12 {
+            let inside = (1..3).contains(&(i % 4)) && (1..3).contains(&(i / 4));
+            let want = if inside { block[0] } else { Sum::ZERO };
+            assert_eq!(film.raw_layer(Layer::Normal)[i], want, "{i}");
+            assert_eq!(film.raw_layer(Layer::Albedo)[i], Sum::ZERO);
+        }
+        let mut bad = block.clone();
+        bad[3] = Sum([3 * one, 0, 0]);
+        let e = film.add_packed_layer(Layer::Albedo, ((1, 1), 2), &bad, &[1; 4]);
+        assert_eq!(e, Err((1, 1)));
     }
 
     #[test]

@@ -54,7 +54,7 @@ impl CheckpointView<'_> {
             sink(&[layers.bits()])?;
             let counts = self.film.raw().1;
             for layer in Layer::ALL.into_iter().filter(|&l| layers.has(l)) {
-                write_pixels((self.film.raw_layer(layer), counts), width, sink)?;
+                write_pixels((&self.film.raw_layer(layer), counts), width, sink)?;
             }
         }
         Ok(())

@@ -8,7 +8,7 @@ use crate::checkpoint::{
     describe_differences, same_render, Checkpoint, CheckpointError, PixelError, Unpacked,
     HEADER_LEN,
 };
-use crate::film::Film;
+use crate::film::{Film, Sum};
 use crate::render::RenderStats;
 use crate::scene::desc::RenderDesc;
 use crate::tile::Tile;
@@ -476,12 +476,7 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
     let mut scratch = vec![0u32; (x1 - x0) * tile.height() as usize];
     for (layer, pixels) in &part.layers {
         scratch.fill(0);
-        let rows = (film.rows_mut())
-            .skip(tile.y0 as usize)
-            .take(tile.height() as usize)
-            .zip(scratch.par_chunks_mut((x1 - x0).max(1)))
-            .map(|(row, counts)| (&mut row.layer_sums[*layer as usize][x0..x1], counts));
-        pixels.add_rows(rows, None).map_err(|(y, e)| match e {
+        let named = |(y, e): (usize, PixelError)| match e {
             PixelError::Malformed(m) => m.to_string(),
             PixelError::Pixel { x, message } => format!(
                 "pixel ({}, {}) of its {} layer {message}",
@@ -489,7 +484,32 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
                 tile.y0 as usize + y,
                 layer.name()
             ),
-        })?;
+        };
+        if Film::packs(*layer) {
+            // Read into a scratch block, then checked and added.
+            let w = (x1 - x0).max(1);
+            let mut sums = vec![Sum::ZERO; scratch.len()];
+            let rows = sums.par_chunks_mut(w).zip(scratch.par_chunks_mut(w));
+            pixels.add_rows(rows, None).map_err(named)?;
+            let origin = (x0, tile.y0 as usize);
+            film.add_packed_layer(*layer, (origin, w), &sums, &scratch)
+                .map_err(|(x, y)| {
+                    named((
+                        y,
+                        PixelError::Pixel {
+                            x,
+                            message: "is not a sum of its samples' values".into(),
+                        },
+                    ))
+                })?;
+            continue;
+        }
+        let rows = (film.rows_mut())
+            .skip(tile.y0 as usize)
+            .take(tile.height() as usize)
+            .zip(scratch.par_chunks_mut((x1 - x0).max(1)))
+            .map(|(row, counts)| (&mut row.layer_sums[*layer as usize][x0..x1], counts));
+        pixels.add_rows(rows, None).map_err(named)?;
     }
     let rows = (film.rows_mut())
         .skip(tile.y0 as usize)
