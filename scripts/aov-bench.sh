@@ -7,6 +7,13 @@
 # 1 = no cost) and their median. The time is the whole process, from start
 # to the last file written, saves included.
 #
+#
+# SEQUENTIAL=1: each round runs the two one after the other instead, on all
+# threads (the order swapped every round), and compares the render time
+# lumen reports (its passes and saves, without start-up and loading). The
+# two runs then share no memory bandwidth, which at the same time weighs
+# against the larger film with layers.
+#
 # usage: scripts/aov-bench.sh LUMEN [ROUNDS] [RENDER ARGS...]
 #   default render: cover --width 640 --spp 64 --seed 1   (needs taskset, two cores)
 #   AOVS=albedo,normal,depth scripts/aov-bench.sh ...   other layers
@@ -34,9 +41,36 @@ timed() {
     }
 }
 
+# Runs lumen on all threads with the rest of the arguments; writes the
+# render time it reports to $out/$1.s.
+whole() {
+    name=$1
+    shift
+    "$lumen" render "$@" -o "$out/$name.exr" >"$out/$name.txt" 2>&1 || {
+        cat "$out/$name.txt" >&2
+        exit 1
+    }
+    seconds "$out/$name.txt" >"$out/$name.s"
+}
+
 ratios=
 i=1
-while [ "$i" -le "$rounds" ]; do
+while [ "${SEQUENTIAL:-0}" = 1 ] && [ "$i" -le "$rounds" ]; do
+    if [ $((i % 2)) = 1 ]; then
+        whole off "$@"
+        whole on "$@" --aov "$aovs"
+    else
+        whole on "$@" --aov "$aovs"
+        whole off "$@"
+    fi
+    ta=$(cat "$out/off.s")
+    tb=$(cat "$out/on.s")
+    r=$(ratio "$ta" "$tb")
+    echo "round $i: without $ta s  with $tb s  speed with/without $r"
+    ratios="$ratios $r"
+    i=$((i + 1))
+done
+while [ "${SEQUENTIAL:-0}" != 1 ] && [ "$i" -le "$rounds" ]; do
     ca=$((i % 2))
     cb=$((1 - ca))
     timed "$ca" off "$@" &
