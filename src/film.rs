@@ -4,7 +4,6 @@
 use crate::aov::{Features, Layer, Layers, LAYERS};
 use crate::math::{Color, Vec3};
 use rayon::prelude::*;
-use std::borrow::Cow;
 
 /// The sum of some samples of a pixel, a number per channel, in 64.64 fixed
 /// point: integers counting 2⁻⁶⁴.
@@ -187,6 +186,15 @@ impl UnitFeatures {
 /// ±2⁶³: it never wraps. A film's files hold them as [`Sum`]s
 /// ([`unit_to_sum`], [`sum_to_unit`]), as they hold every layer.
 pub type UnitSums = [i64; 6];
+
+/// Why [`Film::add_packed_layer`] refused a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PackedError {
+    /// Its sum is not one its samples could have made.
+    NotSamples,
+    /// Added to the film's, it would pass what a sum holds.
+    Overflow,
+}
 
 /// The place of `layer`'s channels in a pixel's [`UnitSums`], if they are
 /// kept there.
@@ -458,18 +466,9 @@ impl Film {
         self.layers
     }
 
-    /// The raw per-pixel sums of `layer` (empty if the film does not keep
-    /// it), as its files hold them.
-    pub fn raw_layer(&self, layer: Layer) -> Cow<'_, [Sum]> {
-        match unit_offset(layer) {
-            Some(_) if !self.layers.has(layer) => Cow::Borrowed(&[]),
-            Some(_) => Cow::Owned((0..self.len()).map(|i| self.layer_sum(layer, i)).collect()),
-            None => Cow::Borrowed(&self.layer_sums[layer as usize]),
-        }
-    }
-
-    /// The sum of `layer` over pixel `i`'s samples, if the film keeps it.
-    fn layer_sum(&self, layer: Layer, i: usize) -> Sum {
+    /// The sum of `layer` over pixel `i`'s samples, as its files hold it
+    /// (0 if the film does not keep the layer).
+    pub fn layer_sum(&self, layer: Layer, i: usize) -> Sum {
         match unit_offset(layer) {
             Some(at) => match self.unit_sums.get(i) {
                 Some(sums) if self.layers.has(layer) => {
@@ -517,28 +516,33 @@ impl Film {
         unit_offset(layer).is_some()
     }
 
+    /// The layers [`Film::packs`].
+    pub const PACKED: Layers = UNIT_LAYERS;
+
     /// Adds `sums`, sums of `layer` (one [`Film::packs`]) over a block of
     /// pixels `width` wide whose top left pixel is `origin`, of `counts`
     /// samples each, to this film's (which keeps the layer). An error
     /// names the block's first pixel, `(x, y)` within it, whose sum is not
     /// one samples could have made (see [`Film::with_layer`]) or would
-    /// pass what a sum holds; the pixels before it are added.
+    /// pass what a sum holds, and which; the film is then left with some
+    /// of the block added (a merge that meets it gives up).
     pub fn add_packed_layer(
         &mut self,
         layer: Layer,
         (origin, width): ((usize, usize), usize),
         sums: &[Sum],
         counts: &[u32],
-    ) -> Result<(), (usize, usize)> {
+    ) -> Result<(), (usize, usize, PackedError)> {
         let at = unit_offset(layer).expect("a layer the film packs");
         let film_width = self.width as usize;
         for (i, (sum, &count)) in sums.iter().zip(counts).enumerate() {
             let (x, y) = (i % width.max(1), i / width.max(1));
             let unit = &mut self.unit_sums[(origin.1 + y) * film_width + origin.0 + x];
             for c in 0..3 {
-                unit[at + c] = sum_to_unit(sum.0[c], count)
-                    .and_then(|v| unit[at + c].checked_add(v))
-                    .ok_or((x, y))?;
+                let v = sum_to_unit(sum.0[c], count).ok_or((x, y, PackedError::NotSamples))?;
+                unit[at + c] = unit[at + c]
+                    .checked_add(v)
+                    .ok_or((x, y, PackedError::Overflow))?;
             }
         }
         Ok(())
@@ -928,6 +932,11 @@ pub fn to_display(linear: f32, gamma: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// Every pixel's sum of `layer`.
+    fn layer_of(film: &Film, layer: Layer) -> Vec<Sum> {
+        (0..film.len()).map(|i| film.layer_sum(layer, i)).collect()
+    }
+
     /// The albedos' and the normals' sums `unit` gathered, as [`Sum`]s.
     fn sums_of(unit: &UnitFeatures) -> [Sum; 2] {
         let wide = |c: usize| unit_to_sum(unit.0[c]);
@@ -1057,8 +1066,8 @@ mod tests {
             let f = features(i);
             let rounded = |v: f32| (3 * round_to_integer(f64::from(v) * UNIT) as i128) << 34;
             let want = |v: Vec3| Sum([rounded(v.x), rounded(v.y), rounded(v.z)]);
-            assert_eq!(film.raw_layer(Layer::Albedo)[i], want(f.albedo));
-            assert_eq!(film.raw_layer(Layer::Normal)[i], want(f.normal));
+            assert_eq!(film.layer_sum(Layer::Albedo, i), want(f.albedo));
+            assert_eq!(film.layer_sum(Layer::Normal, i), want(f.normal));
             assert_eq!(
                 film.feature(Layer::Albedo, i),
                 feature_mean(want(f.albedo), 3)
@@ -1068,7 +1077,7 @@ mod tests {
         let (sums, counts) = film.raw();
         let mut rebuilt = Film::from_raw(3, 2, sums.to_vec(), counts.to_vec()).unwrap();
         for layer in [Layer::Albedo, Layer::Normal, Layer::Depth] {
-            let sums = film.raw_layer(layer).into_owned();
+            let sums = layer_of(&film, layer);
             rebuilt = rebuilt.with_layer(layer, sums).unwrap();
         }
         assert_eq!(rebuilt, film);
@@ -1080,11 +1089,11 @@ mod tests {
             Sum([0, two_each + (1 << 34), 0]),
             Sum([0, 0, -two_each - (1 << 34)]),
         ] {
-            let mut layer = film.raw_layer(Layer::Normal).into_owned();
+            let mut layer = layer_of(&film, Layer::Normal);
             layer[4] = bad;
             assert!(bare().with_layer(Layer::Normal, layer).is_none(), "{bad:?}");
         }
-        let mut at_most = film.raw_layer(Layer::Normal).into_owned();
+        let mut at_most = layer_of(&film, Layer::Normal);
         at_most[4] = Sum([two_each, -two_each, 0]);
         assert!(bare().with_layer(Layer::Normal, at_most).is_some());
     }
@@ -1102,13 +1111,13 @@ mod tests {
         for i in 0..12 {
             let inside = (1..3).contains(&(i % 4)) && (1..3).contains(&(i / 4));
             let want = if inside { block[0] } else { Sum::ZERO };
-            assert_eq!(film.raw_layer(Layer::Normal)[i], want, "{i}");
-            assert_eq!(film.raw_layer(Layer::Albedo)[i], Sum::ZERO);
+            assert_eq!(film.layer_sum(Layer::Normal, i), want, "{i}");
+            assert_eq!(film.layer_sum(Layer::Albedo, i), Sum::ZERO);
         }
         let mut bad = block.clone();
         bad[3] = Sum([3 * one, 0, 0]);
         let e = film.add_packed_layer(Layer::Albedo, ((1, 1), 2), &bad, &[1; 4]);
-        assert_eq!(e, Err((1, 1)));
+        assert_eq!(e, Err((1, 1, PackedError::NotSamples)));
     }
 
     #[test]

@@ -36,12 +36,14 @@ impl CheckpointView<'_> {
             sink(&v.to_le_bytes())?;
         }
         let width = self.film.width() as usize;
-        write_pixels(self.film.raw(), width, sink)?;
+        let (sums, counts) = self.film.raw();
+        write_pixels((|i| sums[i], counts), width, sink)?;
         match self.active {
             // Adaptive: the halves' sums and counts, and the pixels' flags.
             Some(active) if self.film.has_halves() => {
                 sink(&[1])?;
-                write_pixels(self.film.raw_odd(), width, sink)?;
+                let (odd_sums, odd_counts) = self.film.raw_odd();
+                write_pixels((|i| odd_sums[i], odd_counts), width, sink)?;
                 let flags: Vec<u8> = active.iter().map(|&a| u8::from(a)).collect();
                 sink(&flags)?;
             }
@@ -54,7 +56,8 @@ impl CheckpointView<'_> {
             sink(&[layers.bits()])?;
             let counts = self.film.raw().1;
             for layer in Layer::ALL.into_iter().filter(|&l| layers.has(l)) {
-                write_pixels((&self.film.raw_layer(layer), counts), width, sink)?;
+                let sum = |i| self.film.layer_sum(layer, i);
+                write_pixels((sum, counts), width, sink)?;
             }
         }
         Ok(())
@@ -195,7 +198,13 @@ impl Checkpoint {
             if layer_counts != film.raw().1 {
                 return Err("bad pixel data of a feature layer");
             }
-            film = film.with_layer(*layer, sums).ok_or("bad pixel data")?;
+            // Another version's layers may be held otherwise: say so,
+            // rather than that the data is bad.
+            let why = match u.head.renderer_id == super::RENDERER_ID {
+                true => "bad pixel data",
+                false => "feature layers written by another version of lumen",
+            };
+            film = film.with_layer(*layer, sums).ok_or(why)?;
         }
         let (film, active) = match u.odd {
             None => (film, None),

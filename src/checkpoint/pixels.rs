@@ -17,9 +17,11 @@ use rayon::prelude::*;
 
 /// Feeds the pixels of a film `width` pixels wide to `sink`, as
 /// [`Pixels::split`] finds them: every count (`u32`), then the sums row by
-/// row, each row after its byte length (`u32`).
+/// row, each row after its byte length (`u32`). `sum(i)` is pixel `i`'s
+/// sum (a layer kept otherwise than as [`Sum`]s is converted a pixel at a
+/// time, taking no memory of the image's size).
 pub(super) fn write_pixels(
-    (sums, counts): (&[Sum], &[u32]),
+    (sum, counts): (impl Fn(usize) -> Sum + Sync, &[u32]),
     width: usize,
     sink: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
@@ -36,13 +38,17 @@ pub(super) fn write_pixels(
     const BATCH_PIXELS: usize = 1 << 16;
     let width = width.max(1);
     let batch_rows = (BATCH_PIXELS / width).max(1);
-    for batch in sums.chunks(width * batch_rows) {
-        let rows: Vec<Vec<u8>> = batch
-            .par_chunks(width)
-            .map(|row| {
+    let n = counts.len();
+    for batch in (0..n).step_by(width * batch_rows) {
+        let end = (batch + width * batch_rows).min(n);
+        let starts: Vec<usize> = (batch..end).step_by(width).collect();
+        let rows: Vec<Vec<u8>> = starts
+            .into_par_iter()
+            .map(|start| {
+                let row = start..(start + width).min(end);
                 let mut out = Vec::with_capacity(row.len() * (2 + 3 * 16));
-                for sum in row {
-                    put_sum(&mut out, sum);
+                for i in row {
+                    put_sum(&mut out, &sum(i));
                 }
                 out
             })
@@ -227,6 +233,11 @@ impl<'a> Pixels<'a> {
     }
 
     /// The sums and counts, decoded into new vectors (rows in parallel).
+    /// Every pixel's count, row by row.
+    pub(crate) fn counts(&self) -> impl Iterator<Item = u32> + '_ {
+        (self.counts.chunks_exact(4)).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
+    }
+
     pub(super) fn decode(&self) -> Result<(Vec<Sum>, Vec<u32>), &'static str> {
         let n = self.width * self.rows.len();
         let (mut sums, mut counts) = (vec![Sum::ZERO; n], vec![0u32; n]);
@@ -312,7 +323,7 @@ mod tests {
         }
         let width = 20;
         let mut bytes = Vec::new();
-        write_pixels((&sums, &vec![7; sums.len()]), width, &mut |b| {
+        write_pixels((|i| sums[i], &vec![7; sums.len()]), width, &mut |b| {
             bytes.extend_from_slice(b);
             Ok(())
         })

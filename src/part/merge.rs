@@ -4,11 +4,12 @@
 //! the film of the image and at most three parts' bytes, whatever the
 //! number of parts.
 
+use crate::aov::{Layer, Layers};
 use crate::checkpoint::{
     describe_differences, same_render, Checkpoint, CheckpointError, PixelError, Unpacked,
     HEADER_LEN,
 };
-use crate::film::{Film, Sum};
+use crate::film::{Film, PackedError, Sum};
 use crate::render::RenderStats;
 use crate::scene::desc::RenderDesc;
 use crate::tile::Tile;
@@ -437,7 +438,13 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
     };
     let aovs = render.written_aovs();
     let layers = crate::aov::Layers::for_aovs(&aovs);
-    let bytes = Film::bytes(w, h, false) + Film::layer_bytes(w, h, layers);
+    // With the albedo or normal, a part's layer is read into a block of
+    // 128-bit sums before it is packed.
+    let scratch = match layers.meets(Film::PACKED) {
+        true => Film::layer_bytes(w, h, Layers::of(Layer::Depth)),
+        false => 0,
+    };
+    let bytes = Film::bytes(w, h, false) + Film::layer_bytes(w, h, layers) + scratch;
     crate::memory::check(bytes, "the film").map_err(|_| too_large())?;
     let film = Film::try_new(w, h)
         .and_then(|f| f.try_with_layers(layers))
@@ -485,20 +492,40 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
                 layer.name()
             ),
         };
+        let same_counts = |scratch: &[u32]| {
+            if scratch.iter().copied().ne(part.pixels.counts()) {
+                return Err(format!(
+                    "its {} layer's counts are not its pixels'",
+                    layer.name()
+                ));
+            }
+            Ok(())
+        };
         if Film::packs(*layer) {
-            // Read into a scratch block, then checked and added.
+            // Read into a scratch block (counted with the film against
+            // free memory), then checked and added.
             let w = (x1 - x0).max(1);
-            let mut sums = vec![Sum::ZERO; scratch.len()];
+            let mut sums = Vec::new();
+            sums.try_reserve_exact(scratch.len())
+                .map_err(|_| format!("its {} layer does not fit in memory", layer.name()))?;
+            sums.resize(scratch.len(), Sum::ZERO);
             let rows = sums.par_chunks_mut(w).zip(scratch.par_chunks_mut(w));
             pixels.add_rows(rows, None).map_err(named)?;
+            same_counts(&scratch)?;
             let origin = (x0, tile.y0 as usize);
             film.add_packed_layer(*layer, (origin, w), &sums, &scratch)
-                .map_err(|(x, y)| {
+                .map_err(|(x, y, problem)| {
+                    let message = match problem {
+                        PackedError::NotSamples => "is not a sum of its samples' values",
+                        PackedError::Overflow => {
+                            "would pass what a pixel's sum holds with the other parts'"
+                        }
+                    };
                     named((
                         y,
                         PixelError::Pixel {
                             x,
-                            message: "is not a sum of its samples' values".into(),
+                            message: message.into(),
                         },
                     ))
                 })?;
@@ -510,6 +537,7 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
             .zip(scratch.par_chunks_mut((x1 - x0).max(1)))
             .map(|(row, counts)| (&mut row.layer_sums[*layer as usize][x0..x1], counts));
         pixels.add_rows(rows, None).map_err(named)?;
+        same_counts(&scratch)?;
     }
     let rows = (film.rows_mut())
         .skip(tile.y0 as usize)

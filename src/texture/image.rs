@@ -320,8 +320,13 @@ impl Image {
         let n = self.width * self.height;
         // At most 65,536 texels looked at, spread over the image: the
         // fraction is then known to within a few tenths of a percent, and
-        // the look takes a fraction of a millisecond.
-        let step = (n / 65_536).max(1);
+        // the look takes a fraction of a millisecond. An odd step, so that
+        // on an image a power of two wide the texels looked at do not
+        // fall in a few columns.
+        let step = match n.div_ceil(65_536) {
+            0 | 1 => 1,
+            step => step | 1,
+        };
         let (mut looked, mut inward) = (0usize, 0usize);
         for i in (0..n).step_by(step) {
             let [_, _, b, _] = self.texel_rgba(i % self.width, i / self.width, false);
