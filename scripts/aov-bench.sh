@@ -53,31 +53,32 @@ whole() {
     seconds "$out/$name.txt" >"$out/$name.s"
 }
 
+# Runs round $1's two renders (the rest of the arguments, without and
+# with the layers): one after the other with SEQUENTIAL=1, the order
+# swapped every round; otherwise at once, a core each, the cores swapped.
+run_round() {
+    round=$1
+    shift
+    if [ "${SEQUENTIAL:-0}" = 1 ] && [ $((round % 2)) = 1 ]; then
+        whole off "$@"
+        whole on "$@" --aov "$aovs"
+    elif [ "${SEQUENTIAL:-0}" = 1 ]; then
+        whole on "$@" --aov "$aovs"
+        whole off "$@"
+    else
+        ca=$((round % 2))
+        timed "$ca" off "$@" &
+        pa=$!
+        timed $((1 - ca)) on "$@" --aov "$aovs" &
+        pb=$!
+        wait "$pa" "$pb"
+    fi
+}
+
 ratios=
 i=1
-while [ "${SEQUENTIAL:-0}" = 1 ] && [ "$i" -le "$rounds" ]; do
-    if [ $((i % 2)) = 1 ]; then
-        whole off "$@"
-        whole on "$@" --aov "$aovs"
-    else
-        whole on "$@" --aov "$aovs"
-        whole off "$@"
-    fi
-    ta=$(cat "$out/off.s")
-    tb=$(cat "$out/on.s")
-    r=$(ratio "$ta" "$tb")
-    echo "round $i: without $ta s  with $tb s  speed with/without $r"
-    ratios="$ratios $r"
-    i=$((i + 1))
-done
-while [ "${SEQUENTIAL:-0}" != 1 ] && [ "$i" -le "$rounds" ]; do
-    ca=$((i % 2))
-    cb=$((1 - ca))
-    timed "$ca" off "$@" &
-    pa=$!
-    timed "$cb" on "$@" --aov "$aovs" &
-    pb=$!
-    wait "$pa" "$pb"
+while [ "$i" -le "$rounds" ]; do
+    run_round "$i" "$@"
     ta=$(cat "$out/off.s")
     tb=$(cat "$out/on.s")
     r=$(ratio "$ta" "$tb")
