@@ -196,6 +196,16 @@ pub enum PackedError {
     Overflow,
 }
 
+impl PackedError {
+    /// What is wrong with the pixel, following "pixel (x, y) ".
+    pub fn message(self) -> &'static str {
+        match self {
+            PackedError::NotSamples => "is not a sum of its samples' values",
+            PackedError::Overflow => "would pass what a pixel's sum holds with the other parts'",
+        }
+    }
+}
+
 /// The place of `layer`'s channels in a pixel's [`UnitSums`], if they are
 /// kept there.
 fn unit_offset(layer: Layer) -> Option<usize> {
@@ -510,16 +520,11 @@ impl Film {
         Some(self)
     }
 
-    /// Whether the film keeps `layer` in its [`UnitSums`] (the albedo and
-    /// normal), where [`RowMut::layer_sums`] holds nothing of it.
-    pub fn packs(layer: Layer) -> bool {
-        unit_offset(layer).is_some()
-    }
-
-    /// The layers [`Film::packs`].
+    /// The layers the film keeps in its [`UnitSums`] (the albedo and
+    /// normal), where [`RowMut::layer_sums`] holds nothing of them.
     pub const PACKED: Layers = UNIT_LAYERS;
 
-    /// Adds `sums`, sums of `layer` (one [`Film::packs`]) over a block of
+    /// Adds `sums`, sums of `layer` (one of [`Film::PACKED`]) over a block of
     /// pixels `width` wide whose top left pixel is `origin`, of `counts`
     /// samples each, to this film's (which keeps the layer). An error
     /// names the block's first pixel, `(x, y)` within it, whose sum is not

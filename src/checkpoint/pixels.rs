@@ -232,12 +232,12 @@ impl<'a> Pixels<'a> {
         Ok(counted)
     }
 
-    /// The sums and counts, decoded into new vectors (rows in parallel).
     /// Every pixel's count, row by row.
     pub(crate) fn counts(&self) -> impl Iterator<Item = u32> + '_ {
         (self.counts.chunks_exact(4)).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
     }
 
+    /// The sums and counts, decoded into new vectors (rows in parallel).
     pub(super) fn decode(&self) -> Result<(Vec<Sum>, Vec<u32>), &'static str> {
         let n = self.width * self.rows.len();
         let (mut sums, mut counts) = (vec![Sum::ZERO; n], vec![0u32; n]);

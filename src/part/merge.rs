@@ -4,12 +4,11 @@
 //! the film of the image and at most three parts' bytes, whatever the
 //! number of parts.
 
-use crate::aov::{Layer, Layers};
 use crate::checkpoint::{
     describe_differences, same_render, Checkpoint, CheckpointError, PixelError, Unpacked,
     HEADER_LEN,
 };
-use crate::film::{Film, PackedError, Sum};
+use crate::film::{Film, Sum};
 use crate::render::RenderStats;
 use crate::scene::desc::RenderDesc;
 use crate::tile::Tile;
@@ -441,7 +440,7 @@ fn start(path: &Path, part: &Checkpoint) -> Result<Merged, MergeError> {
     // With the albedo or normal, a part's layer is read into a block of
     // 128-bit sums before it is packed.
     let scratch = match layers.meets(Film::PACKED) {
-        true => Film::layer_bytes(w, h, Layers::of(Layer::Depth)),
+        true => u64::from(w) * u64::from(h) * std::mem::size_of::<Sum>() as u64,
         false => 0,
     };
     let bytes = Film::bytes(w, h, false) + Film::layer_bytes(w, h, layers) + scratch;
@@ -501,7 +500,7 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
             }
             Ok(())
         };
-        if Film::packs(*layer) {
+        if Film::PACKED.has(*layer) {
             // Read into a scratch block (counted with the film against
             // free memory), then checked and added.
             let w = (x1 - x0).max(1);
@@ -515,19 +514,8 @@ fn add_pixels(film: &mut Film, part: &Unpacked, done: u32) -> Result<u64, String
             let origin = (x0, tile.y0 as usize);
             film.add_packed_layer(*layer, (origin, w), &sums, &scratch)
                 .map_err(|(x, y, problem)| {
-                    let message = match problem {
-                        PackedError::NotSamples => "is not a sum of its samples' values",
-                        PackedError::Overflow => {
-                            "would pass what a pixel's sum holds with the other parts'"
-                        }
-                    };
-                    named((
-                        y,
-                        PixelError::Pixel {
-                            x,
-                            message: message.into(),
-                        },
-                    ))
+                    let message = problem.message().into();
+                    named((y, PixelError::Pixel { x, message }))
                 })?;
             continue;
         }
